@@ -1,0 +1,144 @@
+//! Batched steady-state evaluation: many operating points, one or many parameter sets.
+//!
+//! These loops are what the Python API calls (with the GIL released) for characteristics, the
+//! parameter study and the fit.
+
+use crate::error::CoreError;
+use crate::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode};
+use crate::scalar::{Dual, Scalar};
+
+/// Column-wise steady states of the Hrovat & Tobler model.
+#[derive(Debug, Clone, Default)]
+pub struct HtSteadyColumns {
+    pub flow_m3_s: Vec<f64>,
+    pub stator_speed_rad_s: Vec<f64>,
+    pub pump_torque_nm: Vec<f64>,
+    pub turbine_torque_nm: Vec<f64>,
+    pub stator_torque_nm: Vec<f64>,
+    /// [`StatorMode`] as an integer, or −1 where the point has no steady state (lenient mode).
+    pub stator_mode: Vec<i8>,
+}
+
+impl HtSteadyColumns {
+    fn with_capacity(n: usize) -> Self {
+        let v = || Vec::with_capacity(n);
+        Self { flow_m3_s: v(), stator_speed_rad_s: v(), pump_torque_nm: v(), turbine_torque_nm: v(), stator_torque_nm: v(), stator_mode: Vec::with_capacity(n) }
+    }
+}
+
+/// A failed point: its index in the batch and the reason.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointError {
+    pub index: usize,
+    pub error: CoreError,
+}
+
+/// Steady states at `pump[i], turbine[i]` with parameter set `geometry[i]` (or `geometry[0]`
+/// for every point when one set is given). `strict` stops at the first point without a steady
+/// state; otherwise such points are NaN with mode −1.
+pub fn ht_steady_states(
+    geometry: &[HtGeometry<f64>],
+    pump_speed_rad_s: &[f64],
+    turbine_speed_rad_s: &[f64],
+    strict: bool,
+) -> Result<HtSteadyColumns, PointError> {
+    let n = pump_speed_rad_s.len();
+    assert!(turbine_speed_rad_s.len() == n && (geometry.len() == 1 || geometry.len() == n), "batch shapes are checked by the caller");
+    let mut out = HtSteadyColumns::with_capacity(n);
+    for i in 0..n {
+        let g = &geometry[if geometry.len() == 1 { 0 } else { i }];
+        match steady_state(g, pump_speed_rad_s[i], turbine_speed_rad_s[i]) {
+            Ok(s) => {
+                out.flow_m3_s.push(s.flow_m3_s);
+                out.stator_speed_rad_s.push(s.stator_speed_rad_s);
+                out.pump_torque_nm.push(s.pump_torque_nm);
+                out.turbine_torque_nm.push(s.turbine_torque_nm);
+                out.stator_torque_nm.push(s.stator_torque_nm);
+                out.stator_mode.push(s.mode as i8);
+            }
+            Err(error) if strict => return Err(PointError { index: i, error }),
+            Err(_) => {
+                for col in [&mut out.flow_m3_s, &mut out.stator_speed_rad_s, &mut out.pump_torque_nm, &mut out.turbine_torque_nm, &mut out.stator_torque_nm] {
+                    col.push(f64::NAN);
+                }
+                out.stator_mode.push(-1);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Torque ratio and capacity factor at the given speed ratios (pump speed `pump_speed_rad_s`),
+/// with their exact derivatives with respect to the parameters `free`.
+///
+/// Returns `(tr, cf, d_tr, d_cf)`; the derivative matrices are row-major, `n_points × free.len()`.
+/// Points without a steady state are NaN, which a least-squares fit must treat as a failure.
+pub fn ht_ratio_gradients(
+    geometry: &HtGeometry<f64>,
+    pump_speed_rad_s: f64,
+    speed_ratio: &[f64],
+    free: &[HtParam],
+) -> (Vec<f64>, Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (n, k) = (speed_ratio.len(), free.len());
+    let mut tr = vec![f64::NAN; n];
+    let mut cf = vec![f64::NAN; n];
+    let mut dtr = vec![f64::NAN; n * k];
+    let mut dcf = vec![f64::NAN; n * k];
+    let wp = Dual::cst(pump_speed_rad_s);
+    let w2 = pump_speed_rad_s * pump_speed_rad_s;
+    for (i, &sr) in speed_ratio.iter().enumerate() {
+        let wt = Dual::cst(sr * pump_speed_rad_s);
+        // one forward pass per free parameter; without free parameters, one plain pass
+        let seeds: Vec<HtGeometry<Dual>> = if k == 0 { vec![geometry.to_dual()] } else { free.iter().map(|&p| geometry.seeded(p)).collect() };
+        for (j, g) in seeds.iter().enumerate() {
+            let Ok(s) = steady_state(g, wp, wt) else { break };
+            let (t, c) = (s.torque_ratio(), s.pump_torque_nm);
+            tr[i] = t.v;
+            cf[i] = c.v / w2;
+            if k > 0 {
+                dtr[i * k + j] = if s.mode == StatorMode::NoFlow { 0.0 } else { t.d };
+                dcf[i * k + j] = c.d / w2;
+            }
+        }
+    }
+    (tr, cf, dtr, dcf)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn batch_matches_pointwise_and_reports_failures() {
+        let g = HtGeometry::appendix_d();
+        let wp = [200.0, 200.0, 200.0];
+        let wt = [0.0, 100.0, 260.0];
+        let lenient = ht_steady_states(&[g], &wp, &wt, false).unwrap();
+        let one = steady_state(&g, 200.0, 100.0).unwrap();
+        assert_eq!(lenient.pump_torque_nm[1], one.pump_torque_nm);
+        assert_eq!(lenient.stator_mode[2], -1);
+        assert!(lenient.flow_m3_s[2].is_nan());
+        let strict = ht_steady_states(&[g], &wp, &wt, true).unwrap_err();
+        assert_eq!(strict.index, 2);
+        assert_eq!(strict.error.field, "speed_ratio");
+    }
+
+    #[test]
+    fn ratio_gradients_match_finite_differences() {
+        let g = HtGeometry::appendix_d();
+        let sr = [0.0, 0.4, 0.8, 0.95];
+        let free = [HtParam::PumpExitAngle, HtParam::FrictionLoss, HtParam::PumpExitRadius];
+        let (tr, cf, dtr, dcf) = ht_ratio_gradients(&g, 209.4, &sr, &free);
+        for (j, p) in free.iter().enumerate() {
+            let h = 1e-7;
+            let mut v = g.values;
+            v[p.index()] += h;
+            let (tr2, cf2, _, _) = ht_ratio_gradients(&HtGeometry { values: v }, 209.4, &sr, &[]);
+            for i in 0..sr.len() {
+                let (fd_tr, fd_cf) = ((tr2[i] - tr[i]) / h, (cf2[i] - cf[i]) / h);
+                assert!((dtr[i * 3 + j] - fd_tr).abs() < 1e-5 * (1.0 + fd_tr.abs()), "{} SR {}: {} vs {fd_tr}", p.key(), sr[i], dtr[i * 3 + j]);
+                assert!((dcf[i * 3 + j] - fd_cf).abs() < 1e-5 * (1e-3 + fd_cf.abs()), "{} SR {}", p.key(), sr[i]);
+            }
+        }
+    }
+}

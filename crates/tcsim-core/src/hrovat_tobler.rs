@@ -1,0 +1,625 @@
+//! Hrovat & Tobler torque-converter model: the steady state in closed form.
+//!
+//! References: D. Hrovat and W. E. Tobler (1985), "Bond graph modelling and computer simulation
+//! of automotive torque converters", J. Franklin Inst. 319(1/2):93–114; Li & Sundén (2016)
+//! §2.2.2, eqs 2.12–2.25. Signs and units: tcsim physics notes §2 and §4.
+//!
+//! With the left-hand sides of eqs 2.12–2.15 zero and Q > 0, the right-hand side of eq 2.15 is
+//! a quadratic in `q = Q/A`: the Euler head gives a constant and a linear term, the shock
+//! velocities (eqs 2.20–2.22) are affine in q, friction (eq 2.19 with
+//! `|V_re,x|² = q²(1 + tan²α_x)`) adds to q². The positive root gives the flow; eqs 2.12–2.14 give
+//! the torques.
+//!
+//! * **Locked stator** (ω_s = 0): the quadratic's leading coefficient is negative, so there is one
+//!   positive root while the head at zero flow exceeds the shock losses.
+//! * **Free-wheeling stator** (T_s = 0): eq 2.14 with Q > 0 gives ω_s affine in q,
+//!   `ω_s = (ω_t R_t² + q (R_t tan α_t − R_s tan α_s)) / R_s²`, so eq 2.15 stays a quadratic in
+//!   q. The branch that continues the locked solution at the coupling point is the larger root.
+//!   T_p + T_t = 0 there, so TR = 1 exactly.
+//! * **No flow.** Close to SR = 1 the free-wheeling quadratic loses its real roots: the shock
+//!   terms of eq 2.19 do not vanish as Q → 0 (they carry sgn Q, not Q), so the model has no
+//!   steady state with a small positive flow. tcsim then reports Q = 0 and zero torques (the
+//!   Filippov solution of the sgn Q discontinuity), TR = 1 by continuity, and the stator speed,
+//!   which the equations leave undetermined at Q = 0, equal to the turbine speed. At SR = 1
+//!   this is physics notes §4's ω_s = ω_p, Q = 0.
+//!
+//! The solvers are generic over [`Scalar`] so that the same code yields exact derivatives.
+
+use crate::error::{CoreError, CoreResult};
+use crate::scalar::{Dual, Scalar};
+
+/// The fifteen parameters of Table 2.2 that fix the steady state, in SI units (angles in
+/// radians). The order is the order of [`HtParam::ALL`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct HtGeometry<T> {
+    pub values: [T; N_PARAMS],
+}
+
+pub const N_PARAMS: usize = 15;
+
+/// Names of the steady-state parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HtParam {
+    FlowArea,
+    FluidDensity,
+    PumpExitRadius,
+    TurbineExitRadius,
+    StatorExitRadius,
+    PumpExitAngle,
+    TurbineExitAngle,
+    StatorExitAngle,
+    PumpInletAngle,
+    TurbineInletAngle,
+    StatorInletAngle,
+    PumpShockLoss,
+    TurbineShockLoss,
+    StatorShockLoss,
+    FrictionLoss,
+}
+
+impl HtParam {
+    pub const ALL: [HtParam; N_PARAMS] = [
+        Self::FlowArea,
+        Self::FluidDensity,
+        Self::PumpExitRadius,
+        Self::TurbineExitRadius,
+        Self::StatorExitRadius,
+        Self::PumpExitAngle,
+        Self::TurbineExitAngle,
+        Self::StatorExitAngle,
+        Self::PumpInletAngle,
+        Self::TurbineInletAngle,
+        Self::StatorInletAngle,
+        Self::PumpShockLoss,
+        Self::TurbineShockLoss,
+        Self::StatorShockLoss,
+        Self::FrictionLoss,
+    ];
+
+    /// Name with unit, as in the converter TOML `[geometry]` section, except that the core
+    /// holds angles in radians (`_rad`) where files hold degrees (`_deg`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Self::FlowArea => "flow_area_m2",
+            Self::FluidDensity => "fluid_density_kg_m3",
+            Self::PumpExitRadius => "pump_exit_radius_m",
+            Self::TurbineExitRadius => "turbine_exit_radius_m",
+            Self::StatorExitRadius => "stator_exit_radius_m",
+            Self::PumpExitAngle => "pump_exit_angle_rad",
+            Self::TurbineExitAngle => "turbine_exit_angle_rad",
+            Self::StatorExitAngle => "stator_exit_angle_rad",
+            Self::PumpInletAngle => "pump_inlet_angle_rad",
+            Self::TurbineInletAngle => "turbine_inlet_angle_rad",
+            Self::StatorInletAngle => "stator_inlet_angle_rad",
+            Self::PumpShockLoss => "pump_shock_loss",
+            Self::TurbineShockLoss => "turbine_shock_loss",
+            Self::StatorShockLoss => "stator_shock_loss",
+            Self::FrictionLoss => "friction_loss",
+        }
+    }
+
+    pub fn index(self) -> usize {
+        self as usize
+    }
+
+    fn is_angle(self) -> bool {
+        (Self::PumpExitAngle.index()..=Self::StatorInletAngle.index()).contains(&self.index())
+    }
+}
+
+impl<T: Scalar> HtGeometry<T> {
+    pub fn get(&self, p: HtParam) -> T {
+        self.values[p.index()]
+    }
+}
+
+impl HtGeometry<f64> {
+    /// Check each parameter's admissible range and return the geometry.
+    pub fn new(values: [f64; N_PARAMS]) -> CoreResult<Self> {
+        for p in HtParam::ALL {
+            let v = values[p.index()];
+            let ok = if p.is_angle() {
+                v.is_finite() && v.abs() < std::f64::consts::FRAC_PI_2
+            } else if matches!(p, HtParam::PumpShockLoss | HtParam::TurbineShockLoss | HtParam::StatorShockLoss | HtParam::FrictionLoss) {
+                v.is_finite() && v >= 0.0
+            } else {
+                v.is_finite() && v > 0.0
+            };
+            if !ok {
+                let expected = if p.is_angle() {
+                    "an angle strictly between -90 and 90 degrees"
+                } else if p.index() >= HtParam::PumpShockLoss.index() {
+                    "a finite, non-negative loss coefficient"
+                } else {
+                    "a finite, positive value"
+                };
+                return Err(CoreError::new(p.key(), v, expected));
+            }
+        }
+        let g = Self { values };
+        let dissipation = g.dissipation_coefficient();
+        if dissipation <= 0.0 {
+            return Err(CoreError::new(
+                "friction_loss",
+                values[HtParam::FrictionLoss.index()],
+                "a positive friction loss or shock losses with non-zero incidence: without losses the flow is unbounded",
+            ));
+        }
+        Ok(g)
+    }
+
+    /// Appendix D reference values (Li & Sundén 2016, Table D.1).
+    pub fn appendix_d() -> Self {
+        let d = |deg: f64| deg.to_radians();
+        Self::new([0.01, 840.0, 0.12, 0.065, 0.06, d(-20.0), d(-50.0), d(60.0), d(-50.0), d(55.0), d(15.0), 1.0, 1.0, 1.0, 0.2]).unwrap()
+    }
+
+    /// Seed parameter `p` for a derivative.
+    pub fn seeded(&self, p: HtParam) -> HtGeometry<Dual> {
+        let mut values = self.values.map(Dual::cst);
+        values[p.index()].d = 1.0;
+        HtGeometry { values }
+    }
+
+    pub fn to_dual(&self) -> HtGeometry<Dual> {
+        HtGeometry { values: self.values.map(Dual::cst) }
+    }
+
+    /// The coefficient of −q² in the locked-stator residual divided by ρ/2; positive when the
+    /// losses bound the flow.
+    fn dissipation_coefficient(&self) -> f64 {
+        let t = |p: HtParam| self.get(p).tan();
+        let b = [
+            t(HtParam::StatorExitAngle) - t(HtParam::PumpInletAngle),
+            t(HtParam::PumpExitAngle) - t(HtParam::TurbineInletAngle),
+            t(HtParam::TurbineExitAngle) - t(HtParam::StatorInletAngle),
+        ];
+        let c = [self.get(HtParam::PumpShockLoss), self.get(HtParam::TurbineShockLoss), self.get(HtParam::StatorShockLoss)];
+        let friction = 3.0 + t(HtParam::PumpExitAngle).powi(2) + t(HtParam::TurbineExitAngle).powi(2) + t(HtParam::StatorExitAngle).powi(2);
+        c.iter().zip(b).map(|(c, b)| c * b * b).sum::<f64>() + self.get(HtParam::FrictionLoss) * friction
+    }
+}
+
+/// A polynomial of degree ≤ 2 in q: `c[0] + c[1] q + c[2] q²`.
+#[derive(Debug, Clone, Copy)]
+struct Quad<T> {
+    c: [T; 3],
+}
+
+impl<T: Scalar> Quad<T> {
+    fn cst(v: T) -> Self {
+        Self { c: [v, T::cst(0.0), T::cst(0.0)] }
+    }
+    fn affine(c0: T, c1: T) -> Self {
+        Self { c: [c0, c1, T::cst(0.0)] }
+    }
+    fn q() -> Self {
+        Self::affine(T::cst(0.0), T::cst(1.0))
+    }
+    fn add(self, o: Self) -> Self {
+        Self { c: [self.c[0] + o.c[0], self.c[1] + o.c[1], self.c[2] + o.c[2]] }
+    }
+    fn sub(self, o: Self) -> Self {
+        self.add(o.times(T::cst(-1.0)))
+    }
+    fn times(self, k: T) -> Self {
+        Self { c: self.c.map(|x| x * k) }
+    }
+    /// Product of two affine polynomials (the q² terms of the factors must be zero).
+    fn mul_affine(self, o: Self) -> Self {
+        debug_assert!(self.c[2].re() == 0.0 && o.c[2].re() == 0.0);
+        Self { c: [self.c[0] * o.c[0], self.c[0] * o.c[1] + self.c[1] * o.c[0], self.c[1] * o.c[1]] }
+    }
+    fn eval(self, q: T) -> T {
+        self.c[0] + q * (self.c[1] + q * self.c[2])
+    }
+}
+
+/// Largest real root of `c0 + c1 q + c2 q²`, computed without cancellation; None if no real root.
+fn largest_real_root<T: Scalar>(p: Quad<T>) -> Option<T> {
+    let [c0, c1, c2] = p.c;
+    if c2.re() == 0.0 {
+        return if c1.re() == 0.0 { None } else { Some(-c0 / c1) };
+    }
+    let disc = c1 * c1 - T::cst(4.0) * c2 * c0;
+    if disc.re() < 0.0 {
+        return None;
+    }
+    let s = disc.sqrt();
+    // w = -(c1 + sign(c1) √disc)/2; roots w/c2 and c0/w
+    let w = if c1.re() >= 0.0 { -(c1 + s).scale(0.5) } else { (s - c1).scale(0.5) };
+    if w.re() == 0.0 {
+        return Some(T::cst(0.0)); // c0 = c1 = 0: double root at zero
+    }
+    let (r1, r2) = (w / c2, c0 / w);
+    Some(if r1.re() >= r2.re() { r1 } else { r2 })
+}
+
+/// Mode of the stator one-way clutch at a steady state.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StatorMode {
+    /// Clutch holding, ω_s = 0, T_s ≥ 0.
+    Locked = 0,
+    /// Clutch released, T_s = 0, TR = 1.
+    FreeWheeling = 1,
+    /// Free-wheeling with no flowing steady state (near SR = 1): Q = 0, zero torque.
+    NoFlow = 2,
+}
+
+/// A steady state of the Hrovat & Tobler model. Torques follow physics notes §2: the pump and
+/// stator torques are the external torques on those elements, the turbine torque is the torque
+/// delivered to the transmission (−T_t).
+#[derive(Debug, Clone, Copy)]
+pub struct HtSteadyState<T> {
+    pub flow_m3_s: T,
+    pub stator_speed_rad_s: T,
+    pub pump_torque_nm: T,
+    pub turbine_torque_nm: T,
+    pub stator_torque_nm: T,
+    pub mode: StatorMode,
+}
+
+impl<T: Scalar> HtSteadyState<T> {
+    /// TR = delivered turbine torque / pump torque; 1 in the no-flow state by continuity.
+    pub fn torque_ratio(&self) -> T {
+        if self.mode == StatorMode::NoFlow {
+            T::cst(1.0)
+        } else {
+            self.turbine_torque_nm / self.pump_torque_nm
+        }
+    }
+}
+
+/// The right-hand side of eq 2.15 at steady state as a quadratic in q, for a stator speed that is
+/// affine in q (zero when locked).
+struct Balance<T> {
+    residual: Quad<T>,
+    stator_speed: Quad<T>,
+}
+
+fn tangents<T: Scalar>(g: &HtGeometry<T>) -> [T; 6] {
+    use HtParam::*;
+    [PumpExitAngle, TurbineExitAngle, StatorExitAngle, PumpInletAngle, TurbineInletAngle, StatorInletAngle].map(|p| g.get(p).tan())
+}
+
+fn balance<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
+    use HtParam::*;
+    let rho = g.get(FluidDensity);
+    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
+    let [tp, tt, ts, tpp, ttt, tss] = tangents(g);
+    let (cwp, cwt, ws) = (Quad::cst(wp), Quad::cst(wt), stator_speed);
+    let q = Quad::q();
+    // Euler head, eq 2.15 first three lines
+    let head0 = Quad::cst(rp * rp * wp * wp + rt * rt * wt * wt - rp * rp * wt * wp)
+        .add(ws.mul_affine(ws).times(rs * rs))
+        .sub(ws.times(rs * rs * wp + rt * rt * wt));
+    let head1 = q.mul_affine(
+        Quad::cst(wp * (rp * tp - rs * ts) + wt * (rt * tt - rp * tp)).add(ws.times(rs * ts - rt * tt)),
+    );
+    // shock velocities, eqs 2.20–2.22
+    let sh_p = ws.sub(cwp).times(rs).add(q.times(ts - tpp));
+    let sh_t = cwp.sub(cwt).times(rp).add(q.times(tp - ttt));
+    let sh_s = cwt.sub(ws).times(rt).add(q.times(tt - tss));
+    let shock = sh_p
+        .mul_affine(sh_p)
+        .times(g.get(PumpShockLoss))
+        .add(sh_t.mul_affine(sh_t).times(g.get(TurbineShockLoss)))
+        .add(sh_s.mul_affine(sh_s).times(g.get(StatorShockLoss)));
+    // friction, eqs 2.19 and 2.23–2.25: Σ|V_re,x|² = q² Σ(1 + tan²α_x)
+    let one = T::cst(1.0);
+    let friction = q.mul_affine(q).times(g.get(FrictionLoss) * (one + tp * tp + one + tt * tt + one + ts * ts));
+    let residual = head0.add(head1).sub(shock.add(friction).times(T::cst(0.5))).times(rho);
+    Balance { residual, stator_speed }
+}
+
+/// Torques of eqs 2.12–2.14 with zero left-hand sides, at flow `q = Q/A`.
+fn torques<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, ws: T, q: T) -> (T, T, T) {
+    use HtParam::*;
+    let rho = g.get(FluidDensity);
+    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
+    let [tp, tt, ts, ..] = tangents(g);
+    let flow = q * g.get(FlowArea);
+    // angular momentum leaving each element per unit mass flow
+    let hp = wp * rp * rp + rp * tp * q;
+    let ht = wt * rt * rt + rt * tt * q;
+    let hs = ws * rs * rs + rs * ts * q;
+    let pump = rho * (hp - hs) * flow;
+    let turbine_external = rho * (ht - hp) * flow;
+    let stator = rho * (hs - ht) * flow;
+    (pump, -turbine_external, stator)
+}
+
+fn solve_mode<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, mode: StatorMode) -> Option<HtSteadyState<T>> {
+    use HtParam::*;
+    let stator_speed = match mode {
+        StatorMode::Locked => Quad::cst(T::cst(0.0)),
+        _ => {
+            let (rt, rs) = (g.get(TurbineExitRadius), g.get(StatorExitRadius));
+            let [_, tt, ts, ..] = tangents(g);
+            Quad::affine(wt * rt * rt / (rs * rs), (rt * tt - rs * ts) / (rs * rs))
+        }
+    };
+    let b = balance(g, wp, wt, stator_speed);
+    let q = largest_real_root(b.residual)?;
+    if q.re() <= 0.0 {
+        return None;
+    }
+    let ws = b.stator_speed.eval(q);
+    let (pump, turbine, stator) = torques(g, wp, wt, ws, q);
+    Some(HtSteadyState {
+        flow_m3_s: q * g.get(FlowArea),
+        stator_speed_rad_s: ws,
+        pump_torque_nm: pump,
+        turbine_torque_nm: turbine,
+        stator_torque_nm: if mode == StatorMode::Locked { stator } else { T::cst(0.0) },
+        mode,
+    })
+}
+
+/// Steady state with the stator held (ω_s = 0), whatever the sign of the holding torque.
+pub fn locked_steady_state<T: Scalar>(g: &HtGeometry<T>, pump_speed_rad_s: T, turbine_speed_rad_s: T) -> Option<HtSteadyState<T>> {
+    solve_mode(g, pump_speed_rad_s, turbine_speed_rad_s, StatorMode::Locked)
+}
+
+fn check_operating_point(wp: f64, wt: f64) -> CoreResult<()> {
+    if !(wp.is_finite() && wp > 0.0) {
+        return Err(CoreError::new("pump_speed_rad_s", wp, "a finite, positive pump speed"));
+    }
+    let sr = wt / wp;
+    if !(0.0..=1.0).contains(&sr) {
+        return Err(CoreError::new(
+            "speed_ratio",
+            sr,
+            "a speed ratio from 0 to 1: the Hrovat & Tobler steady state does not yet cover reverse turbine rotation or overrun",
+        ));
+    }
+    Ok(())
+}
+
+/// Steady state with the one-way clutch: locked while it holds (T_s ≥ 0), free-wheeling past the
+/// coupling point, no flow where the free-wheeling quadratic has no positive root.
+pub fn steady_state<T: Scalar>(g: &HtGeometry<T>, pump_speed_rad_s: T, turbine_speed_rad_s: T) -> CoreResult<HtSteadyState<T>> {
+    let (wp, wt) = (pump_speed_rad_s, turbine_speed_rad_s);
+    check_operating_point(wp.re(), wt.re())?;
+    let locked = locked_steady_state(g, wp, wt).ok_or_else(|| {
+        CoreError::new(
+            "speed_ratio",
+            wt.re() / wp.re(),
+            "an operating point where the locked-stator head exceeds the shock losses (no steady state with positive flow for these parameters)",
+        )
+    })?;
+    if locked.stator_torque_nm.re() >= 0.0 {
+        return Ok(locked);
+    }
+    match solve_mode(g, wp, wt, StatorMode::FreeWheeling) {
+        Some(free) if free.stator_speed_rad_s.re() >= 0.0 => Ok(free),
+        _ => Ok(HtSteadyState {
+            flow_m3_s: T::cst(0.0),
+            stator_speed_rad_s: wt,
+            pump_torque_nm: T::cst(0.0),
+            turbine_torque_nm: T::cst(0.0),
+            stator_torque_nm: T::cst(0.0),
+            mode: StatorMode::NoFlow,
+        }),
+    }
+}
+
+/// The coupling point: the speed ratio in (0, 1) where the locked-stator holding torque changes
+/// sign. The steady state is homogeneous in speed (q ∝ ω_p), so it does not depend on the pump
+/// speed. None if the holding torque keeps one sign on [0, 1].
+///
+/// Safeguarded Newton iteration on T_s(SR) with the exact derivative from [`Dual`].
+pub fn coupling_point(g: &HtGeometry<f64>) -> Option<f64> {
+    let gd = g.to_dual();
+    let ts = |sr: f64| -> Option<(f64, f64)> {
+        let s = locked_steady_state(&gd, Dual::cst(1.0), Dual::var(sr))?;
+        Some((s.stator_torque_nm.v, s.stator_torque_nm.d))
+    };
+    let (mut lo, mut hi) = (0.0, 1.0);
+    let (f_lo, _) = ts(lo)?;
+    let (f_hi, _) = ts(hi)?;
+    if f_lo <= 0.0 || f_hi >= 0.0 {
+        return None;
+    }
+    let mut x = lo + (hi - lo) * f_lo / (f_lo - f_hi);
+    for _ in 0..100 {
+        let (f, df) = ts(x)?;
+        if f > 0.0 {
+            lo = x;
+        } else {
+            hi = x;
+        }
+        let newton = x - f / df;
+        let next = if df != 0.0 && newton > lo && newton < hi { newton } else { 0.5 * (lo + hi) };
+        if (next - x).abs() <= 1e-15 || hi - lo <= 1e-15 {
+            return Some(next);
+        }
+        x = next;
+    }
+    Some(x)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const WP: f64 = 2000.0 * std::f64::consts::PI / 30.0;
+
+    fn eq_2_15_rhs(g: &HtGeometry<f64>, wp: f64, wt: f64, ws: f64, flow: f64) -> f64 {
+        // Direct transcription of the right-hand side of eq 2.15 with eqs 2.19–2.25, Q > 0.
+        use HtParam::*;
+        let v = |p: HtParam| g.get(p);
+        let rho = v(FluidDensity);
+        let q = flow / v(FlowArea);
+        let (rp, rt, rs) = (v(PumpExitRadius), v(TurbineExitRadius), v(StatorExitRadius));
+        let (tp, tt, ts) = (v(PumpExitAngle).tan(), v(TurbineExitAngle).tan(), v(StatorExitAngle).tan());
+        let (tpp, ttt, tss) = (v(PumpInletAngle).tan(), v(TurbineInletAngle).tan(), v(StatorInletAngle).tan());
+        let head = rho * (rp * rp * wp * wp + rt * rt * wt * wt + rs * rs * ws * ws - rs * rs * wp * ws - rp * rp * wt * wp - rt * rt * ws * wt)
+            + wp * rho * (rp * tp - rs * ts) * q
+            + wt * rho * (rt * tt - rp * tp) * q
+            + ws * rho * (rs * ts - rt * tt) * q;
+        let vsh = [rs * (ws - wp) + q * (ts - tpp), rp * (wp - wt) + q * (tp - ttt), rt * (wt - ws) + q * (tt - tss)];
+        let c = [v(PumpShockLoss), v(TurbineShockLoss), v(StatorShockLoss)];
+        let vre2: f64 = [tp, tt, ts].iter().map(|t| q * q * (1.0 + t * t)).sum();
+        let ploss = rho / 2.0 * (0..3).map(|i| c[i] * vsh[i] * vsh[i]).sum::<f64>() + rho * v(FrictionLoss) / 2.0 * vre2;
+        head - ploss
+    }
+
+    fn scale_of_head(wp: f64) -> f64 {
+        840.0 * 0.12f64.powi(2) * wp * wp
+    }
+
+    #[test]
+    fn closed_form_satisfies_eq_2_15_to_round_off() {
+        let g = HtGeometry::appendix_d();
+        for i in 0..=20 {
+            let wt = WP * i as f64 / 20.0;
+            let s = steady_state(&g, WP, wt).unwrap();
+            let r = eq_2_15_rhs(&g, WP, wt, s.stator_speed_rad_s, s.flow_m3_s);
+            if s.mode != StatorMode::NoFlow {
+                assert!(r.abs() < 1e-12 * scale_of_head(WP), "SR {}: residual {r}", i as f64 / 20.0);
+            }
+        }
+    }
+
+    #[test]
+    fn torques_sum_to_zero_at_a_locked_steady_state() {
+        let g = HtGeometry::appendix_d();
+        for sr in [0.0, 0.2, 0.5, 0.8] {
+            let s = steady_state(&g, WP, sr * WP).unwrap();
+            assert_eq!(s.mode, StatorMode::Locked);
+            // external torques: T_p + T_t + T_s with T_t = −delivered
+            let sum = s.pump_torque_nm - s.turbine_torque_nm + s.stator_torque_nm;
+            assert!(sum.abs() < 1e-12 * s.pump_torque_nm, "SR {sr}: {sum}");
+            assert!(s.stator_torque_nm > 0.0);
+        }
+    }
+
+    #[test]
+    fn appendix_d_reference_is_close_to_table_c1_at_stall() {
+        // physics.md §1: CF(0) ≈ 2.94e-3 N·m/(rad/s)², TR(0) ≈ 2.12 (Table C.1: 3.272e-3, 2.14)
+        let s = steady_state(&HtGeometry::appendix_d(), WP, 0.0).unwrap();
+        let cf = s.pump_torque_nm / (WP * WP);
+        assert!((cf - 2.944e-3).abs() < 1e-6, "{cf}");
+        assert!((s.torque_ratio() - 2.123).abs() < 1e-3);
+    }
+
+    #[test]
+    fn coupling_point_separates_locked_and_free_wheeling() {
+        let g = HtGeometry::appendix_d();
+        let sr_c = coupling_point(&g).unwrap();
+        assert!((0.85..0.95).contains(&sr_c), "{sr_c}");
+        let ts = |sr: f64| locked_steady_state(&g, WP, sr * WP).unwrap().stator_torque_nm;
+        assert!(ts(sr_c).abs() < 1e-9, "{}", ts(sr_c));
+        assert!(ts(sr_c - 1e-6) > 0.0 && ts(sr_c + 1e-6) < 0.0);
+        // below: locked and multiplying torque; above: free-wheeling with TR = 1
+        let below = steady_state(&g, WP, (sr_c - 1e-3) * WP).unwrap();
+        assert_eq!(below.mode, StatorMode::Locked);
+        assert!(below.torque_ratio() > 1.0);
+        for sr in [sr_c + 1e-3, 0.93, 0.95, 0.98] {
+            let s = steady_state(&g, WP, sr * WP).unwrap();
+            assert_eq!(s.mode, StatorMode::FreeWheeling, "SR {sr}");
+            assert!((s.torque_ratio() - 1.0).abs() < 1e-12, "SR {sr}: TR {}", s.torque_ratio());
+            assert!(s.stator_speed_rad_s > 0.0 && s.flow_m3_s > 0.0);
+        }
+        // the free-wheeling branch starts from the locked solution: continuous flow and torque
+        let (l, f) = (locked_steady_state(&g, WP, sr_c * WP).unwrap(), steady_state(&g, WP, (sr_c + 1e-9) * WP).unwrap());
+        assert!((l.flow_m3_s - f.flow_m3_s).abs() < 1e-7 && f.stator_speed_rad_s.abs() < 1e-4);
+    }
+
+    #[test]
+    fn speed_ratio_one_has_no_flow_and_stator_at_pump_speed() {
+        let s = steady_state(&HtGeometry::appendix_d(), WP, WP).unwrap();
+        assert_eq!(s.mode, StatorMode::NoFlow);
+        assert_eq!(s.flow_m3_s, 0.0);
+        assert_eq!(s.pump_torque_nm, 0.0);
+        assert_eq!(s.stator_speed_rad_s, WP);
+        assert_eq!(s.torque_ratio(), 1.0);
+    }
+
+    #[test]
+    fn out_of_range_operating_points_are_errors() {
+        let g = HtGeometry::appendix_d();
+        assert_eq!(steady_state(&g, WP, 1.1 * WP).unwrap_err().field, "speed_ratio");
+        assert_eq!(steady_state(&g, WP, -0.1 * WP).unwrap_err().field, "speed_ratio");
+        assert_eq!(steady_state(&g, -WP, 0.0).unwrap_err().field, "pump_speed_rad_s");
+        assert!(steady_state(&g, f64::NAN, 0.0).is_err());
+    }
+
+    #[test]
+    fn steady_state_scales_with_pump_speed() {
+        // homogeneity: Q ∝ ω_p, torques ∝ ω_p²
+        let g = HtGeometry::appendix_d();
+        let (a, b) = (steady_state(&g, WP, 0.4 * WP).unwrap(), steady_state(&g, 2.0 * WP, 0.8 * WP).unwrap());
+        assert!((b.flow_m3_s / a.flow_m3_s - 2.0).abs() < 1e-12);
+        assert!((b.pump_torque_nm / a.pump_torque_nm - 4.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn parameter_checks_name_the_field() {
+        let mut v = HtGeometry::appendix_d().values;
+        v[HtParam::FlowArea.index()] = -0.01;
+        assert_eq!(HtGeometry::new(v).unwrap_err().field, "flow_area_m2");
+        let mut v = HtGeometry::appendix_d().values;
+        v[HtParam::StatorExitAngle.index()] = 95f64.to_radians();
+        assert_eq!(HtGeometry::new(v).unwrap_err().field, "stator_exit_angle_rad");
+        let mut v = HtGeometry::appendix_d().values;
+        for p in [HtParam::PumpShockLoss, HtParam::TurbineShockLoss, HtParam::StatorShockLoss, HtParam::FrictionLoss] {
+            v[p.index()] = 0.0;
+        }
+        assert_eq!(HtGeometry::new(v).unwrap_err().field, "friction_loss");
+    }
+
+    /// Every derivative the dual numbers produce (with respect to each parameter and both
+    /// speeds, for each output and each stator mode) against central finite differences.
+    #[test]
+    fn analytic_derivatives_match_finite_differences() {
+        let g = HtGeometry::appendix_d();
+        let outputs = |s: &HtSteadyState<Dual>| [s.flow_m3_s, s.pump_torque_nm, s.turbine_torque_nm, s.stator_torque_nm, s.stator_speed_rad_s];
+        let outputs_f = |s: &HtSteadyState<f64>| [s.flow_m3_s, s.pump_torque_nm, s.turbine_torque_nm, s.stator_torque_nm, s.stator_speed_rad_s];
+        for sr in [0.0, 0.3, 0.75, 0.95] {
+            let wt = sr * WP;
+            for p in HtParam::ALL {
+                let ad = steady_state(&g.seeded(p), Dual::cst(WP), Dual::cst(wt)).unwrap();
+                let x = g.values[p.index()];
+                let h = 1e-6 * x.abs().max(1e-2);
+                let eval = |dx: f64| {
+                    let mut v = g.values;
+                    v[p.index()] = x + dx;
+                    steady_state(&HtGeometry { values: v }, WP, wt).unwrap()
+                };
+                let (a, b) = (eval(-h), eval(h));
+                assert_eq!(a.mode, b.mode);
+                for (k, (o, (fa, fb))) in outputs(&ad).iter().zip(outputs_f(&a).iter().zip(outputs_f(&b).iter())).enumerate() {
+                    let fd = (fb - fa) / (2.0 * h);
+                    let tol = 1e-6 * (fd.abs() + o.v.abs() / x.abs().max(1e-2));
+                    assert!((o.d - fd).abs() <= tol, "SR {sr}, {}, output {k}: {} vs {fd}", p.key(), o.d);
+                }
+            }
+            for which in 0..2 {
+                let (dp, dt) = if which == 0 { (Dual::var(WP), Dual::cst(wt)) } else { (Dual::cst(WP), Dual::var(wt)) };
+                let ad = steady_state(&g.to_dual(), dp, dt).unwrap();
+                let h = 1e-4;
+                let eval = |d: f64| if which == 0 { steady_state(&g, WP + d, wt).unwrap() } else { steady_state(&g, WP, wt + d).unwrap() };
+                if sr == 0.0 && which == 1 {
+                    continue; // SR < 0 is out of range: one-sided at stall, checked below
+                }
+                let (a, b) = (eval(-h), eval(h));
+                for (o, (fa, fb)) in outputs(&ad).iter().zip(outputs_f(&a).iter().zip(outputs_f(&b).iter())) {
+                    let fd = (fb - fa) / (2.0 * h);
+                    assert!((o.d - fd).abs() <= 1e-6 * (fd.abs() + o.v.abs() / WP), "SR {sr}, speed {which}: {} vs {fd}", o.d);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn largest_root_is_accurate_when_coefficients_cancel() {
+        // (q − 1e8)(q − 1e-8) = q² − (1e8 + 1e-8) q + 1
+        let p = Quad { c: [1.0, -(1e8 + 1e-8), 1.0] };
+        assert!((largest_real_root(p).unwrap() - 1e8).abs() < 1e-6);
+        let p = Quad { c: [-1.0, 0.0, 1.0] };
+        assert_eq!(largest_real_root(p).unwrap(), 1.0);
+        assert!(largest_real_root(Quad { c: [1.0, 0.0, 1.0] }).is_none());
+    }
+}

@@ -1,0 +1,19 @@
+//! tcsim-core: torque-converter models in pure Rust.
+//!
+//! The core holds the models and their solvers and knows nothing of Python, so that the same code
+//! builds the Python extension and, later, the FMU. Units are SI throughout (rad/s, N·m, m, m²,
+//! m³/s, kg, kg/m³, s; angles in radians); signs follow the tcsim physics notes §2.
+//!
+//! * [`capacity`]: the six capacity conventions of characteristic tables.
+//! * [`table`]: the steady-state look-up-table model (Li & Sundén 2016, eqs 2.8–2.11).
+//! * [`hrovat_tobler`]: the Hrovat & Tobler model's closed-form steady state and coupling point.
+//! * [`batch`]: batched evaluation for characteristics, studies and fitting.
+
+pub mod batch;
+pub mod capacity;
+pub mod error;
+pub mod hrovat_tobler;
+pub mod scalar;
+pub mod table;
+
+pub use error::{CoreError, CoreResult};
