@@ -1,0 +1,389 @@
+"""Converter definitions: TOML files validated by pydantic, bundled converters, tables alone.
+
+A converter is a bundled name (``tcsim converters``), a TOML file, or a characteristic table
+alone (CSV or VECTO ``.vtcc``, usable by the ``table`` model and as a fitting target). The
+sections and keys are those of ``conventions.md``; each model needs only its own sections.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+import warnings
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from . import _core
+from .errors import InputError, TcsimWarning, from_core
+
+MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
+Model = Literal["table", "hrovat-tobler", "quasi-dynamic"]
+
+CAPACITY_KEYS = tuple(_core.capacity_conventions())
+
+#: Stall torque at 2000 rpm outside this range (N·m) suggests a capacity read in the wrong
+#: convention (physics notes §1).
+PLAUSIBLE_STALL_TORQUE_NM = (20.0, 2000.0)
+RAD_S_PER_RPM = math.pi / 30.0
+
+
+# --------------------------------------------------------------------------------------------
+# the characteristic table
+
+
+@dataclass(frozen=True)
+class Characteristic:
+    """TR and CF (N·m/(rad/s)²) against SR, validated; ``convention`` is the capacity key read."""
+
+    speed_ratio: np.ndarray
+    torque_ratio: np.ndarray
+    capacity_factor_nm_s2: np.ndarray
+    convention: str = "capacity_factor_nm_s2"
+    source: str = ""
+
+    @classmethod
+    def from_columns(
+        cls,
+        speed_ratio,
+        torque_ratio,
+        capacity,
+        convention: str,
+        source: str,
+        where: str = "",
+        rows: list[int] | None = None,
+    ) -> "Characteristic":
+        """Validate and convert a table read in capacity ``convention``.
+
+        ``where`` prefixes field names (``"[characteristic]."`` for TOML); ``rows`` maps each
+        point to its line number in a text file, so that messages name the line.
+        """
+        if convention not in CAPACITY_KEYS:
+            raise InputError(source, f"{where}capacity", convention, f"one of {', '.join(CAPACITY_KEYS)}")
+        sr = np.asarray(speed_ratio, dtype=float)
+        tr = np.asarray(torque_ratio, dtype=float)
+        cap = np.asarray(capacity, dtype=float)
+
+        def name(col: str, i: int) -> str:
+            return f"line {rows[i]}, {col}" if rows is not None else f"{where}{col}[{i}]"
+
+        for col, v in (("speed_ratio", sr), ("torque_ratio", tr), (convention, cap)):
+            bad = np.flatnonzero(~np.isfinite(v))
+            if bad.size:
+                raise InputError(source, name(col, int(bad[0])), float(v[bad[0]]), "a finite number")
+        if not (len(sr) == len(tr) == len(cap)):
+            raise InputError(source, f"{where}torque_ratio", f"{len(tr)} values",
+                             f"as many values as speed_ratio ({len(sr)}) and {convention} ({len(cap)})")
+        if len(sr) < 2:
+            raise InputError(source, f"{where}speed_ratio", f"{len(sr)} points", "at least 2 points")
+        dec = np.flatnonzero(np.diff(sr) <= 0)
+        if dec.size:
+            i = int(dec[0]) + 1
+            raise InputError(source, name("speed_ratio", i), float(sr[i]),
+                             f"strictly increasing speed ratio (previous value {sr[i - 1]:g})")
+        drive = sr < 1.0
+        for col, v in (("torque_ratio", tr), (convention, cap)):
+            bad = np.flatnonzero(drive & (v <= 0))
+            if bad.size:
+                raise InputError(source, name(col, int(bad[0])), float(v[bad[0]]),
+                                 "a positive value in drive (speed ratio below 1)")
+        cf = np.asarray(_core.capacity_to_cf(convention, np.ascontiguousarray(cap)))
+        try:
+            _core.table_check(sr, tr, cf)
+        except _core.CoreInputError as e:  # pragma: no cover - the checks above come first
+            raise from_core(e, source, where) from None
+        return cls(sr, tr, cf, convention, source)
+
+    def stall_torque_nm(self, pump_speed_rpm: float = 2000.0) -> float:
+        """Pump torque at SR = 0 (or the table's first SR ≥ 0) and the given pump speed."""
+        i = int(np.searchsorted(self.speed_ratio, 0.0))
+        i = min(i, len(self.speed_ratio) - 1)
+        return float(self.capacity_factor_nm_s2[i] * (pump_speed_rpm * RAD_S_PER_RPM) ** 2)
+
+    def warn_if_implausible(self) -> None:
+        t = self.stall_torque_nm()
+        lo, hi = PLAUSIBLE_STALL_TORQUE_NM
+        if not lo <= t <= hi:
+            warnings.warn(
+                f"{self.source}: stall torque at 2000 rpm is {t:.4g} N·m with the capacity read as "
+                f"{self.convention}; a passenger-car converter gives {lo:g}–{hi:g} N·m. "
+                "Check the capacity convention.",
+                TcsimWarning,
+                stacklevel=3,
+            )
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.speed_ratio, self.torque_ratio, self.capacity_factor_nm_s2
+
+
+# --------------------------------------------------------------------------------------------
+# TOML sections
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=True, frozen=True)
+
+
+class CharacteristicSection(_Section):
+    speed_ratio: list[float]
+    torque_ratio: list[float]
+    capacity_factor_nm_s2: list[float] | None = None
+    k_factor_rpm_per_sqrt_nm: list[float] | None = None
+    k_factor_rad_s_per_sqrt_nm: list[float] | None = None
+    k_factor_rpm_per_sqrt_lbf_ft: list[float] | None = None
+    capacity_nm_per_rpm2: list[float] | None = None
+    mp1000_nm: list[float] | None = None
+
+    @model_validator(mode="after")
+    def _one_capacity(self):
+        given = [k for k in CAPACITY_KEYS if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError(f"exactly one capacity key of {', '.join(CAPACITY_KEYS)}; got {given or 'none'}")
+        return self
+
+    def capacity(self) -> tuple[str, list[float]]:
+        key = next(k for k in CAPACITY_KEYS if getattr(self, k) is not None)
+        return key, getattr(self, key)
+
+
+def _positive():
+    return Field(gt=0, allow_inf_nan=False)
+
+
+class InertiaSection(_Section):
+    """Rotating inertias including the fluid carried by each element, kg·m²."""
+
+    pump_kg_m2: float = _positive()
+    turbine_kg_m2: float = _positive()
+    stator_kg_m2: float = _positive()
+
+
+def _angle():
+    return Field(gt=-90.0, lt=90.0, allow_inf_nan=False)
+
+
+def _loss():
+    return Field(ge=0.0, allow_inf_nan=False)
+
+
+class GeometrySection(_Section):
+    """Hrovat & Tobler parameters (Li & Sundén 2016, Table 2.2); angles in degrees."""
+
+    flow_area_m2: float = _positive()
+    fluid_density_kg_m3: float = _positive()
+    pump_exit_radius_m: float = _positive()
+    turbine_exit_radius_m: float = _positive()
+    stator_exit_radius_m: float = _positive()
+    pump_exit_angle_deg: float = _angle()
+    turbine_exit_angle_deg: float = _angle()
+    stator_exit_angle_deg: float = _angle()
+    pump_inlet_angle_deg: float = _angle()
+    turbine_inlet_angle_deg: float = _angle()
+    stator_inlet_angle_deg: float = _angle()
+    pump_shock_loss: float = _loss()
+    turbine_shock_loss: float = _loss()
+    stator_shock_loss: float = _loss()
+    friction_loss: float = _loss()
+    fluid_length_m: float = _positive()
+    pump_shape_effect_m2: float = Field(allow_inf_nan=False)
+    turbine_shape_effect_m2: float = Field(allow_inf_nan=False)
+    stator_shape_effect_m2: float = Field(allow_inf_nan=False)
+
+    def core_row(self) -> np.ndarray:
+        """The fifteen steady-state parameters in the core's order, angles in radians."""
+        return np.array([getattr(self, k) for k in STEADY_KEYS], dtype=float) * STEADY_SCALE
+
+
+class QuasiDynamicSection(_Section):
+    pump_shape_effect_m2: float = Field(allow_inf_nan=False)
+    turbine_shape_effect_m2: float = Field(allow_inf_nan=False)
+    flow_time_constant_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+
+
+#: Geometry keys of the steady state, in the core's parameter order (degrees in files).
+STEADY_KEYS = tuple(k.removesuffix("_rad") + "_deg" if k.endswith("_rad") else k for k in _core.ht_parameter_names())
+STEADY_SCALE = np.array([math.pi / 180.0 if k.endswith("_deg") else 1.0 for k in STEADY_KEYS])
+
+
+class ConverterFile(_Section):
+    name: str
+    source: str
+    description: str | None = None
+    characteristic: CharacteristicSection | None = None
+    inertia: InertiaSection | None = None
+    geometry: GeometrySection | None = None
+    quasi_dynamic: QuasiDynamicSection | None = None
+    #: Where each value comes from: "section.key" -> text ("assumed: ..." where assumed).
+    sources: dict[str, str] = {}
+
+    @model_validator(mode="after")
+    def _sources_name_fields(self):
+        for key in self.sources:
+            section, _, name = key.partition(".")
+            model = getattr(self, section, None) if section in _SECTIONS else None
+            if model is None or name not in type(model).model_fields:
+                raise ValueError(f"[sources] key {key!r} names no value of this converter")
+        return self
+
+
+_SECTIONS = ("characteristic", "inertia", "geometry", "quasi_dynamic")
+_REQUIRED = {
+    "table": ("characteristic",),
+    "hrovat-tobler": ("geometry",),
+    "quasi-dynamic": ("characteristic",),
+}
+
+
+# --------------------------------------------------------------------------------------------
+# the converter
+
+
+@dataclass(frozen=True)
+class Converter:
+    """A validated converter definition. ``path`` is where it was read from (for messages)."""
+
+    name: str
+    source: str
+    path: str
+    characteristic: Characteristic | None = None
+    inertia: InertiaSection | None = None
+    geometry: GeometrySection | None = None
+    quasi_dynamic: QuasiDynamicSection | None = None
+    description: str | None = None
+    sources: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The models whose sections this converter has."""
+        return tuple(m for m in MODELS if all(getattr(self, s) is not None for s in _REQUIRED[m]))
+
+    def require(self, model: str) -> None:
+        """Raise an InputError unless the converter has the sections ``model`` needs."""
+        if model not in MODELS:
+            raise InputError("command line", "--model", model, f"one of {', '.join(MODELS)}")
+        for section in _REQUIRED[model]:
+            if getattr(self, section) is None:
+                raise InputError(self.path, f"[{section}]", "missing", f"a [{section}] section for the {model} model")
+
+    def core_geometry(self) -> np.ndarray:
+        """The geometry as a (1, 15) array for the core."""
+        self.require("hrovat-tobler")
+        return self.geometry.core_row()[None, :]
+
+    def with_geometry(self, geometry: GeometrySection, name: str, source: str, sources: dict[str, str]) -> "Converter":
+        return Converter(name, source, self.path, self.characteristic, self.inertia, geometry, self.quasi_dynamic,
+                         self.description, sources)
+
+    def to_toml_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name, "source": self.source}
+        if self.description:
+            out["description"] = self.description
+        if self.characteristic is not None:
+            c = self.characteristic
+            out["characteristic"] = {
+                "speed_ratio": c.speed_ratio.tolist(),
+                "torque_ratio": c.torque_ratio.tolist(),
+                "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
+            }
+        for section in ("inertia", "geometry", "quasi_dynamic"):
+            model = getattr(self, section)
+            if model is not None:
+                out[section] = model.model_dump(exclude_none=True)
+        if self.sources:
+            out["sources"] = dict(self.sources)
+        return out
+
+
+def _pydantic_to_input_error(err: ValidationError, path: str) -> InputError:
+    e = err.errors()[0]
+    loc = [str(x) for x in e["loc"]]
+    if loc and loc[0] in _SECTIONS + ("sources",):
+        head = f"[{loc[0]}]"
+        rest = "".join(f"[{x}]" if x.isdigit() else f".{x}" for x in loc[1:])
+        field_name = head + rest
+    else:
+        field_name = ".".join(loc) or "(file)"
+    value = e.get("input", "")
+    msg = e["msg"]
+    if e["type"] == "extra_forbidden":
+        value, msg = loc[-1], "no such key (unknown key; see conventions.md for the keys of each section)"
+    elif e["type"] == "missing":
+        value, msg = "missing", "this required key"
+    elif e["type"] == "value_error":
+        msg = msg.removeprefix("Value error, ")
+        value = "" if isinstance(value, dict) else value
+    if isinstance(value, (dict, list)) and len(str(value)) > 60:
+        value = f"{type(value).__name__} of {len(value)}"
+    return InputError(path, field_name, value, msg)
+
+
+def parse_converter(data: dict[str, Any], path: str) -> Converter:
+    """Validate a parsed TOML document."""
+    try:
+        doc = ConverterFile.model_validate(data)
+    except ValidationError as err:
+        raise _pydantic_to_input_error(err, path) from None
+    characteristic = None
+    if doc.characteristic is not None:
+        key, values = doc.characteristic.capacity()
+        characteristic = Characteristic.from_columns(
+            doc.characteristic.speed_ratio, doc.characteristic.torque_ratio, values, key, path, "[characteristic].")
+    if doc.geometry is not None:
+        try:
+            _core.ht_check_geometry(doc.geometry.core_row())
+        except _core.CoreInputError as e:
+            raise from_core(e, path, "[geometry].") from None
+    return Converter(doc.name, doc.source, path, characteristic, doc.inertia, doc.geometry, doc.quasi_dynamic,
+                     doc.description, dict(doc.sources))
+
+
+def read_converter_toml(path: Path) -> Converter:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(str(path), "(syntax)", str(e), "valid TOML") from None
+    conv = parse_converter(data, str(path))
+    if conv.characteristic is not None:
+        conv.characteristic.warn_if_implausible()
+    return conv
+
+
+def _bundled_dir():
+    return resources.files("tcsim") / "data" / "converters"
+
+
+def bundled_names() -> list[str]:
+    return sorted(p.name.removesuffix(".toml") for p in _bundled_dir().iterdir() if p.name.endswith(".toml"))
+
+
+def bundled_converters() -> list[Converter]:
+    return [load_converter(n) for n in bundled_names()]
+
+
+def load_converter(spec: str | Path) -> Converter:
+    """A bundled name, a converter TOML, or a characteristic table (.csv, .vtcc)."""
+    from .tables import read_table  # tables depends on Characteristic
+
+    text = str(spec)
+    if isinstance(spec, str) and text in bundled_names():
+        with resources.as_file(_bundled_dir() / f"{text}.toml") as p:
+            return read_converter_toml(Path(p))
+    path = Path(spec)
+    if not path.exists():
+        raise InputError(text, "converter", text,
+                         f"a bundled converter ({', '.join(bundled_names())}) or an existing .toml, .csv or .vtcc file")
+    suffix = path.suffix.lower()
+    if suffix == ".toml":
+        return read_converter_toml(path)
+    if suffix in (".csv", ".vtcc"):
+        table = read_table(path)
+        return Converter(path.stem, f"characteristic table {path.name}", str(path), characteristic=table)
+    raise InputError(text, "file type", suffix or "(none)", "a .toml converter or a .csv/.vtcc characteristic table")

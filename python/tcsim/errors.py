@@ -1,0 +1,41 @@
+"""Errors and warnings that tcsim reports to its users.
+
+A :class:`InputError` is the user's to fix: the command line turns it into exit code 2 and one
+line that names the file, the field, the value and what was expected. Anything else that goes
+wrong is a failure of tcsim or of a solver (exit code 1).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+class InputError(Exception):
+    """Bad user input: a file, a field in it, the offending value and what was expected."""
+
+    def __init__(self, source: str, field: str, value: Any, expected: str):
+        self.source = str(source)
+        self.field = field
+        self.value = value
+        self.expected = expected
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        return f"{self.source}: {self.field} = {_show(self.value)}: expected {self.expected}"
+
+
+class TcsimWarning(UserWarning):
+    """A suspicious but usable input (for example an implausible stall torque)."""
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    text = repr(value) if isinstance(value, str) else str(value)
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def from_core(exc: Exception, source: str, field_prefix: str = "") -> InputError:
+    """Wrap a ``tcsim._core.CoreInputError`` (args: message, field, value, expected)."""
+    _message, field, value, expected = exc.args
+    return InputError(source, field_prefix + field, value, expected)
