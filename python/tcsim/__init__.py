@@ -1,1 +1,38 @@
-"""tcsim."""
+"""tcsim: hydrodynamic torque converter models for vehicle simulation.
+
+Three models (``table``, ``hrovat-tobler``, ``quasi-dynamic``) after Li & Sundén (2016),
+"Evaluation of torque converter models for vehicle take-off simulation", Chalmers/Volvo Cars,
+and Hrovat & Tobler (1985). Units are SI and carried in every name (``conventions.md``).
+
+Tiers:
+
+* one-liners: :func:`characterise` (a converter name or file and a model → DataFrame);
+* objects: :func:`load_converter` → :class:`Converter`, then :mod:`tcsim.steady` per model;
+* raw: :mod:`tcsim._core` (NumPy arrays in, arrays out, GIL released).
+"""
+
+from __future__ import annotations
+
+from .converter import Characteristic, Converter, bundled_names, load_converter
+from .errors import InputError, TcsimWarning
+from .steady import coupling_point, hrovat_tobler_steady_state
+
+__all__ = [
+    "Characteristic",
+    "Converter",
+    "InputError",
+    "TcsimWarning",
+    "bundled_names",
+    "characterise",
+    "coupling_point",
+    "hrovat_tobler_steady_state",
+    "load_converter",
+]
+
+
+def characterise(converter, model: str = "hrovat-tobler", pump_speed_rpm: float = 2000.0, speed_ratio=None):
+    """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`)."""
+    from . import steady
+
+    conv = converter if isinstance(converter, Converter) else load_converter(converter)
+    return steady.characterise(conv, model, pump_speed_rpm, speed_ratio)

@@ -220,14 +220,6 @@ class ConverterFile(_Section):
     #: Where each value comes from: "section.key" -> text ("assumed: ..." where assumed).
     sources: dict[str, str] = {}
 
-    @model_validator(mode="after")
-    def _sources_name_fields(self):
-        for key in self.sources:
-            section, _, name = key.partition(".")
-            model = getattr(self, section, None) if section in _SECTIONS else None
-            if model is None or name not in type(model).model_fields:
-                raise ValueError(f"[sources] key {key!r} names no value of this converter")
-        return self
 
 
 _SECTIONS = ("characteristic", "inertia", "geometry", "quasi_dynamic")
@@ -308,9 +300,10 @@ def _pydantic_to_input_error(err: ValidationError, path: str) -> InputError:
     else:
         field_name = ".".join(loc) or "(file)"
     value = e.get("input", "")
-    msg = e["msg"]
+    msg = e["msg"].removeprefix("Input should be ")
     if e["type"] == "extra_forbidden":
-        value, msg = loc[-1], "no such key (unknown key; see conventions.md for the keys of each section)"
+        section = f"[{loc[0]}]" if len(loc) > 1 else "the top level"
+        msg = f"a known key of {section} (this key is unknown; conventions.md lists the keys)"
     elif e["type"] == "missing":
         value, msg = "missing", "this required key"
     elif e["type"] == "value_error":
@@ -327,6 +320,11 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
         doc = ConverterFile.model_validate(data)
     except ValidationError as err:
         raise _pydantic_to_input_error(err, path) from None
+    for key in doc.sources:
+        section, _, name = key.partition(".")
+        model = getattr(doc, section, None) if section in _SECTIONS else None
+        if model is None or name not in type(model).model_fields:
+            raise InputError(path, "[sources]", key, "a key 'section.name' naming a value of this converter")
     characteristic = None
     if doc.characteristic is not None:
         key, values = doc.characteristic.capacity()

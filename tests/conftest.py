@@ -1,0 +1,48 @@
+"""Shared fixtures: paths, a CLI runner that checks the error contract."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED_CONVERTERS = REPO.parent / "shared" / "data" / "converters"
+
+# Li & Sundén (2016) Table C.1 with CF in N·m/(rad/s)²
+C1_SR = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0]
+C1_TR = [2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00]
+C1_CF = [3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3,
+         1.842e-3, 1.237e-3, 0.187e-3]
+
+
+@dataclass
+class Run:
+    code: int
+    stdout: str
+    stderr: str
+
+
+def run_cli(*args: str, cwd: Path | None = None) -> Run:
+    """Run ``python -m tcsim`` in a subprocess, as a user would."""
+    env = dict(os.environ, COLUMNS="200")
+    p = subprocess.run([sys.executable, "-m", "tcsim", *map(str, args)], capture_output=True, text=True,
+                       cwd=cwd, env=env, timeout=300)
+    return Run(p.returncode, p.stdout, p.stderr)
+
+
+@pytest.fixture
+def cli():
+    return run_cli
+
+
+@pytest.fixture
+def c1_csv(tmp_path) -> Path:
+    p = tmp_path / "c1.csv"
+    rows = "\n".join(f"{s},{t},{c!r}" for s, t, c in zip(C1_SR, C1_TR, C1_CF))
+    p.write_text("# Li & Sundén (2016) Table C.1\nspeed_ratio,torque_ratio,capacity_factor_nm_s2\n" + rows + "\n")
+    return p
