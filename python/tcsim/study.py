@@ -261,9 +261,9 @@ def plot_study(df: pd.DataFrame, converter: Converter, definition: StudyDefiniti
 def summary(df: pd.DataFrame, definition: StudyDefinition, out: Path) -> str:
     n_values = df.groupby("parameter", sort=False)["parameter_value"].nunique().sum()
     solved = int(np.isfinite(df["torque_ratio"]).sum())
-    free = int((df["stator_mode"] != "locked").sum())
+    free = int(df["stator_mode"].isin(["free-wheeling", "no-flow"]).sum())
     return (f"study: {len(definition.parameters)} parameters, {n_values} values, {len(df)} points "
-            f"({solved} with a steady state, {free} not locked-stator) written to {out}/study.csv "
+            f"({solved} with a steady state, {free} of them past the coupling point) written to {out}/study.csv "
             f"and {len(definition.parameters)} figures")
 
 
