@@ -13,7 +13,7 @@ import warnings
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
@@ -22,7 +22,6 @@ from . import _core
 from .errors import InputError, TcsimWarning, from_core
 
 MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
-Model = Literal["table", "hrovat-tobler", "quasi-dynamic"]
 
 CAPACITY_KEYS = tuple(_core.capacity_conventions())
 
@@ -265,10 +264,6 @@ class Converter:
         """The geometry as a (1, 15) array for the core."""
         self.require("hrovat-tobler")
         return self.geometry.core_row()[None, :]
-
-    def with_geometry(self, geometry: GeometrySection, name: str, source: str, sources: dict[str, str]) -> "Converter":
-        return Converter(name, source, self.path, self.characteristic, self.inertia, geometry, self.quasi_dynamic,
-                         self.description, sources)
 
     def to_toml_dict(self) -> dict[str, Any]:
         out: dict[str, Any] = {"name": self.name, "source": self.source}

@@ -63,11 +63,6 @@ impl CapacityConvention {
         Self::ALL.map(|c| c.key()).join(", ")
     }
 
-    /// K-factor conventions cannot express zero or negative capacity.
-    pub fn is_k_factor(self) -> bool {
-        matches!(self, Self::KFactorRpmPerSqrtNm | Self::KFactorRadSPerSqrtNm | Self::KFactorRpmPerSqrtLbfFt)
-    }
-
     /// Convert a value in this convention to CF in N·m/(rad/s)².
     ///
     /// K-factors must be positive (a K-factor cannot express zero or negative capacity);
