@@ -8,12 +8,18 @@
 //! * [`table`]: the steady-state look-up-table model (Li & Sundén 2016, eqs 2.8–2.11).
 //! * [`hrovat_tobler`]: the Hrovat & Tobler model's closed-form steady state and coupling point.
 //! * [`batch`]: batched evaluation for characteristics, studies and fitting.
+//! * [`dynamics`]: the three models in mass-matrix form (table, Hrovat & Tobler, quasi-dynamic).
+//! * [`signal`]: sampled input signals with a smoothed derivative.
+//! * [`transient`]: the transient engine on diffsol (BDF, root-finding events).
 
 pub mod batch;
 pub mod capacity;
+pub mod dynamics;
 pub mod error;
 pub mod hrovat_tobler;
 pub mod scalar;
+pub mod signal;
 pub mod table;
+pub mod transient;
 
 pub use error::{CoreError, CoreResult};

@@ -1,0 +1,644 @@
+//! The three converter models in mass-matrix form, for the transient engine.
+//!
+//! Every model is written over the same four coordinates `u = [ω_p, ω_t, ω_s, Q]` (rad/s, rad/s,
+//! rad/s, m³/s) as
+//!
+//! ```text
+//!     M · u̇ = F(u) + T_ext
+//! ```
+//!
+//! with a constant mass matrix `M`, the internal forces `F` (torques on pump, turbine and stator,
+//! and the net head of eq 2.15) and the external torques `T_ext` (engine, load, stator clutch).
+//! A model that lacks a coordinate (the table model has no flow, only Hrovat & Tobler has a stator
+//! speed) leaves it out of [`ConverterDynamics::coordinates`]. Which of the remaining coordinates
+//! are states and which are prescribed (a measured speed, a locked stator, a stalled flow) is the
+//! engine's business ([`crate::transient`]), not the model's.
+//!
+//! * [`TableDynamics`]: the steady-state table with pump and turbine inertias, eqs 2.8–2.11.
+//! * [`HtDynamics`]: Hrovat & Tobler, eqs 2.12–2.25.
+//! * [`QuasiDynamics`]: tcsim's quasi-dynamic model (tables plus fluid inertia), physics notes §5.
+//!
+//! Sign conventions follow physics notes §2: `T_ext` holds the external torques on pump, turbine
+//! and stator; the torque delivered to the transmission is `−T_ext[TURBINE]`.
+
+use crate::error::{CoreError, CoreResult};
+use crate::hrovat_tobler::{steady_state, HtGeometry, HtParam};
+use crate::table::Characteristic;
+
+pub const PUMP: usize = 0;
+pub const TURBINE: usize = 1;
+pub const STATOR: usize = 2;
+pub const FLOW: usize = 3;
+
+pub type Vec4 = [f64; 4];
+pub type Mat4 = [[f64; 4]; 4];
+
+/// A steady state used to start a transient run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SteadyPoint {
+    /// Coordinates; the absent ones are zero.
+    pub u: Vec4,
+    /// External pump torque at this point.
+    pub pump_torque_nm: f64,
+}
+
+/// A converter model in mass-matrix form.
+pub trait ConverterDynamics: Sync {
+    /// Which of `[ω_p, ω_t, ω_s, Q]` the model has.
+    fn coordinates(&self) -> [bool; 4];
+    /// The constant mass matrix (rows and columns of absent coordinates are ignored).
+    fn mass(&self) -> Mat4;
+    /// Internal forces `F(u)`. `flow_sign` is the sign of Q in the loss terms (eq 2.19), held as
+    /// a discrete state by the engine: +1, −1, or 0 while the flow is held at zero.
+    fn forces(&self, u: &Vec4, flow_sign: f64) -> Vec4;
+    /// `∂F/∂u`, analytic.
+    fn force_jacobian(&self, u: &Vec4, flow_sign: f64) -> Mat4;
+    /// Torques transferred by the fluid at the pump and at the turbine (figure 3.15): the pump
+    /// torque absorbed, and the turbine torque produced, not counting inertia and fluid terms.
+    fn transferred(&self, u: &Vec4, flow_sign: f64) -> (f64, f64);
+    /// Power dissipated in the fluid, `Q·P_loss` for Hrovat & Tobler (≥ 0).
+    fn loss_power_w(&self, u: &Vec4, flow_sign: f64) -> f64;
+    /// The steady state at the given pump and turbine speeds (0 ≤ SR ≤ 1, ω_p > 0).
+    fn steady_point(&self, pump_speed_rad_s: f64, turbine_speed_rad_s: f64) -> CoreResult<SteadyPoint>;
+    /// Whether the model has a stator one-way clutch (and so stator events).
+    fn has_stator_clutch(&self) -> bool {
+        false
+    }
+    /// Whether the loss terms carry sgn Q (and so flow-reversal events).
+    fn has_flow_sign(&self) -> bool {
+        false
+    }
+    /// Forces on the flow coordinate that do not depend on sgn Q, and the magnitude of the
+    /// sgn-Q term, both at Q = 0 (the "dry friction" of the flow; see [`crate::transient`]).
+    fn zero_flow_head(&self, _u: &Vec4) -> (f64, f64) {
+        (0.0, 0.0)
+    }
+}
+
+/// Inertias of the rotating elements (each including the fluid it carries).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inertias {
+    pub pump_kg_m2: f64,
+    pub turbine_kg_m2: f64,
+    pub stator_kg_m2: f64,
+}
+
+impl Inertias {
+    pub fn new(pump_kg_m2: f64, turbine_kg_m2: f64, stator_kg_m2: f64) -> CoreResult<Self> {
+        for (name, v) in [("inertia.pump_kg_m2", pump_kg_m2), ("inertia.turbine_kg_m2", turbine_kg_m2), ("inertia.stator_kg_m2", stator_kg_m2)] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(CoreError::new(name, v, "a finite, positive inertia in kg·m²"));
+            }
+        }
+        Ok(Self { pump_kg_m2, turbine_kg_m2, stator_kg_m2 })
+    }
+}
+
+/// Six significant digits, like C's `%.6g` without the exponent form for ordinary magnitudes.
+pub fn sig(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let digits = 5 - x.abs().log10().floor() as i32;
+    if (-5..=15).contains(&digits) {
+        let s = format!("{:.*}", digits.max(0) as usize, x);
+        if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+    } else {
+        format!("{x:.5e}")
+    }
+}
+
+fn signed_square(w: f64) -> f64 {
+    w * w.abs()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Table model
+
+/// The steady-state table model with inertias (Li & Sundén 2016, eqs 2.8–2.11):
+/// `I_p ω̇_p = T_p − CF(SR) ω_p|ω_p|`, `I_t ω̇_t = TR(SR) CF(SR) ω_p|ω_p| + T_t`.
+/// Outside the table the end values are held (see [`Characteristic::lookup`]).
+#[derive(Debug, Clone)]
+pub struct TableDynamics {
+    pub characteristic: Characteristic,
+    pub inertia: Inertias,
+}
+
+/// SR = ω_t/ω_p, and its partial derivatives; zero when the pump stands still.
+fn speed_ratio(wp: f64, wt: f64) -> (f64, f64, f64) {
+    if wp == 0.0 {
+        (0.0, 0.0, 0.0)
+    } else {
+        (wt / wp, -wt / (wp * wp), 1.0 / wp)
+    }
+}
+
+/// Table torques `(T_p,tr, T_t,tr)` and their gradients with respect to (ω_p, ω_t).
+fn table_torques(c: &Characteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [f64; 2]) {
+    let (sr, dsr_dwp, dsr_dwt) = speed_ratio(wp, wt);
+    let l = c.lookup(sr);
+    let w2 = signed_square(wp);
+    let tp = l.capacity_factor_nm_s2 * w2;
+    let tt = l.torque_ratio * tp;
+    let dtp = [l.d_capacity_factor * dsr_dwp * w2 + l.capacity_factor_nm_s2 * 2.0 * wp.abs(), l.d_capacity_factor * dsr_dwt * w2];
+    let dtt = [l.d_torque_ratio * dsr_dwp * tp + l.torque_ratio * dtp[0], l.d_torque_ratio * dsr_dwt * tp + l.torque_ratio * dtp[1]];
+    (tp, tt, dtp, dtt)
+}
+
+/// Pump speed of a table steady state, and the table's pump torque there.
+fn table_steady(c: &Characteristic, wp: f64, wt: f64) -> CoreResult<f64> {
+    let op = c.operating_point(wp, wt)?;
+    Ok(op.pump_torque_nm)
+}
+
+impl ConverterDynamics for TableDynamics {
+    fn coordinates(&self) -> [bool; 4] {
+        [true, true, false, false]
+    }
+    fn mass(&self) -> Mat4 {
+        let mut m = [[0.0; 4]; 4];
+        m[PUMP][PUMP] = self.inertia.pump_kg_m2;
+        m[TURBINE][TURBINE] = self.inertia.turbine_kg_m2;
+        m
+    }
+    fn forces(&self, u: &Vec4, _s: f64) -> Vec4 {
+        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        [-tp, tt, 0.0, 0.0]
+    }
+    fn force_jacobian(&self, u: &Vec4, _s: f64) -> Mat4 {
+        let (_, _, dtp, dtt) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        let mut j = [[0.0; 4]; 4];
+        j[PUMP][PUMP] = -dtp[0];
+        j[PUMP][TURBINE] = -dtp[1];
+        j[TURBINE][PUMP] = dtt[0];
+        j[TURBINE][TURBINE] = dtt[1];
+        j
+    }
+    fn transferred(&self, u: &Vec4, _s: f64) -> (f64, f64) {
+        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        (tp, tt)
+    }
+    fn loss_power_w(&self, u: &Vec4, s: f64) -> f64 {
+        let (tp, tt) = self.transferred(u, s);
+        tp * u[PUMP] - tt * u[TURBINE]
+    }
+    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
+        Ok(SteadyPoint { u: [wp, wt, 0.0, 0.0], pump_torque_nm: table_steady(&self.characteristic, wp, wt)? })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Quasi-dynamic model
+
+/// tcsim's quasi-dynamic model: the steady-state tables plus fluid inertia (physics notes §5;
+/// derivation in docs/models.md). States ω_p, ω_t, Q:
+///
+/// ```text
+///     I_p ω̇_p + ρ S_p Q̇ = T_p − CF(SR) ω_p|ω_p|
+///     I_t ω̇_t + ρ S_t Q̇ = TR(SR) CF(SR) ω_p|ω_p| + T_t
+///     Q̇ = (Q_ss − Q)/τ_Q,    Q_ss = CF(SR) |ω_p| / (ρ R_p²)
+/// ```
+///
+/// `Q_ss` is the Euler-equation flow that carries the table's pump torque with the fluid leaving
+/// the pump at `R_p` and entering it with no swirl. At steady state Q̇ = 0, so the torques are the
+/// table's whatever the shape effects; with S = 0 the flow does not act on the speeds at all.
+#[derive(Debug, Clone)]
+pub struct QuasiDynamics {
+    pub characteristic: Characteristic,
+    pub inertia: Inertias,
+    pub fluid_density_kg_m3: f64,
+    pub pump_radius_m: f64,
+    pub pump_shape_effect_m2: f64,
+    pub turbine_shape_effect_m2: f64,
+    pub flow_time_constant_s: f64,
+}
+
+impl QuasiDynamics {
+    pub fn validate(&self) -> CoreResult<()> {
+        let checks = [
+            ("fluid_density_kg_m3", self.fluid_density_kg_m3, "a finite, positive density in kg/m³"),
+            ("pump_exit_radius_m", self.pump_radius_m, "a finite, positive radius in m"),
+            ("quasi_dynamic.flow_time_constant_s", self.flow_time_constant_s, "a finite, positive time constant in s"),
+        ];
+        for (name, v, expected) in checks {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(CoreError::new(name, v, expected));
+            }
+        }
+        for (name, v) in [("quasi_dynamic.pump_shape_effect_m2", self.pump_shape_effect_m2), ("quasi_dynamic.turbine_shape_effect_m2", self.turbine_shape_effect_m2)] {
+            if !v.is_finite() {
+                return Err(CoreError::new(name, v, "a finite shape effect in m²"));
+            }
+        }
+        Ok(())
+    }
+
+    fn flow_scale(&self) -> f64 {
+        1.0 / (self.fluid_density_kg_m3 * self.pump_radius_m * self.pump_radius_m)
+    }
+
+    /// Steady flow Q_ss and its gradient with respect to (ω_p, ω_t).
+    fn steady_flow(&self, wp: f64, wt: f64) -> (f64, [f64; 2]) {
+        let (sr, dsr_dwp, dsr_dwt) = speed_ratio(wp, wt);
+        let l = self.characteristic.lookup(sr);
+        let k = self.flow_scale();
+        let q = k * l.capacity_factor_nm_s2 * wp.abs();
+        let dq = [k * (l.d_capacity_factor * dsr_dwp * wp.abs() + l.capacity_factor_nm_s2 * wp.signum()), k * l.d_capacity_factor * dsr_dwt * wp.abs()];
+        (q, dq)
+    }
+}
+
+impl ConverterDynamics for QuasiDynamics {
+    fn coordinates(&self) -> [bool; 4] {
+        [true, true, false, true]
+    }
+    fn mass(&self) -> Mat4 {
+        let rho = self.fluid_density_kg_m3;
+        let mut m = [[0.0; 4]; 4];
+        m[PUMP][PUMP] = self.inertia.pump_kg_m2;
+        m[TURBINE][TURBINE] = self.inertia.turbine_kg_m2;
+        m[PUMP][FLOW] = rho * self.pump_shape_effect_m2;
+        m[TURBINE][FLOW] = rho * self.turbine_shape_effect_m2;
+        m[FLOW][FLOW] = 1.0;
+        m
+    }
+    fn forces(&self, u: &Vec4, _s: f64) -> Vec4 {
+        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        let (qss, _) = self.steady_flow(u[PUMP], u[TURBINE]);
+        [-tp, tt, 0.0, (qss - u[FLOW]) / self.flow_time_constant_s]
+    }
+    fn force_jacobian(&self, u: &Vec4, _s: f64) -> Mat4 {
+        let (_, _, dtp, dtt) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        let (_, dq) = self.steady_flow(u[PUMP], u[TURBINE]);
+        let tau = self.flow_time_constant_s;
+        let mut j = [[0.0; 4]; 4];
+        j[PUMP][PUMP] = -dtp[0];
+        j[PUMP][TURBINE] = -dtp[1];
+        j[TURBINE][PUMP] = dtt[0];
+        j[TURBINE][TURBINE] = dtt[1];
+        j[FLOW][PUMP] = dq[0] / tau;
+        j[FLOW][TURBINE] = dq[1] / tau;
+        j[FLOW][FLOW] = -1.0 / tau;
+        j
+    }
+    fn transferred(&self, u: &Vec4, _s: f64) -> (f64, f64) {
+        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        (tp, tt)
+    }
+    fn loss_power_w(&self, u: &Vec4, s: f64) -> f64 {
+        let (tp, tt) = self.transferred(u, s);
+        tp * u[PUMP] - tt * u[TURBINE]
+    }
+    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
+        let tp = table_steady(&self.characteristic, wp, wt)?;
+        Ok(SteadyPoint { u: [wp, wt, 0.0, self.steady_flow(wp, wt).0], pump_torque_nm: tp })
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Hrovat & Tobler
+
+/// The Hrovat & Tobler model, eqs 2.12–2.25, in mass-matrix form:
+///
+/// ```text
+///     M = [[I_p, 0, 0, ρS_p], [0, I_t, 0, ρS_t], [0, 0, I_s, ρS_s], [ρS_p, ρS_t, ρS_s, ρL_f/A]]
+/// ```
+///
+/// Shape effects are signed as in eqs 2.16–2.18 (S = ∫R tan α dl). The fluid terms act on the
+/// effective torques as `ρS_p Q̇` (pump) and `−ρS_t Q̇` (turbine): a positive S, as in thesis
+/// chapter 4, lowers the effective TR while the flow builds up (docs/models.md).
+#[derive(Debug, Clone)]
+pub struct HtDynamics {
+    pub geometry: HtGeometry<f64>,
+    pub inertia: Inertias,
+    pub fluid_length_m: f64,
+    /// Shape effects of pump, turbine and stator, m² (eqs 2.16–2.18).
+    pub shape_effect_m2: [f64; 3],
+}
+
+const SHAPE_KEYS: [&str; 3] = ["geometry.pump_shape_effect_m2", "geometry.turbine_shape_effect_m2", "geometry.stator_shape_effect_m2"];
+
+/// Constants of eqs 2.12–2.25 for fast evaluation.
+struct HtConst {
+    rho: f64,
+    area: f64,
+    r2: [f64; 3],
+    /// R_x tan α_x at each exit.
+    rt: [f64; 3],
+    /// Coefficients of q in the shock velocities (eqs 2.20–2.22).
+    b: [f64; 3],
+    c: [f64; 3],
+    friction: f64,
+    r: [f64; 3],
+}
+
+impl HtDynamics {
+    /// Check the parameters and the positive definiteness of the mass matrix (physics notes §4).
+    /// An inadmissible shape effect is refused with the largest admissible magnitude.
+    pub fn new(geometry: HtGeometry<f64>, inertia: Inertias, fluid_length_m: f64, shape_effect_m2: [f64; 3]) -> CoreResult<Self> {
+        if !(fluid_length_m.is_finite() && fluid_length_m > 0.0) {
+            return Err(CoreError::new("geometry.fluid_length_m", fluid_length_m, "a finite, positive fluid length in m"));
+        }
+        for (k, s) in SHAPE_KEYS.iter().zip(shape_effect_m2) {
+            if !s.is_finite() {
+                return Err(CoreError::new(*k, s, "a finite shape effect in m²"));
+            }
+        }
+        let d = Self { geometry, inertia, fluid_length_m, shape_effect_m2 };
+        d.check_mass_matrix()?;
+        Ok(d)
+    }
+
+    fn inertia_array(&self) -> [f64; 3] {
+        [self.inertia.pump_kg_m2, self.inertia.turbine_kg_m2, self.inertia.stator_kg_m2]
+    }
+
+    /// `ρ L_f / A`, the fluid's own inertance.
+    pub fn fluid_inertance(&self) -> f64 {
+        self.geometry.get(HtParam::FluidDensity) * self.fluid_length_m / self.geometry.get(HtParam::FlowArea)
+    }
+
+    /// Largest admissible magnitude of each shape effect with the others as given: M is positive
+    /// definite iff `ρL_f/A > Σ ρ² S_x² / I_x` (the Schur complement of the diagonal inertias).
+    pub fn shape_effect_bounds(&self) -> [f64; 3] {
+        let rho = self.geometry.get(HtParam::FluidDensity);
+        let inertia = self.inertia_array();
+        let terms: [f64; 3] = std::array::from_fn(|i| rho * rho * self.shape_effect_m2[i].powi(2) / inertia[i]);
+        std::array::from_fn(|i| {
+            let room = self.fluid_inertance() - (terms.iter().sum::<f64>() - terms[i]);
+            if room <= 0.0 {
+                0.0
+            } else {
+                (room * inertia[i]).sqrt() / rho
+            }
+        })
+    }
+
+    fn check_mass_matrix(&self) -> CoreResult<()> {
+        let rho = self.geometry.get(HtParam::FluidDensity);
+        let inertia = self.inertia_array();
+        let terms: [f64; 3] = std::array::from_fn(|i| rho * rho * self.shape_effect_m2[i].powi(2) / inertia[i]);
+        if self.fluid_inertance() - terms.iter().sum::<f64>() > 0.0 {
+            return Ok(());
+        }
+        // blame the largest contribution
+        let i = (0..3).max_by(|&a, &b| terms[a].total_cmp(&terms[b])).unwrap_or(0);
+        let bound = self.shape_effect_bounds()[i];
+        Err(CoreError::new(
+            SHAPE_KEYS[i],
+            self.shape_effect_m2[i],
+            format!(
+                "|S| < {} m² with the other parameters as given: the mass matrix must be positive definite, ρL_f/A = {} > Σρ²S²/I = {} (physics notes §4)",
+                sig(bound),
+                sig(self.fluid_inertance()),
+                sig(terms.iter().sum::<f64>())
+            ),
+        ))
+    }
+
+    fn constants(&self) -> HtConst {
+        use HtParam::*;
+        let g = &self.geometry;
+        let r = [g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius)];
+        let t = [g.get(PumpExitAngle).tan(), g.get(TurbineExitAngle).tan(), g.get(StatorExitAngle).tan()];
+        let ti = [g.get(PumpInletAngle).tan(), g.get(TurbineInletAngle).tan(), g.get(StatorInletAngle).tan()];
+        HtConst {
+            rho: g.get(FluidDensity),
+            area: g.get(FlowArea),
+            r2: r.map(|x| x * x),
+            rt: [r[0] * t[0], r[1] * t[1], r[2] * t[2]],
+            // pump inlet from stator exit, turbine inlet from pump exit, stator inlet from turbine exit
+            b: [t[2] - ti[0], t[0] - ti[1], t[1] - ti[2]],
+            c: [g.get(PumpShockLoss), g.get(TurbineShockLoss), g.get(StatorShockLoss)],
+            friction: g.get(FrictionLoss) * (3.0 + t[0] * t[0] + t[1] * t[1] + t[2] * t[2]),
+            r,
+        }
+    }
+}
+
+/// Shock velocities of eqs 2.20–2.22 at speeds ω and q = Q/A.
+fn shock_velocities(k: &HtConst, w: &[f64; 3], q: f64) -> [f64; 3] {
+    [
+        k.r[2] * (w[2] - w[0]) + q * k.b[0],
+        k.r[0] * (w[0] - w[1]) + q * k.b[1],
+        k.r[1] * (w[1] - w[2]) + q * k.b[2],
+    ]
+}
+
+impl ConverterDynamics for HtDynamics {
+    fn coordinates(&self) -> [bool; 4] {
+        [true; 4]
+    }
+    fn has_stator_clutch(&self) -> bool {
+        true
+    }
+    fn has_flow_sign(&self) -> bool {
+        true
+    }
+    fn mass(&self) -> Mat4 {
+        let rho = self.geometry.get(HtParam::FluidDensity);
+        let inertia = self.inertia_array();
+        let mut m = [[0.0; 4]; 4];
+        for i in 0..3 {
+            m[i][i] = inertia[i];
+            m[i][FLOW] = rho * self.shape_effect_m2[i];
+            m[FLOW][i] = rho * self.shape_effect_m2[i];
+        }
+        m[FLOW][FLOW] = self.fluid_inertance();
+        m
+    }
+    fn forces(&self, u: &Vec4, sigma: f64) -> Vec4 {
+        let k = self.constants();
+        let w = [u[PUMP], u[TURBINE], u[STATOR]];
+        let flow = u[FLOW];
+        let q = flow / k.area;
+        // angular momentum per unit mass flow leaving each element
+        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.rt[i] * q);
+        let head = k.r2[0] * w[0] * w[0] + k.r2[1] * w[1] * w[1] + k.r2[2] * w[2] * w[2]
+            - k.r2[2] * w[0] * w[2]
+            - k.r2[0] * w[1] * w[0]
+            - k.r2[1] * w[2] * w[1];
+        let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
+        let linear = q * (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]);
+        let v = shock_velocities(&k, &w, q);
+        let loss = sigma * 0.5 * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2] + k.friction * q * q);
+        [
+            -k.rho * (h[0] - h[2]) * flow,
+            -k.rho * (h[1] - h[0]) * flow,
+            -k.rho * (h[2] - h[1]) * flow,
+            k.rho * (head + linear - loss),
+        ]
+    }
+    fn force_jacobian(&self, u: &Vec4, sigma: f64) -> Mat4 {
+        let k = self.constants();
+        let (rho, area) = (k.rho, k.area);
+        let w = [u[PUMP], u[TURBINE], u[STATOR]];
+        let flow = u[FLOW];
+        let q = flow / area;
+        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.rt[i] * q);
+        let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
+        let v = shock_velocities(&k, &w, q);
+        let mut j = [[0.0; 4]; 4];
+        // torques: F_i = −ρ (h_i − h_prev(i)) Q with prev = stator, pump, turbine
+        let prev = [2usize, 0, 1];
+        for i in 0..3 {
+            let p = prev[i];
+            j[i][i] = -rho * k.r2[i] * flow;
+            j[i][p] = rho * k.r2[p] * flow;
+            j[i][FLOW] = -rho * (h[i] - h[p]) - rho * flow * (k.rt[i] - k.rt[p]) / area;
+        }
+        // head of eq 2.15
+        let dhead = [
+            2.0 * k.r2[0] * w[0] - k.r2[2] * w[2] - k.r2[0] * w[1],
+            2.0 * k.r2[1] * w[1] - k.r2[0] * w[0] - k.r2[1] * w[2],
+            2.0 * k.r2[2] * w[2] - k.r2[2] * w[0] - k.r2[1] * w[1],
+        ];
+        // ∂V/∂ω: V_p = R_s(ω_s − ω_p) + …, V_t = R_p(ω_p − ω_t) + …, V_s = R_t(ω_t − ω_s) + …
+        let dloss = [
+            sigma * (-k.c[0] * v[0] * k.r[2] + k.c[1] * v[1] * k.r[0]),
+            sigma * (-k.c[1] * v[1] * k.r[0] + k.c[2] * v[2] * k.r[1]),
+            sigma * (k.c[0] * v[0] * k.r[2] - k.c[2] * v[2] * k.r[1]),
+        ];
+        for i in 0..3 {
+            j[FLOW][i] = rho * (dhead[i] + q * a[i] - dloss[i]);
+        }
+        let dloss_dq = sigma * (k.c[0] * v[0] * k.b[0] + k.c[1] * v[1] * k.b[1] + k.c[2] * v[2] * k.b[2] + k.friction * q);
+        j[FLOW][FLOW] = rho * ((w[0] * a[0] + w[1] * a[1] + w[2] * a[2]) - dloss_dq) / area;
+        j
+    }
+    fn transferred(&self, u: &Vec4, sigma: f64) -> (f64, f64) {
+        let f = self.forces(u, sigma);
+        (-f[PUMP], f[TURBINE])
+    }
+    fn loss_power_w(&self, u: &Vec4, sigma: f64) -> f64 {
+        // −(ω·F): the flow terms cancel exactly (physics notes §4), leaving Q·P_loss
+        let f = self.forces(u, sigma);
+        -(u[0] * f[0] + u[1] * f[1] + u[2] * f[2] + u[3] * f[3])
+    }
+    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
+        let s = steady_state(&self.geometry, wp, wt)?;
+        Ok(SteadyPoint { u: [wp, wt, s.stator_speed_rad_s, s.flow_m3_s], pump_torque_nm: s.pump_torque_nm })
+    }
+    fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
+        let mut at_zero = *u;
+        at_zero[FLOW] = 0.0;
+        let k = self.constants();
+        let v = shock_velocities(&k, &[u[0], u[1], u[2]], 0.0);
+        let shock = 0.5 * k.rho * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2]);
+        (self.forces(&at_zero, 0.0)[FLOW], shock)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    pub(crate) fn c1() -> Characteristic {
+        Characteristic::new(
+            vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
+            vec![2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
+            vec![3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3, 1.842e-3, 1.237e-3, 0.187e-3],
+        )
+        .unwrap()
+    }
+
+    fn inertia() -> Inertias {
+        Inertias::new(0.109, 0.056, 0.01).unwrap()
+    }
+
+    fn ht(shape: [f64; 3]) -> HtDynamics {
+        HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, shape).unwrap()
+    }
+
+    fn qd() -> QuasiDynamics {
+        QuasiDynamics {
+            characteristic: c1(),
+            inertia: inertia(),
+            fluid_density_kg_m3: 840.0,
+            pump_radius_m: 0.12,
+            pump_shape_effect_m2: 0.006,
+            turbine_shape_effect_m2: 0.002,
+            flow_time_constant_s: 0.05,
+        }
+    }
+
+    fn check_jacobian(m: &dyn ConverterDynamics, u: Vec4, sigma: f64) {
+        let j = m.force_jacobian(&u, sigma);
+        let present = m.coordinates();
+        for c in (0..4).filter(|&c| present[c]) {
+            let h = 1e-6 * u[c].abs().max(if c == FLOW { 1e-3 } else { 1.0 });
+            let (mut up, mut dn) = (u, u);
+            up[c] += h;
+            dn[c] -= h;
+            let (fp, fm) = (m.forces(&up, sigma), m.forces(&dn, sigma));
+            for r in (0..4).filter(|&r| present[r]) {
+                let fd = (fp[r] - fm[r]) / (2.0 * h);
+                let scale = m.forces(&u, sigma).iter().map(|x| x.abs()).fold(1e-3, f64::max) / u[c].abs().max(1e-6);
+                assert!((fd - j[r][c]).abs() <= 1e-6 * scale + 1e-6 * fd.abs(), "row {r} col {c} sigma {sigma}: analytic {} fd {fd}", j[r][c]);
+            }
+        }
+    }
+
+    #[test]
+    fn analytic_jacobians_match_finite_differences() {
+        let h = ht([-0.00569, 0.00134, 0.0009]);
+        for u in [[200.0, 0.0, 0.0, 0.12], [210.0, 150.0, 20.0, 0.05], [150.0, 170.0, 60.0, -0.03], [100.0, 40.0, 0.0, 0.0]] {
+            for sigma in [1.0, -1.0, 0.0] {
+                check_jacobian(&h, u, sigma);
+            }
+        }
+        // points inside table segments (the table is piecewise linear)
+        for u in [[200.0, 33.0, 0.0, 0.1], [210.0, 170.0, 0.0, 0.05], [150.0, 160.0, 0.0, 0.02]] {
+            check_jacobian(&TableDynamics { characteristic: c1(), inertia: inertia() }, u, 1.0);
+            check_jacobian(&qd(), u, 1.0);
+        }
+    }
+
+    #[test]
+    fn ht_flow_terms_cancel_in_the_power_balance() {
+        // ω·F = −Q·P_loss with P_loss from eq 2.19 written out directly
+        let h = ht([0.0; 3]);
+        let g = &h.geometry;
+        use HtParam::*;
+        for (u, sigma) in [([210.0, 150.0, 20.0, 0.05], 1.0), ([150.0, 170.0, 60.0, -0.03], -1.0)] {
+            let q = u[3] / g.get(FlowArea);
+            let t = |p| g.get(p).tan();
+            let vp = g.get(StatorExitRadius) * (u[2] - u[0]) + q * (t(StatorExitAngle) - t(PumpInletAngle));
+            let vt = g.get(PumpExitRadius) * (u[0] - u[1]) + q * (t(PumpExitAngle) - t(TurbineInletAngle));
+            let vs = g.get(TurbineExitRadius) * (u[1] - u[2]) + q * (t(TurbineExitAngle) - t(StatorInletAngle));
+            let rho = g.get(FluidDensity);
+            let vre2: f64 = [PumpExitAngle, TurbineExitAngle, StatorExitAngle].iter().map(|&a| q * q * (1.0 + t(a).powi(2))).sum();
+            let ploss = sigma * rho / 2.0 * (vp * vp + vt * vt + vs * vs) + sigma * rho * g.get(FrictionLoss) / 2.0 * vre2;
+            let lp = h.loss_power_w(&u, sigma);
+            assert!((lp - u[3] * ploss).abs() <= 1e-10 * lp.abs(), "{lp} vs {}", u[3] * ploss);
+            assert!(lp > 0.0);
+        }
+    }
+
+    #[test]
+    fn ht_steady_forces_balance_the_closed_form() {
+        // at the closed-form steady state the flow equation has zero net head
+        let h = ht([0.0; 3]);
+        let p = h.steady_point(209.4, 100.0).unwrap();
+        let f = h.forces(&p.u, 1.0);
+        assert!(f[FLOW].abs() < 1e-9 * 840.0 * 0.0144 * 209.4f64.powi(2));
+        assert!((-f[PUMP] - p.pump_torque_nm).abs() < 1e-10 * p.pump_torque_nm);
+    }
+
+    #[test]
+    fn inadmissible_shape_effect_is_refused_with_its_bound() {
+        // S_p = 0.2 m² (thesis §4.1 range) breaks ρL_f/A > ρ²S_p²/I_p; the bound is √(I_p ρL_f/A)/ρ
+        let err = HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.2, 0.0, 0.0]).unwrap_err();
+        assert_eq!(err.field, "geometry.pump_shape_effect_m2");
+        let expected_bound = (0.109f64 * 840.0 * 0.2914 / 0.01).sqrt() / 840.0;
+        assert!(err.expected.starts_with(&format!("|S| < {} m²", sig(expected_bound))), "{}", err.expected);
+        assert!(err.expected.starts_with("|S| < 0.0614"), "{}", err.expected);
+        // with S_t alone past its bound there is no room left for S_p
+        let err = HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.01, 0.2, 0.0]).unwrap_err();
+        assert_eq!(err.field, "geometry.turbine_shape_effect_m2");
+        // the bound is sharp: just below it is admitted, at it refused
+        let b = ht([0.0; 3]).shape_effect_bounds()[1];
+        assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.0, 0.999 * b, 0.0]).is_ok());
+        assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.0, 1.001 * b, 0.0]).is_err());
+    }
+}

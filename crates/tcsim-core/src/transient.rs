@@ -1,0 +1,766 @@
+//! The transient engine: a converter model, a way of driving it, and diffsol's BDF solver with
+//! root finding for the discrete events.
+//!
+//! # Coordinates, states and modes
+//!
+//! A model ([`ConverterDynamics`]) is written over `u = [ω_p, ω_t, ω_s, Q]` as `M u̇ = F(u) + T`.
+//! Each coordinate the model has is, at any time, one of:
+//!
+//! * **free**: a state of the ODE;
+//! * **given**: a measured speed from the [`Drive`]; its rate is the signal's smoothed derivative
+//!   ([`crate::signal`]);
+//! * **held** at zero: the stator while the one-way clutch holds, the flow while it is stalled.
+//!
+//! The free coordinates `x` obey `M_xx ẋ = F_x(u) + T_x(t, u) − M_xz ż(t)`, handed to diffsol in
+//! this mass-matrix form with its analytic Jacobian. The external torque on a given or held
+//! coordinate is whatever the constraint needs, `T_z = (M u̇ − F)_z`: the turbine torque in drive
+//! (a), both torques in drive (b), the stator's holding torque.
+//!
+//! # Events
+//!
+//! The system is smooth between events; at an event the engine stops at the root (diffsol's root
+//! finder), switches the mode and starts a new BDF segment from the state at the root, which is
+//! continuous. Root functions per mode:
+//!
+//! * stator **locked**: the holding torque `T_s`. It crosses zero at the coupling point and the
+//!   clutch releases (`T_s ≥ 0` is all a one-way clutch can give).
+//! * stator **free-wheeling** (`T_s = 0`): the stator speed. It reaches zero and the clutch locks.
+//! * flow with **sign σ = ±1** in the losses (eq 2.19): Q. At Q = 0 the sign is decided as below.
+//! * flow **held at zero** (σ = 0): `P₀ − d` and `P₀ + d`, see next.
+//!
+//! **Flow reversal (sgn Q).** The shock losses carry `sgn Q`, not Q, so at Q = 0 they jump by
+//! `2P₀`, `P₀ = ½ρ Σ C_sh V_sh²`. The engine treats sgn Q as dry friction (the Filippov
+//! solution): with `d` the net head on the flow at Q = 0 (eq 2.15 without the losses, minus the
+//! inertial coupling, with the flow held), the flow stays at zero while `|d| ≤ P₀` and starts in
+//! the direction of `d` once `|d| > P₀`. Between events the sign is constant, so the right-hand
+//! side is smooth and the energy identity holds exactly (the held flow does no work). This is the
+//! same state the closed-form steady state calls `no-flow` near SR = 1.
+
+use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
+
+use crate::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::error::CoreError;
+use crate::signal::Signal;
+
+type Matrix = NalgebraMat<f64>;
+type Lu = NalgebraLU<f64>;
+
+/// How the converter is driven (issue: drives a, b, c).
+#[derive(Debug, Clone)]
+pub enum Drive {
+    /// (a) Pump torque and turbine speed given (the thesis/VSIM causality): pump speed and
+    /// turbine torque come out.
+    PumpTorqueTurbineSpeed { pump_torque_nm: Signal, turbine_speed_rad_s: Signal },
+    /// (b) Both speeds given: the torques come out.
+    Speeds { pump_speed_rad_s: Signal, turbine_speed_rad_s: Signal },
+    /// (c) Pump torque given, the turbine loaded by an inertia and a torque: both speeds come out.
+    PumpTorqueLoad { pump_torque_nm: Signal, load: TurbineLoad },
+}
+
+/// The load on the turbine in drive (c): `T_load = torque(t) + drag·ω_t|ω_t|`, opposing rotation,
+/// with an extra inertia (the driveline reflected to the turbine).
+#[derive(Debug, Clone)]
+pub struct TurbineLoad {
+    pub torque_nm: Signal,
+    pub inertia_kg_m2: f64,
+    pub drag_nm_s2: f64,
+}
+
+impl Drive {
+    fn given(&self, coordinate: usize) -> Option<&Signal> {
+        match (self, coordinate) {
+            (Drive::PumpTorqueTurbineSpeed { turbine_speed_rad_s, .. }, TURBINE) => Some(turbine_speed_rad_s),
+            (Drive::Speeds { turbine_speed_rad_s, .. }, TURBINE) => Some(turbine_speed_rad_s),
+            (Drive::Speeds { pump_speed_rad_s, .. }, PUMP) => Some(pump_speed_rad_s),
+            _ => None,
+        }
+    }
+
+    fn pump_torque(&self) -> Option<&Signal> {
+        match self {
+            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, .. } | Drive::PumpTorqueLoad { pump_torque_nm, .. } => Some(pump_torque_nm),
+            Drive::Speeds { .. } => None,
+        }
+    }
+
+    fn load(&self) -> Option<&TurbineLoad> {
+        match self {
+            Drive::PumpTorqueLoad { load, .. } => Some(load),
+            _ => None,
+        }
+    }
+
+    /// Earliest time at which every signal has a sample.
+    pub fn start_time(&self) -> f64 {
+        let signals: Vec<&Signal> = match self {
+            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, turbine_speed_rad_s } => vec![pump_torque_nm, turbine_speed_rad_s],
+            Drive::Speeds { pump_speed_rad_s, turbine_speed_rad_s } => vec![pump_speed_rad_s, turbine_speed_rad_s],
+            Drive::PumpTorqueLoad { pump_torque_nm, load } => vec![pump_torque_nm, &load.torque_nm],
+        };
+        signals.iter().map(|s| s.times()[0]).fold(f64::NEG_INFINITY, f64::max)
+    }
+}
+
+/// Tolerances and limits of the BDF solver.
+#[derive(Debug, Clone, Copy)]
+pub struct SolverOptions {
+    pub rtol: f64,
+    pub speed_atol_rad_s: f64,
+    pub flow_atol_m3_s: f64,
+    /// Initial step at the start and after every event, s.
+    pub first_step_s: f64,
+    /// More events than this in one run is reported as chattering.
+    pub max_events: usize,
+    pub max_steps: usize,
+    /// Event hysteresis: a switch fires when its root function passes this far beyond zero
+    /// (flow m³/s, stator speed rad/s, stator torque N·m, flow head Pa). It keeps round-off at a
+    /// freshly switched zero (Q = 0, ω_s = 0) from firing the event back, and it is far below the
+    /// tolerances of the results.
+    pub hysteresis: Hysteresis,
+}
+
+/// See [`SolverOptions::hysteresis`].
+#[derive(Debug, Clone, Copy)]
+pub struct Hysteresis {
+    pub flow_m3_s: f64,
+    pub stator_speed_rad_s: f64,
+    pub stator_torque_nm: f64,
+    pub head_pa: f64,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        Self {
+            rtol: 1e-6,
+            speed_atol_rad_s: 1e-5,
+            flow_atol_m3_s: 1e-8,
+            first_step_s: 1e-5,
+            max_events: 10_000,
+            max_steps: 2_000_000,
+            hysteresis: Hysteresis { flow_m3_s: 1e-7, stator_speed_rad_s: 1e-4, stator_torque_nm: 1e-6, head_pa: 1e-3 },
+        }
+    }
+}
+
+/// Optional initial values; what is not given comes from the steady state consistent with the
+/// first input sample ([`initial_state`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct InitialState {
+    pub pump_speed_rad_s: Option<f64>,
+    pub turbine_speed_rad_s: Option<f64>,
+    pub stator_speed_rad_s: Option<f64>,
+    pub flow_m3_s: Option<f64>,
+}
+
+/// Discrete state of the piecewise-smooth system.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Mode {
+    pub stator_locked: bool,
+    /// Sign of Q in the losses: +1, −1, or 0 while the flow is held at zero.
+    pub flow_sign: f64,
+}
+
+/// What went wrong in a transient run.
+#[derive(Debug, Clone)]
+pub enum TransientError {
+    /// The user's input (exit code 2).
+    Input(CoreError),
+    /// The solver failed (exit code 1): time, state and message.
+    Solver { time_s: f64, state: Vec4, message: String },
+}
+
+impl From<CoreError> for TransientError {
+    fn from(e: CoreError) -> Self {
+        TransientError::Input(e)
+    }
+}
+
+impl std::fmt::Display for TransientError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            TransientError::Input(e) => write!(f, "{e}"),
+            TransientError::Solver { time_s, state, message } => write!(
+                f,
+                "solver failed at t = {time_s:.6} s (ω_p = {:.6} rad/s, ω_t = {:.6} rad/s, ω_s = {:.6} rad/s, Q = {:.6e} m³/s): {message}",
+                state[0], state[1], state[2], state[3]
+            ),
+        }
+    }
+}
+
+pub type TransientResult<T> = Result<T, TransientError>;
+
+/// One sampled instant of a run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    pub time_s: f64,
+    pub u: Vec4,
+    pub u_dot: Vec4,
+    /// External torques on pump, turbine, stator: `M u̇ − F` with the converter's own mass.
+    pub torque: [f64; 3],
+    pub transferred: (f64, f64),
+    pub mode: Mode,
+    pub loss_power_w: f64,
+    pub stored_energy_j: f64,
+}
+
+/// An event: time, kind and the mode after it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Event {
+    pub time_s: f64,
+    pub kind: EventKind,
+    pub mode: Mode,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventKind {
+    StatorRelease,
+    StatorLock,
+    FlowZero,
+    FlowStart,
+}
+
+/// The result of a run: samples at the requested times, the events, and solver statistics.
+#[derive(Debug, Clone, Default)]
+pub struct Trajectory {
+    pub samples: Vec<Sample>,
+    pub events: Vec<Event>,
+    pub steps: usize,
+}
+
+// ---------------------------------------------------------------------------------------------
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Role {
+    Free,
+    Given,
+    Held,
+    Absent,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Root {
+    StatorTorque,
+    StatorSpeed,
+    Flow,
+    FlowStartsPositive,
+    FlowStartsNegative,
+}
+
+/// One smooth piece of a run: a mode, the roles of the coordinates and the reduced mass matrix.
+struct Segment<'a> {
+    model: &'a dyn ConverterDynamics,
+    drive: &'a Drive,
+    /// The model's mass matrix.
+    mass: Mat4,
+    /// The mass matrix of the dynamics (with the load inertia on the turbine in drive c).
+    dyn_mass: Mat4,
+    mode: Mode,
+    role: [Role; 4],
+    free: Vec<usize>,
+    /// Inverse of `M_xx`.
+    inv: Mat4,
+    roots: Vec<Root>,
+}
+
+impl<'a> Segment<'a> {
+    fn new(model: &'a dyn ConverterDynamics, drive: &'a Drive, mode: Mode) -> Self {
+        let present = model.coordinates();
+        let role: [Role; 4] = std::array::from_fn(|c| {
+            if !present[c] {
+                Role::Absent
+            } else if drive.given(c).is_some() {
+                Role::Given
+            } else if (c == STATOR && mode.stator_locked) || (c == FLOW && model.has_flow_sign() && mode.flow_sign == 0.0) {
+                Role::Held
+            } else {
+                Role::Free
+            }
+        });
+        let free: Vec<usize> = (0..4).filter(|&c| role[c] == Role::Free).collect();
+        let mass = model.mass();
+        let mut dyn_mass = mass;
+        if let Some(load) = drive.load() {
+            dyn_mass[TURBINE][TURBINE] += load.inertia_kg_m2;
+        }
+        let n = free.len();
+        let mut sub = [[0.0; 4]; 4];
+        for (i, &r) in free.iter().enumerate() {
+            for (j, &c) in free.iter().enumerate() {
+                sub[i][j] = dyn_mass[r][c];
+            }
+        }
+        let inv = invert(n, &sub).expect("the reduced mass matrix of a positive-definite M is invertible");
+        let mut roots = Vec::new();
+        if model.has_stator_clutch() && present[STATOR] {
+            roots.push(if mode.stator_locked { Root::StatorTorque } else { Root::StatorSpeed });
+        }
+        if model.has_flow_sign() {
+            if mode.flow_sign == 0.0 {
+                roots.extend([Root::FlowStartsPositive, Root::FlowStartsNegative]);
+            } else {
+                roots.push(Root::Flow);
+            }
+        }
+        Self { model, drive, mass, dyn_mass, mode, role, free, inv, roots }
+    }
+
+    /// Number of ODE states (one dummy state when every coordinate is given or held).
+    fn n_states(&self) -> usize {
+        self.free.len().max(1)
+    }
+
+    fn full(&self, x: &[f64], t: f64) -> Vec4 {
+        let mut u = [0.0; 4];
+        for (i, &c) in self.free.iter().enumerate() {
+            u[c] = x[i];
+        }
+        for c in 0..4 {
+            if self.role[c] == Role::Given {
+                u[c] = self.drive.given(c).map_or(0.0, |s| s.value(t));
+            }
+        }
+        u
+    }
+
+    fn state(&self, u: &Vec4) -> Vec<f64> {
+        if self.free.is_empty() {
+            vec![0.0]
+        } else {
+            self.free.iter().map(|&c| u[c]).collect()
+        }
+    }
+
+    fn given_rates(&self, t: f64) -> Vec4 {
+        std::array::from_fn(|c| if self.role[c] == Role::Given { self.drive.given(c).map_or(0.0, |s| s.rate(t)) } else { 0.0 })
+    }
+
+    /// External torques acting on the free coordinates, and their derivative with respect to ω_t.
+    fn external(&self, u: &Vec4, t: f64) -> (Vec4, f64) {
+        let mut e = [0.0; 4];
+        let mut de_dwt = 0.0;
+        if self.role[PUMP] == Role::Free {
+            e[PUMP] = self.drive.pump_torque().map_or(0.0, |s| s.value(t));
+        }
+        if let (Some(load), Role::Free) = (self.drive.load(), self.role[TURBINE]) {
+            let w = u[TURBINE];
+            e[TURBINE] = -(load.torque_nm.value(t) + load.drag_nm_s2 * w * w.abs());
+            de_dwt = -2.0 * load.drag_nm_s2 * w.abs();
+        }
+        (e, de_dwt)
+    }
+
+    /// Right-hand side of the reduced system, `F_x + T_x − M_xz ż`.
+    fn rhs(&self, x: &[f64], t: f64, out: &mut [f64]) {
+        if self.free.is_empty() {
+            out[0] = 0.0;
+            return;
+        }
+        let u = self.full(x, t);
+        let f = self.model.forces(&u, self.mode.flow_sign);
+        let (e, _) = self.external(&u, t);
+        let zd = self.given_rates(t);
+        for (i, &r) in self.free.iter().enumerate() {
+            let coupling: f64 = (0..4).map(|c| self.dyn_mass[r][c] * zd[c]).sum();
+            out[i] = f[r] + e[r] - coupling;
+        }
+    }
+
+    fn jacobian_times(&self, x: &[f64], t: f64, v: &[f64], out: &mut [f64]) {
+        if self.free.is_empty() {
+            out[0] = 0.0;
+            return;
+        }
+        let u = self.full(x, t);
+        let j = self.model.force_jacobian(&u, self.mode.flow_sign);
+        let (_, de_dwt) = self.external(&u, t);
+        for (i, &r) in self.free.iter().enumerate() {
+            out[i] = self.free.iter().enumerate().map(|(k, &c)| (j[r][c] + if r == TURBINE && c == TURBINE { de_dwt } else { 0.0 }) * v[k]).sum();
+        }
+    }
+
+    fn mass_times(&self, v: &[f64], beta: f64, y: &mut [f64]) {
+        if self.free.is_empty() {
+            y[0] = v[0] + beta * y[0];
+            return;
+        }
+        for (i, &r) in self.free.iter().enumerate() {
+            let mv: f64 = self.free.iter().enumerate().map(|(k, &c)| self.dyn_mass[r][c] * v[k]).sum();
+            y[i] = mv + beta * y[i];
+        }
+    }
+
+    /// All coordinates and their rates at (x, t).
+    fn kinematics(&self, x: &[f64], t: f64) -> (Vec4, Vec4) {
+        let u = self.full(x, t);
+        let mut ud = self.given_rates(t);
+        let n = self.free.len();
+        if n > 0 {
+            let mut r = [0.0; 4];
+            self.rhs(x, t, &mut r[..n]);
+            for (i, &c) in self.free.iter().enumerate() {
+                ud[c] = (0..n).map(|k| self.inv[i][k] * r[k]).sum();
+            }
+        }
+        (u, ud)
+    }
+
+    /// `M u̇ − F` with the converter's own mass: the external torque on every coordinate.
+    fn external_torques(&self, u: &Vec4, ud: &Vec4) -> Vec4 {
+        let f = self.model.forces(u, self.mode.flow_sign);
+        std::array::from_fn(|r| (0..4).map(|c| self.mass[r][c] * ud[c]).sum::<f64>() - f[r])
+    }
+
+    /// The net head on a held flow, `d = F_Q(σ = 0) − (M u̇)_Q`, and the shock term `P₀`.
+    fn held_flow_balance(&self, u: &Vec4, ud: &Vec4) -> (f64, f64) {
+        let (head, shock) = self.model.zero_flow_head(u);
+        let inertial: f64 = (0..4).map(|c| self.mass[FLOW][c] * ud[c]).sum();
+        (head - inertial, shock)
+    }
+
+    /// Root functions, each positive while the mode holds (with the hysteresis `h`).
+    fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
+        let (u, ud) = self.kinematics(x, t);
+        for (k, root) in self.roots.iter().enumerate() {
+            out[k] = match root {
+                Root::StatorTorque => self.external_torques(&u, &ud)[STATOR] + h.stator_torque_nm,
+                Root::StatorSpeed => u[STATOR] + h.stator_speed_rad_s,
+                Root::Flow => self.mode.flow_sign * u[FLOW] + h.flow_m3_s,
+                Root::FlowStartsPositive => {
+                    let (d, p0) = self.held_flow_balance(&u, &ud);
+                    p0 - d + h.head_pa
+                }
+                Root::FlowStartsNegative => {
+                    let (d, p0) = self.held_flow_balance(&u, &ud);
+                    p0 + d + h.head_pa
+                }
+            };
+        }
+    }
+
+    fn sample(&self, x: &[f64], t: f64) -> Sample {
+        let (u, ud) = self.kinematics(x, t);
+        let e = self.external_torques(&u, &ud);
+        let stored = 0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| self.mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
+        let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
+        let transferred = self.model.transferred(&u, self.mode.flow_sign);
+        if self.role[STATOR] == Role::Absent {
+            // the reaction that balances the transferred torques
+            torque[2] = transferred.1 - transferred.0;
+        }
+        let loss = if self.mode.flow_sign == 0.0 && self.model.has_flow_sign() { 0.0 } else { self.model.loss_power_w(&u, self.mode.flow_sign) };
+        Sample { time_s: t, u, u_dot: ud, torque, transferred, mode: self.mode, loss_power_w: loss, stored_energy_j: stored }
+    }
+
+    fn atol(&self, o: &SolverOptions) -> Vec<f64> {
+        if self.free.is_empty() {
+            return vec![1.0];
+        }
+        self.free.iter().map(|&c| if c == FLOW { o.flow_atol_m3_s } else { o.speed_atol_rad_s }).collect()
+    }
+}
+
+/// Inverse of the leading n×n block (Gauss–Jordan with partial pivoting).
+fn invert(n: usize, a: &Mat4) -> Option<Mat4> {
+    let mut m = *a;
+    let mut inv = [[0.0; 4]; 4];
+    for (i, row) in inv.iter_mut().enumerate().take(n) {
+        row[i] = 1.0;
+    }
+    for col in 0..n {
+        let p = (col..n).max_by(|&i, &j| m[i][col].abs().total_cmp(&m[j][col].abs()))?;
+        if m[p][col] == 0.0 || !m[p][col].is_finite() {
+            return None;
+        }
+        m.swap(col, p);
+        inv.swap(col, p);
+        let d = m[col][col];
+        for k in 0..n {
+            m[col][k] /= d;
+            inv[col][k] /= d;
+        }
+        for r in 0..n {
+            if r != col {
+                let f = m[r][col];
+                for k in 0..n {
+                    m[r][k] -= f * m[col][k];
+                    inv[r][k] -= f * inv[col][k];
+                }
+            }
+        }
+    }
+    Some(inv)
+}
+
+// ---------------------------------------------------------------------------------------------
+
+/// The mode a state starts in: the stator locked if it stands and the clutch would hold; the flow
+/// sign from Q, or from the held-flow balance when Q = 0.
+fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64) -> Mode {
+    let mut mode = Mode { stator_locked: false, flow_sign: if u[FLOW] > 0.0 { 1.0 } else if u[FLOW] < 0.0 { -1.0 } else { 0.0 } };
+    if model.has_flow_sign() && u[FLOW] == 0.0 {
+        mode.flow_sign = flow_sign_at_zero(model, drive, u, t, mode.stator_locked || u[STATOR] <= 0.0);
+    }
+    if model.has_stator_clutch() && u[STATOR] <= 0.0 {
+        let locked = Mode { stator_locked: true, ..mode };
+        let seg = Segment::new(model, drive, locked);
+        let (uu, ud) = seg.kinematics(&seg.state(u), t);
+        mode.stator_locked = seg.external_torques(&uu, &ud)[STATOR] >= 0.0;
+    }
+    mode
+}
+
+/// Sign of the flow that starts from Q = 0: +1 or −1 when the net head beats the shock term,
+/// else 0 (held).
+fn flow_sign_at_zero(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64, stator_locked: bool) -> f64 {
+    let seg = Segment::new(model, drive, Mode { stator_locked, flow_sign: 0.0 });
+    let mut u0 = *u;
+    u0[FLOW] = 0.0;
+    let (uu, ud) = seg.kinematics(&seg.state(&u0), t);
+    let (d, p0) = seg.held_flow_balance(&uu, &ud);
+    if d > p0 {
+        1.0
+    } else if d < -p0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// The steady state consistent with the inputs at time `t0` (documented default of
+/// `tcsim replay`):
+///
+/// * drive (b): the steady state at the given speeds;
+/// * drive (a): the pump speed whose steady pump torque equals the given pump torque at the given
+///   turbine speed (bisection on SR in (0, 1]; the pump torque of a steady state falls with SR);
+/// * drive (c): the same with the turbine speed from `init` (default 0, a vehicle at rest).
+///
+/// Values in `init` override the steady state.
+pub fn initial_state(model: &dyn ConverterDynamics, drive: &Drive, t0: f64, init: &InitialState) -> TransientResult<Vec4> {
+    let given_wt = drive.given(TURBINE).map(|s| s.value(t0));
+    let given_wp = drive.given(PUMP).map(|s| s.value(t0));
+    let wt = given_wt.or(init.turbine_speed_rad_s).unwrap_or(0.0);
+    let wp = match (given_wp, init.pump_speed_rad_s) {
+        (Some(w), _) | (None, Some(w)) => w,
+        (None, None) => {
+            let tp = drive.pump_torque().map_or(0.0, |s| s.value(t0));
+            steady_pump_speed(model, tp, wt)?
+        }
+    };
+    let mut u = if init.flow_m3_s.is_some() && init.stator_speed_rad_s.is_some() {
+        [wp, wt, 0.0, 0.0]
+    } else {
+        model.steady_point(wp, wt).map_err(|e| CoreError::new(format!("initial state: {}", e.field), e.value, format!("{}; give the initial state explicitly", e.expected)))?.u
+    };
+    u[PUMP] = wp;
+    u[TURBINE] = wt;
+    if let Some(ws) = init.stator_speed_rad_s {
+        u[STATOR] = ws;
+    }
+    if let Some(q) = init.flow_m3_s {
+        u[FLOW] = q;
+    }
+    let present = model.coordinates();
+    for c in 0..4 {
+        if !present[c] {
+            u[c] = 0.0;
+        }
+    }
+    for (name, v) in [("initial pump_speed_rad_s", u[0]), ("initial turbine_speed_rad_s", u[1]), ("initial stator_speed_rad_s", u[2]), ("initial flow_m3_s", u[3])] {
+        if !v.is_finite() {
+            return Err(CoreError::new(name, v, "a finite value").into());
+        }
+    }
+    if model.has_stator_clutch() && u[STATOR] < 0.0 {
+        return Err(CoreError::new("initial stator_speed_rad_s", u[STATOR], "zero or more: the one-way clutch stops backward rotation").into());
+    }
+    Ok(u)
+}
+
+/// The pump speed at which the steady-state pump torque equals `pump_torque_nm` at turbine
+/// speed `wt` ≥ 0.
+fn steady_pump_speed(model: &dyn ConverterDynamics, pump_torque_nm: f64, wt: f64) -> TransientResult<f64> {
+    let bad = |expected: &str| TransientError::Input(CoreError::new("initial pump_torque_nm", pump_torque_nm, expected.to_string()));
+    if !(pump_torque_nm > 0.0) {
+        return Err(bad("a positive pump torque at the start for a steady initial state; give the initial pump speed explicitly"));
+    }
+    if !(wt >= 0.0) {
+        return Err(bad("a turbine speed of zero or more at the start for a steady initial state; give the initial pump speed explicitly"));
+    }
+    let torque_at = |wp: f64| model.steady_point(wp, wt).map(|p| p.pump_torque_nm);
+    if wt == 0.0 {
+        let t1 = torque_at(1.0)?;
+        return Ok((pump_torque_nm / t1).sqrt());
+    }
+    // pump torque falls with SR: bisect on SR in (0, 1]
+    let f = |sr: f64| -> TransientResult<f64> { Ok(torque_at(wt / sr)? - pump_torque_nm) };
+    if f(1.0)? >= 0.0 {
+        return Err(bad("a pump torque above the steady torque at SR = 1 for the first turbine speed (the start is in overrun); give the initial pump speed explicitly"));
+    }
+    let (mut lo, mut hi) = (1e-9_f64, 1.0_f64);
+    if f(lo)? <= 0.0 {
+        return Err(bad("a pump torque the converter can absorb at the first turbine speed"));
+    }
+    for _ in 0..200 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid)? > 0.0 {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+        if hi - lo <= 1e-15 * hi {
+            break;
+        }
+    }
+    Ok(wt / (0.5 * (lo + hi)))
+}
+
+/// Run `model` under `drive`, sampled at `times_s` (sorted, the first is the start time).
+pub fn simulate(model: &dyn ConverterDynamics, drive: &Drive, times_s: &[f64], init: &InitialState, options: &SolverOptions) -> TransientResult<Trajectory> {
+    check_times(times_s)?;
+    let t0 = times_s[0];
+    let u0 = initial_state(model, drive, t0, init)?;
+    let mode = initial_mode(model, drive, &u0, t0);
+    simulate_from(model, drive, times_s, u0, mode, options)
+}
+
+fn check_times(times_s: &[f64]) -> TransientResult<()> {
+    if times_s.len() < 2 {
+        return Err(CoreError::new("time_s", format!("{} samples", times_s.len()), "at least two output times").into());
+    }
+    if let Some(i) = times_s.iter().position(|t| !t.is_finite()) {
+        return Err(CoreError::new(format!("time_s[{i}]"), times_s[i], "finite times").into());
+    }
+    if let Some(i) = (1..times_s.len()).find(|&i| times_s[i] <= times_s[i - 1]) {
+        return Err(CoreError::new(format!("time_s[{i}]"), times_s[i], "strictly increasing times").into());
+    }
+    Ok(())
+}
+
+/// Run from a given state and mode.
+pub fn simulate_from(model: &dyn ConverterDynamics, drive: &Drive, times_s: &[f64], u0: Vec4, mode0: Mode, options: &SolverOptions) -> TransientResult<Trajectory> {
+    check_times(times_s)?;
+    let t_end = *times_s.last().unwrap_or(&0.0);
+    let mut traj = Trajectory { samples: Vec::with_capacity(times_s.len()), ..Default::default() };
+    let (mut t, mut u, mut mode) = (times_s[0], u0, mode0);
+    loop {
+        let seg = Segment::new(model, drive, mode);
+        match run_segment(&seg, &u, t, t_end, times_s, options, &mut traj)? {
+            None => return Ok(traj),
+            Some((t_root, root, x_root)) => {
+                let mut next = seg.full(&x_root, t_root);
+                let (kind, new_mode) = switch(&seg, root, &mut next, t_root);
+                traj.events.push(Event { time_s: t_root, kind, mode: new_mode });
+                if std::env::var("TCSIM_DEBUG").is_ok() { eprintln!("event {t_root} {kind:?} {new_mode:?} u={next:?}"); }
+                if traj.events.len() > options.max_events {
+                    return Err(TransientError::Solver { time_s: t_root, state: next, message: format!("more than {} events: the clutch or flow events chatter", options.max_events) });
+                }
+                t = t_root;
+                u = next;
+                mode = new_mode;
+            }
+        }
+    }
+}
+
+/// The mode after `root` fired, with the state adjusted (a locking stator stops, a reversing flow
+/// passes zero).
+fn switch(seg: &Segment, root: Root, u: &mut Vec4, t: f64) -> (EventKind, Mode) {
+    let mut mode = seg.mode;
+    let kind = match root {
+        Root::StatorTorque => {
+            mode.stator_locked = false;
+            EventKind::StatorRelease
+        }
+        Root::StatorSpeed => {
+            mode.stator_locked = true;
+            u[STATOR] = 0.0;
+            EventKind::StatorLock
+        }
+        Root::Flow => {
+            u[FLOW] = 0.0;
+            mode.flow_sign = flow_sign_at_zero(seg.model, seg.drive, u, t, mode.stator_locked);
+            EventKind::FlowZero
+        }
+        Root::FlowStartsPositive => {
+            mode.flow_sign = 1.0;
+            EventKind::FlowStart
+        }
+        Root::FlowStartsNegative => {
+            mode.flow_sign = -1.0;
+            EventKind::FlowStart
+        }
+    };
+    (kind, mode)
+}
+
+/// Integrate one segment, writing the samples that fall in it. Returns the root that ended it, if
+/// any, with its time and state.
+fn run_segment(seg: &Segment, u0: &Vec4, t0: f64, t_end: f64, times_s: &[f64], o: &SolverOptions, traj: &mut Traj) -> TransientResult<Option<(f64, Root, Vec<f64>)>> {
+    let x0 = seg.state(u0);
+    let n = seg.n_states();
+    let fail = |t: f64, x: &[f64], e: &dyn std::fmt::Display| TransientError::Solver { time_s: t, state: seg.full(x, t), message: e.to_string() };
+    // samples at the start of the segment
+    while traj.samples.len() < times_s.len() && times_s[traj.samples.len()] <= t0 {
+        traj.samples.push(seg.sample(&x0, times_s[traj.samples.len()]));
+    }
+    if t0 >= t_end {
+        return Ok(None);
+    }
+    let nroots = seg.roots.len().max(1);
+    let problem = OdeBuilder::<Matrix>::new()
+        .t0(t0)
+        .h0(o.first_step_s.min(t_end - t0))
+        .rtol(o.rtol)
+        .atol(seg.atol(o))
+        .rhs_implicit(
+            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| seg.rhs(x, t, y),
+            |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| seg.jacobian_times(x, t, v, y),
+        )
+        .mass(|v: &[f64], _p: &[f64], _t: f64, beta: f64, y: &mut [f64]| seg.mass_times(v, beta, y))
+        .init(move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(&x0), n)
+        .root(
+            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
+                if seg.roots.is_empty() {
+                    y[0] = 1.0;
+                } else {
+                    seg.root_values(x, t, &o.hysteresis, y)
+                }
+            },
+            nroots,
+        )
+        .build()
+        .map_err(|e| fail(t0, &seg.state(u0), &e))?;
+    let mut solver = problem.bdf::<Lu>().map_err(|e| fail(t0, &seg.state(u0), &e))?;
+    solver.set_stop_time(t_end).map_err(|e| fail(t0, &seg.state(u0), &e))?;
+    loop {
+        if traj.steps >= o.max_steps {
+            let s = solver.state();
+            return Err(fail(s.t, s.y.batch_as_slice(0), &format!("more than {} steps", o.max_steps)));
+        }
+        traj.steps += 1;
+        let reason = solver.step().map_err(|e| {
+            let s = solver.state();
+            fail(s.t, s.y.batch_as_slice(0), &e)
+        })?;
+        let t_now = solver.state().t;
+        let (upto, root) = match reason {
+            OdeSolverStopReason::RootFound(tr, idx) if !seg.roots.is_empty() => (tr, Some(seg.roots[idx.min(seg.roots.len() - 1)])),
+            _ => (t_now, None),
+        };
+        while traj.samples.len() < times_s.len() && times_s[traj.samples.len()] <= upto {
+            let t = times_s[traj.samples.len()];
+            let x = solver.interpolate(t).map_err(|e| fail(t, &[], &e))?;
+            traj.samples.push(seg.sample(x.batch_as_slice(0), t));
+        }
+        if let Some(root) = root {
+            let x = solver.interpolate(upto).map_err(|e| fail(upto, &[], &e))?;
+            return Ok(Some((upto, root, x.batch_as_slice(0).to_vec())));
+        }
+        if matches!(reason, OdeSolverStopReason::TstopReached) || t_now >= t_end {
+            return Ok(None);
+        }
+    }
+}
+
+type Traj = Trajectory;

@@ -1,0 +1,73 @@
+//! Shared scenarios for the transient tests: the bundled li-sunden-2016 converter and the
+//! isolated take-off of `bench/scipy_reference.py`.
+#![allow(dead_code)]
+
+use tcsim_core::dynamics::{HtDynamics, Inertias, QuasiDynamics, TableDynamics};
+use tcsim_core::hrovat_tobler::HtGeometry;
+use tcsim_core::signal::Signal;
+use tcsim_core::table::Characteristic;
+use tcsim_core::transient::{Drive, TurbineLoad};
+
+pub fn c1() -> Characteristic {
+    Characteristic::new(
+        vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
+        vec![2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
+        vec![3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3, 1.842e-3, 1.237e-3, 0.187e-3],
+    )
+    .unwrap()
+}
+
+pub fn inertia() -> Inertias {
+    Inertias::new(0.109, 0.056, 0.01).unwrap()
+}
+
+/// The bundled converter's shape effects (torus estimate, eqs 2.16–2.18).
+pub const SHAPE: [f64; 3] = [-0.00569, 0.00134, 0.00090];
+
+pub fn ht(shape: [f64; 3]) -> HtDynamics {
+    HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, shape).unwrap()
+}
+
+pub fn table() -> TableDynamics {
+    TableDynamics { characteristic: c1(), inertia: inertia() }
+}
+
+pub fn qd(sp: f64, st: f64) -> QuasiDynamics {
+    QuasiDynamics {
+        characteristic: c1(),
+        inertia: inertia(),
+        fluid_density_kg_m3: 840.0,
+        pump_radius_m: 0.12,
+        pump_shape_effect_m2: sp,
+        turbine_shape_effect_m2: st,
+        flow_time_constant_s: 0.03,
+    }
+}
+
+pub fn signal(name: &str, points: &[(f64, f64)]) -> Signal {
+    Signal::new(name, points.iter().map(|p| p.0).collect(), points.iter().map(|p| p.1).collect(), 0.0).unwrap()
+}
+
+/// Pump torque of the isolated take-off: 40 N·m, ramp to 250 N·m over 0.1–0.3 s; with a tip-out,
+/// a ramp to −30 N·m over 5.0–5.1 s.
+pub fn takeoff_torque(tip_out: bool) -> Signal {
+    let mut p = vec![(0.0, 40.0), (0.1, 40.0), (0.3, 250.0)];
+    if tip_out {
+        p.extend([(5.0, 250.0), (5.1, -30.0)]);
+    }
+    p.push((10.0, *p.last().map(|x: &(f64, f64)| &x.1).unwrap()));
+    signal("pump_torque_nm", &p)
+}
+
+/// Drive (c): the take-off pump torque with the turbine loaded by 1.2 kg·m², 10 N·m and a drag
+/// of 0.002 N·m/(rad/s)².
+pub fn takeoff(tip_out: bool) -> Drive {
+    Drive::PumpTorqueLoad {
+        pump_torque_nm: takeoff_torque(tip_out),
+        load: TurbineLoad { torque_nm: Signal::constant(10.0), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 },
+    }
+}
+
+pub fn grid(t0: f64, t1: f64, n: usize) -> Vec<f64> {
+    (0..n).map(|i| t0 + (t1 - t0) * i as f64 / (n - 1) as f64).collect()
+}
