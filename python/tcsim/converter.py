@@ -198,9 +198,14 @@ class GeometrySection(_Section):
 
 
 class QuasiDynamicSection(_Section):
+    """tcsim's quasi-dynamic model (physics notes §5, docs/transient.md). The density and pump
+    radius set the Euler flow estimate; they default to the [geometry] values."""
+
     pump_shape_effect_m2: float = Field(allow_inf_nan=False)
     turbine_shape_effect_m2: float = Field(allow_inf_nan=False)
     flow_time_constant_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    fluid_density_kg_m3: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    pump_exit_radius_m: float | None = Field(default=None, gt=0, allow_inf_nan=False)
 
 
 #: Geometry keys of the steady state, in the core's parameter order (degrees in files).

@@ -142,3 +142,58 @@ mod tests {
         }
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// Transient runs
+
+/// One transient run of a batch.
+pub struct TransientJob {
+    pub model: Box<dyn crate::dynamics::ConverterDynamics + Send>,
+    pub drive: crate::transient::Drive,
+    pub times_s: Vec<f64>,
+    pub init: crate::transient::InitialState,
+    pub options: crate::transient::SolverOptions,
+}
+
+/// Columns of a run (see [`crate::outputs::COLUMNS`]) and its events.
+pub type RunOutput = (Vec<Vec<f64>>, Vec<crate::transient::Event>);
+
+/// Run one job; a panic inside the solver becomes a solver error instead of unwinding.
+pub fn run_transient_job(job: &TransientJob) -> crate::transient::TransientResult<RunOutput> {
+    use crate::transient::{simulate, TransientError};
+    let run = || {
+        let traj = simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
+        Ok((crate::outputs::columns(job.model.as_ref(), &traj), traj.events))
+    };
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|payload| {
+        let msg = payload.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| payload.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into());
+        Err(TransientError::Solver { time_s: f64::NAN, state: [f64::NAN; 4], message: format!("internal error: {msg}") })
+    })
+}
+
+/// Run all jobs on `threads` worker threads (0: one per core). Results are in job order.
+pub fn run_transient_jobs(jobs: &[TransientJob], threads: usize) -> Vec<crate::transient::TransientResult<RunOutput>> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+    let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }.min(jobs.len()).max(1);
+    if threads == 1 {
+        return jobs.iter().map(run_transient_job).collect();
+    }
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<crate::transient::TransientResult<RunOutput>>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= jobs.len() {
+                    break;
+                }
+                let r = run_transient_job(&jobs[i]);
+                if let Ok(mut guard) = results.lock() {
+                    guard[i] = Some(r);
+                }
+            });
+        }
+    });
+    results.into_inner().unwrap_or_default().into_iter().map(|r| r.expect("every job ran")).collect()
+}

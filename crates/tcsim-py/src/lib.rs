@@ -11,7 +11,10 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use tcsim_core::batch::{ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states};
+use tcsim_core::batch::{ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs, TransientJob};
+use tcsim_core::dynamics::{ConverterDynamics, HtDynamics, Inertias, QuasiDynamics, TableDynamics};
+use tcsim_core::signal::Signal;
+use tcsim_core::transient::{Drive, EventKind, InitialState, SolverOptions, TransientError, TurbineLoad};
 use tcsim_core::capacity::CapacityConvention;
 use tcsim_core::hrovat_tobler::{coupling_point, HtGeometry, HtParam, N_PARAMS};
 use tcsim_core::table::Characteristic;
@@ -215,6 +218,188 @@ fn table_steady_states<'py>(
     })
 }
 
+// ---------------------------------------------------------------------------------------------
+// Transient runs
+
+fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
+    d.get_item(key)?
+        .ok_or_else(|| PyValueError::new_err(format!("missing key {key:?}")))?
+        .extract::<T>()
+        .map_err(|e| PyValueError::new_err(format!("{key}: {}", Into::<PyErr>::into(e))))
+}
+
+fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Option<T>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        Some(v) => v.extract::<T>().map(Some).map_err(|e| PyValueError::new_err(format!("{key}: {}", Into::<PyErr>::into(e)))),
+    }
+}
+
+fn model_from(d: &Bound<'_, PyDict>) -> PyResult<Box<dyn ConverterDynamics + Send>> {
+    let kind: String = item(d, "kind")?;
+    let inertia: [f64; 3] = item(d, "inertia_kg_m2")?;
+    let inertia = Inertias::new(inertia[0], inertia[1], inertia[2]).map_err(input_error)?;
+    let table = || -> PyResult<Characteristic> {
+        Characteristic::new(item(d, "speed_ratio")?, item(d, "torque_ratio")?, item(d, "capacity_factor_nm_s2")?).map_err(input_error)
+    };
+    Ok(match kind.as_str() {
+        "table" => Box::new(TableDynamics { characteristic: table()?, inertia }),
+        "quasi-dynamic" => {
+            let shape: [f64; 2] = item(d, "shape_effect_m2")?;
+            let m = QuasiDynamics {
+                characteristic: table()?,
+                inertia,
+                fluid_density_kg_m3: item(d, "fluid_density_kg_m3")?,
+                pump_radius_m: item(d, "pump_exit_radius_m")?,
+                pump_shape_effect_m2: shape[0],
+                turbine_shape_effect_m2: shape[1],
+                flow_time_constant_s: item(d, "flow_time_constant_s")?,
+            };
+            m.validate().map_err(input_error)?;
+            Box::new(m)
+        }
+        "hrovat-tobler" => {
+            let g: Vec<f64> = item(d, "geometry")?;
+            let g: [f64; N_PARAMS] = g.try_into().map_err(|_| PyValueError::new_err(format!("geometry must have {N_PARAMS} values")))?;
+            let geometry = HtGeometry::new(g).map_err(input_error)?;
+            Box::new(HtDynamics::new(geometry, inertia, item(d, "fluid_length_m")?, item(d, "shape_effect_m2")?).map_err(input_error)?)
+        }
+        other => return Err(PyValueError::new_err(format!("unknown model kind {other:?}"))),
+    })
+}
+
+fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal> {
+    let t: Vec<f64> = item(d, "time_s")?;
+    match d.get_item(key)? {
+        Some(v) if v.extract::<f64>().is_ok() => Ok(Signal::constant(v.extract::<f64>()?)),
+        _ => Signal::new(key, t, item(d, key)?, window).map_err(input_error),
+    }
+}
+
+fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
+    let kind: String = item(d, "kind")?;
+    let window: f64 = opt_item(d, "derivative_window_s")?.unwrap_or(tcsim_core::signal::DEFAULT_DERIVATIVE_WINDOW_S);
+    let out: Vec<f64> = match opt_item(d, "output_time_s")? {
+        Some(t) => t,
+        None => item(d, "time_s")?,
+    };
+    let drive = match kind.as_str() {
+        "pump-torque-turbine-speed" => Drive::PumpTorqueTurbineSpeed {
+            pump_torque_nm: signal_from(d, "pump_torque_nm", window)?,
+            turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)?,
+        },
+        "speeds" => Drive::Speeds { pump_speed_rad_s: signal_from(d, "pump_speed_rad_s", window)?, turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)? },
+        "pump-torque-load" => {
+            let load = TurbineLoad {
+                torque_nm: signal_from(d, "load_torque_nm", window)?,
+                inertia_kg_m2: item(d, "load_inertia_kg_m2")?,
+                drag_nm_s2: opt_item(d, "load_drag_nm_s2")?.unwrap_or(0.0),
+            };
+            if !(load.inertia_kg_m2.is_finite() && load.inertia_kg_m2 >= 0.0) {
+                return Err(input_error(CoreError::new("load_inertia_kg_m2", load.inertia_kg_m2, "a finite inertia of zero or more in kg·m²")));
+            }
+            if !(load.drag_nm_s2.is_finite() && load.drag_nm_s2 >= 0.0) {
+                return Err(input_error(CoreError::new("load_drag_nm_s2", load.drag_nm_s2, "a finite drag coefficient of zero or more")));
+            }
+            Drive::PumpTorqueLoad { pump_torque_nm: signal_from(d, "pump_torque_nm", window)?, load }
+        }
+        other => return Err(PyValueError::new_err(format!("unknown drive kind {other:?}"))),
+    };
+    Ok((drive, out))
+}
+
+fn init_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<InitialState> {
+    let Some(d) = d else { return Ok(InitialState::default()) };
+    Ok(InitialState {
+        pump_speed_rad_s: opt_item(d, "pump_speed_rad_s")?,
+        turbine_speed_rad_s: opt_item(d, "turbine_speed_rad_s")?,
+        stator_speed_rad_s: opt_item(d, "stator_speed_rad_s")?,
+        flow_m3_s: opt_item(d, "flow_m3_s")?,
+    })
+}
+
+fn options_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<SolverOptions> {
+    let mut o = SolverOptions::default();
+    if let Some(d) = d {
+        o.rtol = opt_item(d, "rtol")?.unwrap_or(o.rtol);
+        o.speed_atol_rad_s = opt_item(d, "speed_atol_rad_s")?.unwrap_or(o.speed_atol_rad_s);
+        o.flow_atol_m3_s = opt_item(d, "flow_atol_m3_s")?.unwrap_or(o.flow_atol_m3_s);
+        o.first_step_s = opt_item(d, "first_step_s")?.unwrap_or(o.first_step_s);
+        o.max_events = opt_item(d, "max_events")?.unwrap_or(o.max_events);
+    }
+    for (k, v) in [("rtol", o.rtol), ("speed_atol_rad_s", o.speed_atol_rad_s), ("flow_atol_m3_s", o.flow_atol_m3_s), ("first_step_s", o.first_step_s)] {
+        if !(v.is_finite() && v > 0.0) {
+            return Err(input_error(CoreError::new(k, v, "a finite, positive tolerance")));
+        }
+    }
+    Ok(o)
+}
+
+fn event_name(k: EventKind) -> &'static str {
+    match k {
+        EventKind::StatorRelease => "stator-release",
+        EventKind::StatorLock => "stator-lock",
+        EventKind::FlowZero => "flow-zero",
+        EventKind::FlowStart => "flow-start",
+    }
+}
+
+/// Output column names of a transient run.
+#[pyfunction]
+fn transient_columns() -> Vec<&'static str> {
+    tcsim_core::outputs::COLUMNS.to_vec()
+}
+
+/// Run transient jobs: `models[i]` under `drives[i]` (a list of length one is broadcast), with
+/// the GIL released and `threads` workers (0: one per core). Each model and drive is a dict (see
+/// tcsim.transient). Returns one entry per job: `("ok", {column: array}, [(time_s, kind, stator_locked,
+/// flow_sign)])`, or `("input", message, field, value, expected)`, or `("solver", message)`.
+#[pyfunction]
+#[pyo3(signature = (models, drives, init=None, options=None, threads=0))]
+fn transient_runs<'py>(
+    py: Python<'py>,
+    models: Vec<Bound<'py, PyDict>>,
+    drives: Vec<Bound<'py, PyDict>>,
+    init: Option<Bound<'py, PyDict>>,
+    options: Option<Bound<'py, PyDict>>,
+    threads: usize,
+) -> PyResult<Vec<Py<PyAny>>> {
+    guard(|| {
+        let n = models.len().max(drives.len());
+        if models.is_empty() || drives.is_empty() || (models.len() != n && models.len() != 1) || (drives.len() != n && drives.len() != 1) {
+            return Err(PyValueError::new_err("models and drives must have equal lengths, or one of them length one"));
+        }
+        let init = init_from(init.as_ref())?;
+        let options = options_from(options.as_ref())?;
+        let parsed_drives = drives.iter().map(|d| drive_from(d)).collect::<PyResult<Vec<_>>>()?;
+        let jobs = (0..n)
+            .map(|i| {
+                let (drive, times) = &parsed_drives[if parsed_drives.len() == 1 { 0 } else { i }];
+                Ok(TransientJob { model: model_from(&models[if models.len() == 1 { 0 } else { i }])?, drive: drive.clone(), times_s: times.clone(), init, options })
+            })
+            .collect::<PyResult<Vec<_>>>()?;
+        let results = py.detach(|| run_transient_jobs(&jobs, threads));
+        results
+            .into_iter()
+            .map(|r| -> PyResult<Py<PyAny>> {
+                Ok(match r {
+                    Ok((cols, events)) => {
+                        let d = PyDict::new(py);
+                        for (name, col) in tcsim_core::outputs::COLUMNS.iter().zip(cols) {
+                            d.set_item(*name, col.into_pyarray(py))?;
+                        }
+                        let ev: Vec<(f64, &str, bool, f64)> = events.iter().map(|e| (e.time_s, event_name(e.kind), e.mode.stator_locked, e.mode.flow_sign)).collect();
+                        ("ok", d, ev).into_pyobject(py)?.into_any().unbind()
+                    }
+                    Err(TransientError::Input(e)) => ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind(),
+                    Err(e @ TransientError::Solver { .. }) => ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind(),
+                })
+            })
+            .collect()
+    })
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
@@ -228,5 +413,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ht_ratio_gradients, m)?)?;
     m.add_function(wrap_pyfunction!(table_check, m)?)?;
     m.add_function(wrap_pyfunction!(table_steady_states, m)?)?;
+    m.add_function(wrap_pyfunction!(transient_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
     Ok(())
 }
