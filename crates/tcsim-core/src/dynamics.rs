@@ -54,10 +54,17 @@ pub trait ConverterDynamics: Sync {
     /// `∂F/∂u`, analytic.
     fn force_jacobian(&self, u: &Vec4, flow_sign: f64) -> Mat4;
     /// Torques transferred by the fluid at the pump and at the turbine (figure 3.15): the pump
-    /// torque absorbed, and the turbine torque produced, not counting inertia and fluid terms.
-    fn transferred(&self, u: &Vec4, flow_sign: f64) -> (f64, f64);
-    /// Power dissipated in the fluid, `Q·P_loss` for Hrovat & Tobler (≥ 0).
-    fn loss_power_w(&self, u: &Vec4, flow_sign: f64) -> f64;
+    /// torque absorbed, and the turbine torque produced, not counting inertia and fluid terms,
+    /// given the forces `f = F(u)`.
+    fn transferred(&self, f: &Vec4) -> (f64, f64) {
+        (-f[PUMP], f[TURBINE])
+    }
+    /// Power dissipated in the fluid given the forces `f = F(u)`: `−u·F`, which is `Q·P_loss`
+    /// (≥ 0) for Hrovat & Tobler (the flow terms cancel, physics notes §4) and the power the
+    /// table's torques absorb, `T_p,tr ω_p − T_t,tr ω_t`, for the table models.
+    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
+        -(u[0] * f[0] + u[1] * f[1] + u[2] * f[2] + u[3] * f[3])
+    }
     /// The steady state at the given pump and turbine speeds (0 ≤ SR ≤ 1, ω_p > 0).
     fn steady_point(&self, pump_speed_rad_s: f64, turbine_speed_rad_s: f64) -> CoreResult<SteadyPoint>;
     /// Whether the model has a stator one-way clutch (and so stator events).
@@ -174,14 +181,6 @@ impl ConverterDynamics for TableDynamics {
         j[TURBINE][TURBINE] = dtt[1];
         j
     }
-    fn transferred(&self, u: &Vec4, _s: f64) -> (f64, f64) {
-        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
-        (tp, tt)
-    }
-    fn loss_power_w(&self, u: &Vec4, s: f64) -> f64 {
-        let (tp, tt) = self.transferred(u, s);
-        tp * u[PUMP] - tt * u[TURBINE]
-    }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         Ok(SteadyPoint { u: [wp, wt, 0.0, 0.0], pump_torque_nm: table_steady(&self.characteristic, wp, wt)? })
     }
@@ -281,13 +280,9 @@ impl ConverterDynamics for QuasiDynamics {
         j[FLOW][FLOW] = -1.0 / tau;
         j
     }
-    fn transferred(&self, u: &Vec4, _s: f64) -> (f64, f64) {
-        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
-        (tp, tt)
-    }
-    fn loss_power_w(&self, u: &Vec4, s: f64) -> f64 {
-        let (tp, tt) = self.transferred(u, s);
-        tp * u[PUMP] - tt * u[TURBINE]
+    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
+        // the flow row is a lag, not a power balance
+        -(u[PUMP] * f[PUMP] + u[TURBINE] * f[TURBINE])
     }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         let tp = table_steady(&self.characteristic, wp, wt)?;
@@ -314,11 +309,13 @@ pub struct HtDynamics {
     pub fluid_length_m: f64,
     /// Shape effects of pump, turbine and stator, m² (eqs 2.16–2.18).
     pub shape_effect_m2: [f64; 3],
+    k: HtConst,
 }
 
 const SHAPE_KEYS: [&str; 3] = ["geometry.pump_shape_effect_m2", "geometry.turbine_shape_effect_m2", "geometry.stator_shape_effect_m2"];
 
 /// Constants of eqs 2.12–2.25 for fast evaluation.
+#[derive(Debug, Clone)]
 struct HtConst {
     rho: f64,
     area: f64,
@@ -344,7 +341,7 @@ impl HtDynamics {
                 return Err(CoreError::new(*k, s, "a finite shape effect in m²"));
             }
         }
-        let d = Self { geometry, inertia, fluid_length_m, shape_effect_m2 };
+        let d = Self { k: Self::constants(&geometry), geometry, inertia, fluid_length_m, shape_effect_m2 };
         d.check_mass_matrix()?;
         Ok(d)
     }
@@ -396,9 +393,8 @@ impl HtDynamics {
         ))
     }
 
-    fn constants(&self) -> HtConst {
+    fn constants(g: &HtGeometry<f64>) -> HtConst {
         use HtParam::*;
-        let g = &self.geometry;
         let r = [g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius)];
         let t = [g.get(PumpExitAngle).tan(), g.get(TurbineExitAngle).tan(), g.get(StatorExitAngle).tan()];
         let ti = [g.get(PumpInletAngle).tan(), g.get(TurbineInletAngle).tan(), g.get(StatorInletAngle).tan()];
@@ -448,7 +444,7 @@ impl ConverterDynamics for HtDynamics {
         m
     }
     fn forces(&self, u: &Vec4, sigma: f64) -> Vec4 {
-        let k = self.constants();
+        let k = &self.k;
         let w = [u[PUMP], u[TURBINE], u[STATOR]];
         let flow = u[FLOW];
         let q = flow / k.area;
@@ -460,7 +456,7 @@ impl ConverterDynamics for HtDynamics {
             - k.r2[1] * w[2] * w[1];
         let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
         let linear = q * (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]);
-        let v = shock_velocities(&k, &w, q);
+        let v = shock_velocities(k, &w, q);
         let loss = sigma * 0.5 * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2] + k.friction * q * q);
         [
             -k.rho * (h[0] - h[2]) * flow,
@@ -470,14 +466,14 @@ impl ConverterDynamics for HtDynamics {
         ]
     }
     fn force_jacobian(&self, u: &Vec4, sigma: f64) -> Mat4 {
-        let k = self.constants();
+        let k = &self.k;
         let (rho, area) = (k.rho, k.area);
         let w = [u[PUMP], u[TURBINE], u[STATOR]];
         let flow = u[FLOW];
         let q = flow / area;
         let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.rt[i] * q);
         let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
-        let v = shock_velocities(&k, &w, q);
+        let v = shock_velocities(k, &w, q);
         let mut j = [[0.0; 4]; 4];
         // torques: F_i = −ρ (h_i − h_prev(i)) Q with prev = stator, pump, turbine
         let prev = [2usize, 0, 1];
@@ -506,15 +502,6 @@ impl ConverterDynamics for HtDynamics {
         j[FLOW][FLOW] = rho * ((w[0] * a[0] + w[1] * a[1] + w[2] * a[2]) - dloss_dq) / area;
         j
     }
-    fn transferred(&self, u: &Vec4, sigma: f64) -> (f64, f64) {
-        let f = self.forces(u, sigma);
-        (-f[PUMP], f[TURBINE])
-    }
-    fn loss_power_w(&self, u: &Vec4, sigma: f64) -> f64 {
-        // −(ω·F): the flow terms cancel exactly (physics notes §4), leaving Q·P_loss
-        let f = self.forces(u, sigma);
-        -(u[0] * f[0] + u[1] * f[1] + u[2] * f[2] + u[3] * f[3])
-    }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         let s = steady_state(&self.geometry, wp, wt)?;
         Ok(SteadyPoint { u: [wp, wt, s.stator_speed_rad_s, s.flow_m3_s], pump_torque_nm: s.pump_torque_nm })
@@ -522,8 +509,8 @@ impl ConverterDynamics for HtDynamics {
     fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
         let mut at_zero = *u;
         at_zero[FLOW] = 0.0;
-        let k = self.constants();
-        let v = shock_velocities(&k, &[u[0], u[1], u[2]], 0.0);
+        let k = &self.k;
+        let v = shock_velocities(k, &[u[0], u[1], u[2]], 0.0);
         let shock = 0.5 * k.rho * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2]);
         (self.forces(&at_zero, 0.0)[FLOW], shock)
     }
@@ -609,7 +596,7 @@ mod tests {
             let rho = g.get(FluidDensity);
             let vre2: f64 = [PumpExitAngle, TurbineExitAngle, StatorExitAngle].iter().map(|&a| q * q * (1.0 + t(a).powi(2))).sum();
             let ploss = sigma * rho / 2.0 * (vp * vp + vt * vt + vs * vs) + sigma * rho * g.get(FrictionLoss) / 2.0 * vre2;
-            let lp = h.loss_power_w(&u, sigma);
+            let lp = h.loss_power_w(&u, &h.forces(&u, sigma));
             assert!((lp - u[3] * ploss).abs() <= 1e-10 * lp.abs(), "{lp} vs {}", u[3] * ploss);
             assert!(lp > 0.0);
         }

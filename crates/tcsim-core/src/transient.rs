@@ -315,9 +315,9 @@ impl<'a> Segment<'a> {
         for (i, &c) in self.free.iter().enumerate() {
             u[c] = x[i];
         }
-        for c in 0..4 {
+        for (c, value) in u.iter_mut().enumerate() {
             if self.role[c] == Role::Given {
-                u[c] = self.drive.given(c).map_or(0.0, |s| s.value(t));
+                *value = self.drive.given(c).map_or(0.0, |s| s.value(t));
             }
         }
         u
@@ -350,7 +350,16 @@ impl<'a> Segment<'a> {
         (e, de_dwt)
     }
 
-    /// Right-hand side of the reduced system, `F_x + T_x − M_xz ż`.
+    /// Right-hand side of the reduced system, `F_x + T_x − M_xz ż`, given `u` and `f = F(u)`.
+    fn reduced_rhs(&self, u: &Vec4, f: &Vec4, t: f64, out: &mut [f64]) {
+        let (e, _) = self.external(u, t);
+        let zd = self.given_rates(t);
+        for (i, &r) in self.free.iter().enumerate() {
+            let coupling: f64 = (0..4).map(|c| self.dyn_mass[r][c] * zd[c]).sum();
+            out[i] = f[r] + e[r] - coupling;
+        }
+    }
+
     fn rhs(&self, x: &[f64], t: f64, out: &mut [f64]) {
         if self.free.is_empty() {
             out[0] = 0.0;
@@ -358,12 +367,7 @@ impl<'a> Segment<'a> {
         }
         let u = self.full(x, t);
         let f = self.model.forces(&u, self.mode.flow_sign);
-        let (e, _) = self.external(&u, t);
-        let zd = self.given_rates(t);
-        for (i, &r) in self.free.iter().enumerate() {
-            let coupling: f64 = (0..4).map(|c| self.dyn_mass[r][c] * zd[c]).sum();
-            out[i] = f[r] + e[r] - coupling;
-        }
+        self.reduced_rhs(&u, &f, t, out);
     }
 
     fn jacobian_times(&self, x: &[f64], t: f64, v: &[f64], out: &mut [f64]) {
@@ -390,24 +394,24 @@ impl<'a> Segment<'a> {
         }
     }
 
-    /// All coordinates and their rates at (x, t).
-    fn kinematics(&self, x: &[f64], t: f64) -> (Vec4, Vec4) {
+    /// All coordinates, their rates and the forces at (x, t).
+    fn kinematics(&self, x: &[f64], t: f64) -> (Vec4, Vec4, Vec4) {
         let u = self.full(x, t);
+        let f = self.model.forces(&u, self.mode.flow_sign);
         let mut ud = self.given_rates(t);
         let n = self.free.len();
         if n > 0 {
             let mut r = [0.0; 4];
-            self.rhs(x, t, &mut r[..n]);
+            self.reduced_rhs(&u, &f, t, &mut r[..n]);
             for (i, &c) in self.free.iter().enumerate() {
                 ud[c] = (0..n).map(|k| self.inv[i][k] * r[k]).sum();
             }
         }
-        (u, ud)
+        (u, ud, f)
     }
 
     /// `M u̇ − F` with the converter's own mass: the external torque on every coordinate.
-    fn external_torques(&self, u: &Vec4, ud: &Vec4) -> Vec4 {
-        let f = self.model.forces(u, self.mode.flow_sign);
+    fn external_torques(&self, ud: &Vec4, f: &Vec4) -> Vec4 {
         std::array::from_fn(|r| (0..4).map(|c| self.mass[r][c] * ud[c]).sum::<f64>() - f[r])
     }
 
@@ -420,10 +424,10 @@ impl<'a> Segment<'a> {
 
     /// Root functions, each positive while the mode holds (with the hysteresis `h`).
     fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
-        let (u, ud) = self.kinematics(x, t);
+        let (u, ud, f) = self.kinematics(x, t);
         for (k, root) in self.roots.iter().enumerate() {
             out[k] = match root {
-                Root::StatorTorque => self.external_torques(&u, &ud)[STATOR] + h.stator_torque_nm,
+                Root::StatorTorque => self.external_torques(&ud, &f)[STATOR] + h.stator_torque_nm,
                 Root::StatorSpeed => u[STATOR] + h.stator_speed_rad_s,
                 Root::Flow => self.mode.flow_sign * u[FLOW] + h.flow_m3_s,
                 Root::FlowStartsPositive => {
@@ -439,16 +443,16 @@ impl<'a> Segment<'a> {
     }
 
     fn sample(&self, x: &[f64], t: f64) -> Sample {
-        let (u, ud) = self.kinematics(x, t);
-        let e = self.external_torques(&u, &ud);
+        let (u, ud, f) = self.kinematics(x, t);
+        let e = self.external_torques(&ud, &f);
         let stored = 0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| self.mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
         let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
-        let transferred = self.model.transferred(&u, self.mode.flow_sign);
+        let transferred = self.model.transferred(&f);
         if self.role[STATOR] == Role::Absent {
             // the reaction that balances the transferred torques
             torque[2] = transferred.1 - transferred.0;
         }
-        let loss = if self.mode.flow_sign == 0.0 && self.model.has_flow_sign() { 0.0 } else { self.model.loss_power_w(&u, self.mode.flow_sign) };
+        let loss = if self.mode.flow_sign == 0.0 && self.model.has_flow_sign() { 0.0 } else { self.model.loss_power_w(&u, &f) };
         Sample { time_s: t, u, u_dot: ud, torque, transferred, mode: self.mode, loss_power_w: loss, stored_energy_j: stored }
     }
 
@@ -504,8 +508,8 @@ fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64) 
     if model.has_stator_clutch() && u[STATOR] <= 0.0 {
         let locked = Mode { stator_locked: true, ..mode };
         let seg = Segment::new(model, drive, locked);
-        let (uu, ud) = seg.kinematics(&seg.state(u), t);
-        mode.stator_locked = seg.external_torques(&uu, &ud)[STATOR] >= 0.0;
+        let (_, ud, f) = seg.kinematics(&seg.state(u), t);
+        mode.stator_locked = seg.external_torques(&ud, &f)[STATOR] >= 0.0;
     }
     mode
 }
@@ -516,7 +520,7 @@ fn flow_sign_at_zero(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: 
     let seg = Segment::new(model, drive, Mode { stator_locked, flow_sign: 0.0 });
     let mut u0 = *u;
     u0[FLOW] = 0.0;
-    let (uu, ud) = seg.kinematics(&seg.state(&u0), t);
+    let (uu, ud, _) = seg.kinematics(&seg.state(&u0), t);
     let (d, p0) = seg.held_flow_balance(&uu, &ud);
     if d > p0 {
         1.0
@@ -581,10 +585,10 @@ pub fn initial_state(model: &dyn ConverterDynamics, drive: &Drive, t0: f64, init
 /// speed `wt` ≥ 0.
 fn steady_pump_speed(model: &dyn ConverterDynamics, pump_torque_nm: f64, wt: f64) -> TransientResult<f64> {
     let bad = |expected: &str| TransientError::Input(CoreError::new("initial pump_torque_nm", pump_torque_nm, expected.to_string()));
-    if !(pump_torque_nm > 0.0) {
+    if pump_torque_nm.is_nan() || pump_torque_nm <= 0.0 {
         return Err(bad("a positive pump torque at the start for a steady initial state; give the initial pump speed explicitly"));
     }
-    if !(wt >= 0.0) {
+    if wt.is_nan() || wt < 0.0 {
         return Err(bad("a turbine speed of zero or more at the start for a steady initial state; give the initial pump speed explicitly"));
     }
     let torque_at = |wp: f64| model.steady_point(wp, wt).map(|p| p.pump_torque_nm);

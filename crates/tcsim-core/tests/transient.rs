@@ -1,20 +1,259 @@
+//! Physical invariants of the transient engine (issue 3 acceptance).
+
 mod common;
 
 use common::*;
-use tcsim_core::transient::{simulate, InitialState, SolverOptions};
+use tcsim_core::dynamics::ConverterDynamics;
+use tcsim_core::hrovat_tobler::{coupling_point, steady_state, HtGeometry, StatorMode};
+use tcsim_core::outputs::{columns, COLUMNS};
+use tcsim_core::signal::Signal;
+use tcsim_core::transient::{simulate, Drive, EventKind, InitialState, SolverOptions, Trajectory};
+
+fn col<'a>(cols: &'a [Vec<f64>], name: &str) -> &'a [f64] {
+    &cols[COLUMNS.iter().position(|c| *c == name).unwrap_or_else(|| panic!("no column {name}"))]
+}
+
+fn run(model: &dyn ConverterDynamics, drive: &Drive, t: &[f64], init: InitialState) -> (Trajectory, Vec<Vec<f64>>) {
+    let traj = simulate(model, drive, t, &init, &SolverOptions::default()).unwrap_or_else(|e| panic!("{e}"));
+    let cols = columns(model, &traj);
+    (traj, cols)
+}
+
+fn trapezoid(t: &[f64], y: &[f64]) -> f64 {
+    (1..t.len()).map(|i| 0.5 * (y[i] + y[i - 1]) * (t[i] - t[i - 1])).sum()
+}
+
+/// Residual of the energy identity (physics notes §4) relative to the energy that passed through
+/// the converter: Δ stored − ∫(input power − loss power).
+fn energy_residual(cols: &[Vec<f64>]) -> (f64, f64) {
+    let t = col(cols, "time_s");
+    let stored = col(cols, "stored_energy_j");
+    let input = col(cols, "converter_input_power_w");
+    let loss = col(cols, "fluid_loss_power_w");
+    let net: Vec<f64> = input.iter().zip(loss).map(|(i, l)| i - l).collect();
+    let passed = trapezoid(t, &col(cols, "pump_torque_nm").iter().zip(col(cols, "pump_speed_rad_s")).map(|(a, b)| (a * b).abs()).collect::<Vec<_>>());
+    let residual = (stored[stored.len() - 1] - stored[0]) - trapezoid(t, &net);
+    (residual / passed, passed)
+}
 
 #[test]
-fn smoke() {
-    let m = ht(SHAPE);
-    let t = grid(0.0, 10.0, 1001);
-    let start = std::time::Instant::now();
-    let r = simulate(&m, &takeoff(false), &t, &InitialState::default(), &SolverOptions::default()).unwrap();
-    println!("{:?} steps {} events {:?}", start.elapsed(), r.steps, r.events);
-    println!("{:?}", r.samples.last().unwrap());
-    let o = SolverOptions { max_events: 20, ..Default::default() };
-    let r = tcsim_core::transient::simulate(&m, &takeoff(true), &t, &InitialState::default(), &o);
-    if let Err(e) = &r { println!("{e}"); }
-    let r = r.unwrap();
-    println!("steps {} events {:?}", r.steps, r.events);
-    println!("{:?}", r.samples.last().unwrap());
+fn energy_identity_holds_through_clutch_and_flow_events() {
+    let t = grid(0.0, 10.0, 40_001);
+    for tip_out in [false, true] {
+        let (traj, cols) = run(&ht(SHAPE), &takeoff(tip_out), &t, InitialState::default());
+        assert!(traj.events.iter().any(|e| e.kind == EventKind::StatorRelease), "{:?}", traj.events);
+        let (rel, passed) = energy_residual(&cols);
+        println!("tip_out={tip_out}: energy through the pump {passed:.0} J, residual {rel:.2e}, events {}", traj.events.len());
+        assert!(rel.abs() < 1e-3, "energy residual {rel:e}");
+        // the losses dissipate
+        assert!(col(&cols, "fluid_loss_power_w").iter().all(|&p| p >= -1e-9));
+    }
+    // the table model balances too: its "loss" is the power the table's torques absorb
+    let (_, cols) = run(&table(), &takeoff(false), &t, InitialState::default());
+    assert!(energy_residual(&cols).0.abs() < 1e-3);
+}
+
+#[test]
+fn agrees_with_the_scipy_reference_take_off() {
+    // bench/scipy_reference.py (LSODA/Radau, rtol 1e-10): final state at 10 s and event times
+    let t = grid(0.0, 10.0, 101);
+    let (traj, cols) = run(&ht(SHAPE), &takeoff(true), &t, InitialState::default());
+    let reference_events = [2.3734962, 5.1049215, 5.5777629, 5.6587392, 6.8475352, 8.8716640];
+    let times: Vec<f64> = traj.events.iter().map(|e| e.time_s).collect();
+    assert_eq!(times.len(), reference_events.len(), "{:?}", traj.events);
+    for (a, b) in times.iter().zip(reference_events) {
+        assert!((a - b).abs() < 5e-5, "event at {a} vs {b}");
+    }
+    let last = |name| *col(&cols, name).last().unwrap();
+    for (name, reference) in [("pump_speed_rad_s", -126.98775), ("turbine_speed_rad_s", 21.33480), ("flow_m3_s", 0.01775067), ("stator_torque_nm", 3.4574)] {
+        assert!((last(name) - reference).abs() <= 2e-4 * reference.abs(), "{name}: {} vs {reference}", last(name));
+    }
+    let (_, cols) = run(&ht(SHAPE), &takeoff(false), &t, InitialState::default());
+    let last = |name| *col(&cols, name).last().unwrap();
+    for (name, reference) in [("pump_speed_rad_s", 375.57147), ("turbine_speed_rad_s", 346.39751), ("stator_speed_rad_s", 48.21712), ("flow_m3_s", 0.07111556)] {
+        assert!((last(name) - reference).abs() <= 1e-5 * reference.abs(), "{name}: {} vs {reference}", last(name));
+    }
+}
+
+/// Drive (b) at constant speeds.
+fn held(wp: f64, wt: f64, until: f64) -> Drive {
+    Drive::Speeds { pump_speed_rad_s: signal("pump_speed_rad_s", &[(0.0, wp), (until, wp)]), turbine_speed_rad_s: signal("turbine_speed_rad_s", &[(0.0, wt), (until, wt)]) }
+}
+
+#[test]
+fn held_speeds_settle_on_the_closed_form_steady_state() {
+    let g = HtGeometry::appendix_d();
+    let wp = 209.44;
+    let t = grid(0.0, 10.0, 101);
+    // locked (SR 0, 0.5), free-wheeling (SR 0.95) and no-flow (SR 0.995) steady states, each
+    // started away from it: half the flow, stator at rest. (Without flow the stator speed is
+    // undetermined: it keeps whatever speed it had when the flow stopped.)
+    for sr in [0.0, 0.5, 0.95, 0.995] {
+        let ss = steady_state(&g, wp, sr * wp).unwrap();
+        let init = InitialState { flow_m3_s: Some(0.5 * ss.flow_m3_s.max(0.02)), stator_speed_rad_s: Some(0.0), ..Default::default() };
+        let (traj, cols) = run(&ht(SHAPE), &held(wp, sr * wp, 10.0), &t, init);
+        let last = |name| *col(&cols, name).last().unwrap();
+        let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-3 * ss.pump_torque_nm.abs().max(1.0));
+        println!("SR {sr}: mode {:?}, Q {} vs {}, events {:?}", ss.mode, last("flow_m3_s"), ss.flow_m3_s, traj.events.len());
+        match ss.mode {
+            StatorMode::NoFlow => {
+                assert_eq!(last("flow_m3_s"), 0.0);
+                assert_eq!(last("flow_direction"), 0.0);
+                assert_eq!(last("pump_torque_nm"), 0.0);
+            }
+            _ => {
+                assert!(rel(last("flow_m3_s"), ss.flow_m3_s) < 1e-4, "Q {} vs {}", last("flow_m3_s"), ss.flow_m3_s);
+                assert!(rel(last("pump_torque_nm"), ss.pump_torque_nm) < 1e-4);
+                assert!(rel(last("turbine_torque_nm"), ss.turbine_torque_nm) < 1e-4);
+                assert!(rel(last("stator_torque_nm"), ss.stator_torque_nm) < 1e-4 || (ss.stator_torque_nm == 0.0 && last("stator_torque_nm").abs() < 1e-6));
+                assert!((last("stator_speed_rad_s") - ss.stator_speed_rad_s).abs() < 1e-4 * wp);
+                assert_eq!(last("stator_mode"), if ss.mode == StatorMode::Locked { 0.0 } else { 1.0 });
+            }
+        }
+        // Tp + Tt + Ts = 0 at steady state (external torques; turbine_torque_nm is −T_t)
+        let sum = last("pump_torque_nm") - last("turbine_torque_nm") + last("stator_torque_nm");
+        assert!(sum.abs() < 1e-4 * last("pump_torque_nm").abs().max(1.0), "sum {sum}");
+    }
+}
+
+#[test]
+fn stator_clutch_releases_at_the_coupling_point_and_locks_again() {
+    // pump at 200 rad/s; the turbine slowly up to SR 0.97 and back to 0.5 (quasi-steady)
+    let wp = 200.0;
+    let cp = coupling_point(&HtGeometry::appendix_d()).unwrap();
+    let drive = Drive::Speeds {
+        pump_speed_rad_s: signal("pump", &[(0.0, wp), (40.0, wp)]),
+        turbine_speed_rad_s: signal("turbine", &[(0.0, 0.0), (20.0, 0.97 * wp), (120.0, 0.5 * wp)]),
+    };
+    // the free stator lags the flow by I_s/(ρR_s²Q) ≈ 0.1 s, so the return ramp is slow
+    let t = grid(0.0, 120.0, 401);
+    let (traj, _) = run(&ht([0.0; 3]), &drive, &t, InitialState::default());
+    let sr_at = |time: f64| if time <= 20.0 { 0.97 * time / 20.0 } else { 0.97 - 0.47 * (time - 20.0) / 100.0 };
+    let release: Vec<_> = traj.events.iter().filter(|e| e.kind == EventKind::StatorRelease).collect();
+    let lock: Vec<_> = traj.events.iter().filter(|e| e.kind == EventKind::StatorLock).collect();
+    println!("coupling point {cp}; events {:?}", traj.events);
+    assert_eq!((release.len(), lock.len()), (1, 1));
+    assert!((sr_at(release[0].time_s) - cp).abs() < 2e-3, "release at SR {}", sr_at(release[0].time_s));
+    assert!(lock[0].time_s > 20.0 && (sr_at(lock[0].time_s) - cp).abs() < 2e-3, "lock at SR {}", sr_at(lock[0].time_s));
+}
+
+#[test]
+fn tip_out_reverses_the_flow_and_finishes() {
+    let t = grid(0.0, 10.0, 2001);
+    let (traj, cols) = run(&ht(SHAPE), &takeoff(true), &t, InitialState::default());
+    assert_eq!(*col(&cols, "time_s").last().unwrap(), 10.0);
+    assert!(traj.events.iter().any(|e| e.kind == EventKind::FlowStart && e.mode.flow_sign == -1.0), "{:?}", traj.events);
+    assert!(col(&cols, "flow_m3_s").iter().any(|&q| q < 0.0));
+    assert!(traj.events.iter().any(|e| e.kind == EventKind::StatorLock));
+}
+
+#[test]
+fn quasi_dynamic_properties() {
+    let t = grid(0.0, 3.0, 3001);
+    // (2) at steady state the tables hold exactly, whatever the shape effects
+    for s in [0.0, 0.2, 0.5] {
+        let (_, cols) = run(&qd(s, s), &held(209.44, 104.72, 3.0), &t, InitialState { flow_m3_s: Some(0.0), ..Default::default() });
+        let op = c1().operating_point(209.44, 104.72).unwrap();
+        let last = |name| *col(&cols, name).last().unwrap();
+        assert!((last("pump_torque_nm") - op.pump_torque_nm).abs() < 1e-9 * op.pump_torque_nm, "S {s}");
+        assert!((last("turbine_torque_nm") - op.turbine_torque_nm).abs() < 1e-9 * op.turbine_torque_nm);
+    }
+    // (3) with S = 0 the model is the table model (speeds and torques to solver tolerance)
+    let (_, table_cols) = run(&table(), &takeoff(false), &t, InitialState::default());
+    let (_, qd_cols) = run(&qd(0.0, 0.0), &takeoff(false), &t, InitialState::default());
+    for name in ["pump_speed_rad_s", "turbine_speed_rad_s", "turbine_torque_nm", "effective_torque_ratio"] {
+        let (a, b) = (col(&table_cols, name), col(&qd_cols, name));
+        let scale = a.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let err = a.iter().zip(b).fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+        assert!(err < 1e-4 * scale, "{name}: {err} of {scale}");
+    }
+    // (4) with S > 0 the effective TR drops below the table's TR at the same SR during the
+    // take-off, and returns to it within about a second of the torque ramp (0.1–0.3 s)
+    let (_, s_cols) = run(&qd(0.1, 0.1), &takeoff(false), &t, InitialState::default());
+    let table_tr: Vec<f64> = col(&s_cols, "speed_ratio").iter().map(|&sr| c1().lookup(sr).torque_ratio).collect();
+    let e1 = col(&s_cols, "effective_torque_ratio");
+    let deficit = |from: f64, to: f64| (0..t.len()).filter(|&i| t[i] >= from && t[i] <= to).map(|i| table_tr[i] - e1[i]).fold(f64::NEG_INFINITY, f64::max);
+    let late = (0..t.len()).filter(|&i| t[i] >= 1.3).map(|i| (table_tr[i] - e1[i]).abs()).fold(0.0f64, f64::max);
+    println!("quasi-dynamic S = 0.1: largest deficit in effective TR {:.3}, after 1.3 s {late:.4}", deficit(0.0, 0.5));
+    assert!(deficit(0.0, 0.5) > 0.2);
+    assert!(late < 0.05 * deficit(0.0, 0.5), "still {late} after 1 s");
+}
+
+#[test]
+fn hrovat_tobler_follows_its_steady_state_when_the_flow_is_quasi_steady() {
+    // S = 0 and slow speeds: the outputs equal the closed form at every sample
+    let drive = Drive::Speeds {
+        pump_speed_rad_s: signal("pump", &[(0.0, 150.0), (10.0, 250.0)]),
+        turbine_speed_rad_s: signal("turbine", &[(0.0, 0.0), (10.0, 200.0)]),
+    };
+    let t = grid(0.0, 10.0, 101);
+    let (_, cols) = run(&ht([0.0; 3]), &drive, &t, InitialState::default());
+    let g = HtGeometry::appendix_d();
+    for i in 1..t.len() {
+        let (wp, wt) = (col(&cols, "pump_speed_rad_s")[i], col(&cols, "turbine_speed_rad_s")[i]);
+        let ss = steady_state(&g, wp, wt).unwrap();
+        let tp = col(&cols, "pump_torque_nm")[i] - 0.109 * 10.0; // minus the pump inertia torque I_p ω̇_p
+        assert!((tp - ss.pump_torque_nm).abs() < 2e-3 * ss.pump_torque_nm, "t {}: {tp} vs {}", t[i], ss.pump_torque_nm);
+    }
+}
+
+/// Smallest effective TR while the pump torque rises (0.1–0.35 s): the dip of thesis figure 4.1.
+fn ramp_minimum(t: &[f64], e: &[f64]) -> f64 {
+    (0..t.len()).filter(|&i| t[i] >= 0.1 && t[i] <= 0.35).map(|i| e[i]).fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+fn larger_shape_effect_deepens_the_effective_tr_drop_and_vanishes_at_steady_state() {
+    let t = grid(0.0, 10.0, 2001);
+    let mut minima = Vec::new();
+    let mut finals = Vec::new();
+    for s in [0.0, 0.01, 0.02, 0.03] {
+        let (_, cols) = run(&ht([s, s, 0.0]), &takeoff(false), &t, InitialState::default());
+        let e = col(&cols, "effective_torque_ratio");
+        minima.push(ramp_minimum(&t, e));
+        finals.push(*e.last().unwrap());
+    }
+    println!("Hrovat & Tobler minimum effective TR during the torque ramp: {minima:?}; at 10 s: {finals:?}");
+    assert!(minima.windows(2).all(|w| w[1] < w[0] - 1e-3), "{minima:?}");
+    assert!(finals.iter().all(|f| (f - finals[0]).abs() < 1e-3), "{finals:?}");
+    let mut minima = Vec::new();
+    for s in [0.0, 0.05, 0.1, 0.2, 0.4] {
+        let (_, cols) = run(&qd(s, s), &takeoff(false), &t, InitialState::default());
+        let e = col(&cols, "effective_torque_ratio");
+        minima.push(ramp_minimum(&t, e));
+        assert!((e.last().unwrap() - 1.0).abs() < 1e-3);
+    }
+    println!("quasi-dynamic minimum effective TR during the torque ramp: {minima:?}");
+    assert!(minima.windows(2).all(|w| w[1] < w[0] - 1e-3), "{minima:?}");
+}
+
+#[test]
+fn the_three_drives_agree_on_one_take_off() {
+    // drive (c) → record the turbine speed → drive (a) reproduces the pump speed, drive (b) the torques
+    let t = grid(0.0, 3.0, 3001);
+    let model = ht(SHAPE);
+    let (_, c) = run(&model, &takeoff(false), &t, InitialState::default());
+    let turbine = Signal::new("turbine_speed_rad_s", t.clone(), col(&c, "turbine_speed_rad_s").to_vec(), 0.0).unwrap();
+    let pump = Signal::new("pump_speed_rad_s", t.clone(), col(&c, "pump_speed_rad_s").to_vec(), 0.0).unwrap();
+    let (_, a) = run(&model, &Drive::PumpTorqueTurbineSpeed { pump_torque_nm: takeoff_torque(false), turbine_speed_rad_s: turbine.clone() }, &t, InitialState::default());
+    let (_, b) = run(&model, &Drive::Speeds { pump_speed_rad_s: pump, turbine_speed_rad_s: turbine }, &t, InitialState::default());
+    let max_err = |x: &[f64], y: &[f64]| x.iter().zip(y).skip(1).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
+    let ep = max_err(col(&c, "pump_speed_rad_s"), col(&a, "pump_speed_rad_s"));
+    let et = max_err(col(&c, "turbine_torque_nm"), col(&a, "turbine_torque_nm"));
+    let eb = max_err(col(&c, "pump_torque_nm"), col(&b, "pump_torque_nm"));
+    println!("drive (a) vs (c): pump speed {ep:.2e} rad/s, turbine torque {et:.2e} N·m; drive (b): pump torque {eb:.2e} N·m");
+    assert!(ep < 0.05 && et < 1.0 && eb < 2.0);
+}
+
+#[test]
+fn bad_runs_are_input_errors() {
+    let t = grid(0.0, 1.0, 11);
+    let drive = Drive::PumpTorqueTurbineSpeed { pump_torque_nm: Signal::constant(-10.0), turbine_speed_rad_s: Signal::constant(0.0) };
+    match simulate(&ht(SHAPE), &drive, &t, &InitialState::default(), &SolverOptions::default()) {
+        Err(tcsim_core::transient::TransientError::Input(e)) => assert_eq!(e.field, "initial pump_torque_nm"),
+        other => panic!("{other:?}"),
+    }
+    let init = InitialState { pump_speed_rad_s: Some(100.0), stator_speed_rad_s: Some(-1.0), flow_m3_s: Some(0.01), ..Default::default() };
+    assert!(simulate(&ht(SHAPE), &drive, &t, &init, &SolverOptions::default()).is_err());
+    assert!(simulate(&ht(SHAPE), &drive, &[0.0, 0.0], &InitialState::default(), &SolverOptions::default()).is_err());
 }
