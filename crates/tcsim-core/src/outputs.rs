@@ -60,7 +60,7 @@ fn ratio(a: f64, b: f64) -> f64 {
 pub fn columns(model: &dyn ConverterDynamics, traj: &Trajectory) -> Vec<Vec<f64>> {
     let present = model.coordinates();
     let m = model.mass();
-    let mut cols: Vec<Vec<f64>> = vec![Vec::with_capacity(traj.samples.len()); COLUMNS.len()];
+    let mut cols: Vec<Vec<f64>> = (0..COLUMNS.len()).map(|_| Vec::with_capacity(traj.samples.len())).collect();
     for s in &traj.samples {
         let coord = |c: usize, v: f64| if present[c] { v } else { f64::NAN };
         let (u, ud) = (s.u, s.u_dot);

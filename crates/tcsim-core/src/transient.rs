@@ -737,6 +737,7 @@ fn run_segment(seg: &Segment, u0: &Vec4, t0: f64, t_end: f64, times_s: &[f64], o
         .map_err(|e| fail(t0, &seg.state(u0), &e))?;
     let mut solver = problem.bdf::<Lu>().map_err(|e| fail(t0, &seg.state(u0), &e))?;
     solver.set_stop_time(t_end).map_err(|e| fail(t0, &seg.state(u0), &e))?;
+    let mut buffer = solver.state().y.clone();
     loop {
         if traj.steps >= o.max_steps {
             let s = solver.state();
@@ -754,8 +755,8 @@ fn run_segment(seg: &Segment, u0: &Vec4, t0: f64, t_end: f64, times_s: &[f64], o
         };
         while traj.samples.len() < times_s.len() && times_s[traj.samples.len()] <= upto {
             let t = times_s[traj.samples.len()];
-            let x = solver.interpolate(t).map_err(|e| fail(t, &[], &e))?;
-            traj.samples.push(seg.sample(x.batch_as_slice(0), t));
+            solver.interpolate_inplace(t, &mut buffer).map_err(|e| fail(t, &[], &e))?;
+            traj.samples.push(seg.sample(buffer.batch_as_slice(0), t));
         }
         if let Some(root) = root {
             let x = solver.interpolate(upto).map_err(|e| fail(upto, &[], &e))?;
