@@ -6,8 +6,11 @@ and Hrovat & Tobler (1985). Units are SI and carried in every name (``convention
 
 Tiers:
 
-* one-liners: :func:`characterise` (a converter name or file and a model → DataFrame);
+* one-liners: :func:`characterise` (a converter name or file and a model → DataFrame) and
+  :func:`simulate` (a converter, a drive and a model → :class:`~tcsim.transient.TransientResult`);
 * objects: :func:`load_converter` → :class:`Converter`, then :mod:`tcsim.steady` per model;
+  :func:`dynamic_model` → :class:`~tcsim.transient.DynamicModel` and the drives of
+  :mod:`tcsim.transient`; :func:`simulate_batch` for many runs on all cores;
 * raw: :mod:`tcsim._core` (NumPy arrays in, arrays out, GIL released).
 """
 
@@ -16,6 +19,7 @@ from __future__ import annotations
 from .converter import Characteristic, Converter, bundled_names, load_converter
 from .errors import InputError, TcsimWarning
 from .steady import coupling_point, hrovat_tobler_steady_state
+from .transient import dynamic_model, simulate, simulate_batch
 
 __all__ = [
     "Characteristic",
@@ -25,8 +29,11 @@ __all__ = [
     "bundled_names",
     "characterise",
     "coupling_point",
+    "dynamic_model",
     "hrovat_tobler_steady_state",
     "load_converter",
+    "simulate",
+    "simulate_batch",
 ]
 
 

@@ -385,7 +385,7 @@ impl HtDynamics {
             SHAPE_KEYS[i],
             self.shape_effect_m2[i],
             format!(
-                "|S| < {} m² with the other parameters as given: the mass matrix must be positive definite, ρL_f/A = {} > Σρ²S²/I = {} (physics notes §4)",
+                "|S| < {} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
                 sig(bound),
                 sig(self.fluid_inertance()),
                 sig(terms.iter().sum::<f64>())
