@@ -68,8 +68,9 @@ def test_batch_releases_the_gil():
     elapsed = time.perf_counter() - t0
     done.set()
     th.join()
+    # with the GIL held the counter could not move at all during the call
     assert elapsed > 0.02
-    assert ticks >= 0.3 * elapsed / 0.001, (ticks, elapsed)
+    assert ticks >= 5, (ticks, elapsed)
 
 
 def test_inadmissible_shape_effect_names_the_bound():

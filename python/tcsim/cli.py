@@ -95,6 +95,42 @@ def study(
     stdout.print(study_command(converter, out))
 
 
+@app.command()
+def replay(
+    converter: Annotated[str, typer.Argument(help="bundled name or converter .toml")],
+    measurement: Annotated[str, typer.Argument(help="measured time series: .csv, .parquet, .mat or .mf4/.mdf")],
+    model: Annotated[Optional[list[str]], typer.Option("--model", "-m", help="table | hrovat-tobler | quasi-dynamic, repeatable (default: every model the converter supports)")] = None,
+    out: OutOpt = Path("replay"),
+    channel: Annotated[Optional[list[str]], typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")] = None,
+    drive: Annotated[str, typer.Option("--drive", help="pump-torque (pump torque and turbine speed given) | speeds (both speeds given)")] = "pump-torque",
+    initial: Annotated[Optional[list[str]], typer.Option("--initial", help="NAME=VALUE initial state override (SI), repeatable")] = None,
+    window: Annotated[Optional[float], typer.Option("--window", help="derivative smoothing window S, s: local least-squares slope over ±S/2 [default: 0.04]")] = None,
+    metrics_window: Annotated[float, typer.Option("--metrics-window", help="width of the consecutive metric windows, s")] = 1.0,
+) -> None:
+    """Isolated converter driven by measured signals: DIR/<model>.csv, events, metrics, plots."""
+    from .replay import replay_command
+
+    stdout.print(replay_command(converter, measurement, model or [], out, channel or [], drive, initial or [],
+                                window, metrics_window))
+
+
+@app.command("fit-shapes")
+def fit_shapes(
+    converter: Annotated[str, typer.Argument(help="bundled name or converter .toml")],
+    measurement: Annotated[str, typer.Argument(help="take-off measurement: .csv, .parquet, .mat or .mf4/.mdf")],
+    model: ModelOpt = "quasi-dynamic",
+    target: Annotated[str, typer.Option("--target", help="effective_turbine_torque_nm | effective_torque_ratio")] = "effective_turbine_torque_nm",
+    out: OutOpt = Path("shape_fit"),
+    channel: Annotated[Optional[list[str]], typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")] = None,
+    drive: Annotated[str, typer.Option("--drive", help="pump-torque | speeds")] = "pump-torque",
+    equal: Annotated[bool, typer.Option("--equal", help="fit one shape effect, S_p = S_t")] = False,
+) -> None:
+    """Fit the pump and turbine shape effects to a transient measurement; sweep plots like thesis figs 4.1–4.2."""
+    from .shape_fit import shape_fit_command
+
+    stdout.print(shape_fit_command(converter, measurement, out, model, target, channel or [], drive, equal))
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     if issubclass(category, TcsimWarning):
         console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True)

@@ -35,7 +35,15 @@ def _show(value: Any) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
+def core_value(value: Any) -> Any:
+    """The core reports values as text; show numbers as numbers."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return value
+
+
 def from_core(exc: Exception, source: str, field_prefix: str = "") -> InputError:
     """Wrap a ``tcsim._core.CoreInputError`` (args: message, field, value, expected)."""
     _message, field, value, expected = exc.args
-    return InputError(source, field_prefix + field, value, expected)
+    return InputError(source, field_prefix + field, core_value(value), expected)

@@ -26,7 +26,7 @@ import pandas as pd
 
 from . import _core
 from .converter import Converter, load_converter
-from .errors import InputError
+from .errors import InputError, core_value
 
 #: Default width of the smoothing window of measured-speed derivatives, s (see docs/transient.md).
 DERIVATIVE_WINDOW_S = 0.04
@@ -255,7 +255,7 @@ def _unpack(entry, model: DynamicModel, index: int | None) -> TransientResult:
         return TransientResult(model.name, dict(cols), [Event(*e) for e in events])
     if status == "input":
         _, _msg, fld, value, expected = entry
-        raise InputError(model.source, fld + where, value, expected)
+        raise InputError(model.source, fld + where, core_value(value), expected)
     raise SolverError(f"{model.name}{where}: {entry[1]}")
 
 
@@ -297,6 +297,6 @@ def simulate_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], time
         raw = _core.transient_runs([m.spec for m in models], specs, _initial(initial), _options(rtol, **solver_options), threads)
     except _core.CoreInputError as e:
         _msg, fld, value, expected = e.args
-        raise InputError(models[0].source if len(models) == 1 else "drive", fld, value, expected) from None
+        raise InputError(models[0].source if len(models) == 1 else "model or drive", fld, core_value(value), expected) from None
     n = len(raw)
     return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None) for i, r in enumerate(raw)]

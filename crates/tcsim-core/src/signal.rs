@@ -96,7 +96,8 @@ fn smoothed_rate(t: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
     if n < 2 {
         return vec![0.0; n];
     }
-    let half = 0.5 * window_s;
+    // samples at exactly ±window/2 are in, whatever the rounding of the time stamps
+    let half = 0.5 * window_s * (1.0 + 1e-9);
     let (mut lo, mut hi) = (0usize, 0usize);
     (0..n)
         .map(|i| {
@@ -147,8 +148,14 @@ mod tests {
         // ±0.5 rad/s alternating noise on a ramp: the raw difference is off by 1000 rad/s², the
         // smoothed derivative by less than 1 %
         let noisy: Vec<f64> = t.iter().enumerate().map(|(i, t)| 40.0 * t + if i % 2 == 0 { 0.5 } else { -0.5 }).collect();
-        let s = Signal::new("w", t, noisy, DEFAULT_DERIVATIVE_WINDOW_S).unwrap();
+        let s = Signal::new("w", t.clone(), noisy, DEFAULT_DERIVATIVE_WINDOW_S).unwrap();
         assert!((s.rate(0.5) - 40.0).abs() < 0.4, "{}", s.rate(0.5));
+        // symmetric windows at every inner sample, so the slope of a parabola is exact there
+        let parabola: Vec<f64> = t.iter().map(|t| t * t).collect();
+        let s = Signal::new("w", t.clone(), parabola, DEFAULT_DERIVATIVE_WINDOW_S).unwrap();
+        for &i in &[25usize, 290, 500, 975] {
+            assert!((s.rate(t[i]) - 2.0 * t[i]).abs() < 1e-9, "{}: {}", t[i], s.rate(t[i]));
+        }
     }
 
     #[test]

@@ -345,6 +345,17 @@ fn event_name(k: EventKind) -> &'static str {
     }
 }
 
+/// The smoothed derivative the transient engine uses for given speeds (local least-squares slope
+/// over ±window/2, tcsim_core::signal), at the sample times.
+#[pyfunction]
+fn smoothed_rate<'py>(py: Python<'py>, time_s: PyReadonlyArray1<'py, f64>, values: PyReadonlyArray1<'py, f64>, window_s: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    guard(|| {
+        let t = slice(&time_s, "time_s")?.to_vec();
+        let s = Signal::new("values", t.clone(), slice(&values, "values")?.to_vec(), window_s).map_err(input_error)?;
+        Ok(t.iter().map(|&ti| s.rate(ti)).collect::<Vec<_>>().into_pyarray(py))
+    })
+}
+
 /// Output column names of a transient run.
 #[pyfunction]
 fn transient_columns() -> Vec<&'static str> {
@@ -414,6 +425,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(table_check, m)?)?;
     m.add_function(wrap_pyfunction!(table_steady_states, m)?)?;
     m.add_function(wrap_pyfunction!(transient_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(smoothed_rate, m)?)?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
     Ok(())
 }
