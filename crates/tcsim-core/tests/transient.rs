@@ -181,7 +181,8 @@ fn quasi_dynamic_properties() {
 
 #[test]
 fn hrovat_tobler_follows_its_steady_state_when_the_flow_is_quasi_steady() {
-    // S = 0 and slow speeds: the outputs equal the closed form at every sample
+    // S = 0 still leaves the fluid inertance ρL_f/A of eq 2.15: with slow speeds the outputs follow
+    // the closed form at every sample, up to the flow's lag
     let drive = Drive::Speeds {
         pump_speed_rad_s: signal("pump", &[(0.0, 150.0), (10.0, 250.0)]),
         turbine_speed_rad_s: signal("turbine", &[(0.0, 0.0), (10.0, 200.0)]),
@@ -189,12 +190,16 @@ fn hrovat_tobler_follows_its_steady_state_when_the_flow_is_quasi_steady() {
     let t = grid(0.0, 10.0, 101);
     let (_, cols) = run(&ht([0.0; 3]), &drive, &t, InitialState::default());
     let g = HtGeometry::appendix_d();
+    let mut worst = 0.0f64;
     for i in 1..t.len() {
         let (wp, wt) = (col(&cols, "pump_speed_rad_s")[i], col(&cols, "turbine_speed_rad_s")[i]);
         let ss = steady_state(&g, wp, wt).unwrap();
         let tp = col(&cols, "pump_torque_nm")[i] - 0.109 * 10.0; // minus the pump inertia torque I_p ω̇_p
-        assert!((tp - ss.pump_torque_nm).abs() < 2e-3 * ss.pump_torque_nm, "t {}: {tp} vs {}", t[i], ss.pump_torque_nm);
+        worst = worst.max((tp - ss.pump_torque_nm).abs() / ss.pump_torque_nm);
+        // the flow lags its steady value by τ_Q·|Q̇|/Q ≈ 3 ms × 0.005/0.08 s⁻¹ ≈ 2·10⁻⁴
+        assert!((tp - ss.pump_torque_nm).abs() < 3e-4 * ss.pump_torque_nm, "t {}: {tp} vs {}", t[i], ss.pump_torque_nm);
     }
+    println!("Hrovat & Tobler, S = 0, slow ramp: largest relative difference from the closed form {worst:.2e}");
 }
 
 /// Smallest effective TR while the pump torque rises (0.1–0.35 s): the dip of thesis figure 4.1.
