@@ -167,7 +167,7 @@ pub fn run_transient_job(job: &TransientJob) -> crate::transient::TransientResul
     };
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|payload| {
         let msg = payload.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| payload.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into());
-        Err(TransientError::Solver { time_s: f64::NAN, state: [f64::NAN; 4], message: format!("internal error: {msg}") })
+        Err(TransientError::Solver { time_s: f64::NAN, state: vec![], message: format!("internal error: {msg}") })
     })
 }
 

@@ -19,6 +19,7 @@ pub mod error;
 pub mod hrovat_tobler;
 pub mod outputs;
 pub mod scalar;
+pub mod segment;
 pub mod signal;
 pub mod table;
 pub mod transient;

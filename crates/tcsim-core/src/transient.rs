@@ -36,14 +36,11 @@
 //! side is smooth and the energy identity holds exactly (the held flow does no work). This is the
 //! same state the closed-form steady state calls `no-flow` near SR = 1.
 
-use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
 
 use crate::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::error::CoreError;
+use crate::segment::SmoothSegment;
 use crate::signal::Signal;
-
-type Matrix = NalgebraMat<f64>;
-type Lu = NalgebraLU<f64>;
 
 /// How the converter is driven (issue: drives a, b, c).
 #[derive(Debug, Clone)]
@@ -166,7 +163,7 @@ pub enum TransientError {
     /// The user's input (exit code 2).
     Input(CoreError),
     /// The solver failed (exit code 1): time, state and message.
-    Solver { time_s: f64, state: Vec4, message: String },
+    Solver { time_s: f64, state: Vec<f64>, message: String },
 }
 
 impl From<CoreError> for TransientError {
@@ -179,11 +176,11 @@ impl std::fmt::Display for TransientError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             TransientError::Input(e) => write!(f, "{e}"),
-            TransientError::Solver { time_s, state, message } => write!(
-                f,
-                "solver failed at t = {time_s:.6} s (ω_p = {:.6} rad/s, ω_t = {:.6} rad/s, ω_s = {:.6} rad/s, Q = {:.6e} m³/s): {message}",
-                state[0], state[1], state[2], state[3]
-            ),
+            TransientError::Solver { time_s, state, message } => {
+                let names = ["ω_p", "ω_t", "ω_s", "Q"];
+                let shown: Vec<String> = state.iter().enumerate().map(|(i, v)| format!("{} = {v:.6}", names.get(i).copied().unwrap_or("x"))).collect();
+                write!(f, "solver failed at t = {time_s:.6} s ({}): {message}", shown.join(", "))
+            }
         }
     }
 }
@@ -657,7 +654,7 @@ pub fn simulate_from(model: &dyn ConverterDynamics, drive: &Drive, times_s: &[f6
                 traj.events.push(Event { time_s: t_root, kind, mode: new_mode });
                 if std::env::var("TCSIM_DEBUG").is_ok() { eprintln!("event {t_root} {kind:?} {new_mode:?} u={next:?}"); }
                 if traj.events.len() > options.max_events {
-                    return Err(TransientError::Solver { time_s: t_root, state: next, message: format!("more than {} events: the clutch or flow events chatter", options.max_events) });
+                    return Err(TransientError::Solver { time_s: t_root, state: next.to_vec(), message: format!("more than {} events: the clutch or flow events chatter", options.max_events) });
                 }
                 t = t_root;
                 u = next;
@@ -698,74 +695,41 @@ fn switch(seg: &Segment, root: Root, u: &mut Vec4, t: f64) -> (EventKind, Mode) 
     (kind, mode)
 }
 
-/// Integrate one segment, writing the samples that fall in it. Returns the root that ended it, if
-/// any, with its time and state.
+impl SmoothSegment for Segment<'_> {
+    type Root = Root;
+    type Sample = Sample;
+    fn n_states(&self) -> usize {
+        Segment::n_states(self)
+    }
+    fn atol(&self, o: &SolverOptions) -> Vec<f64> {
+        Segment::atol(self, o)
+    }
+    fn rhs(&self, x: &[f64], t: f64, out: &mut [f64]) {
+        Segment::rhs(self, x, t, out)
+    }
+    fn jacobian_times(&self, x: &[f64], t: f64, v: &[f64], out: &mut [f64]) {
+        Segment::jacobian_times(self, x, t, v, out)
+    }
+    fn mass_times(&self, v: &[f64], beta: f64, y: &mut [f64]) {
+        Segment::mass_times(self, v, beta, y)
+    }
+    fn roots(&self) -> &[Root] {
+        &self.roots
+    }
+    fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
+        Segment::root_values(self, x, t, h, out)
+    }
+    fn sample(&self, x: &[f64], t: f64) -> Sample {
+        Segment::sample(self, x, t)
+    }
+    fn coordinates(&self, x: &[f64], t: f64) -> Vec<f64> {
+        self.full(x, t).to_vec()
+    }
+}
+
+/// Integrate one segment (see [`crate::segment::run_segment`]).
 fn run_segment(seg: &Segment, u0: &Vec4, t0: f64, t_end: f64, times_s: &[f64], o: &SolverOptions, traj: &mut Traj) -> TransientResult<Option<(f64, Root, Vec<f64>)>> {
-    let x0 = seg.state(u0);
-    let n = seg.n_states();
-    let fail = |t: f64, x: &[f64], e: &dyn std::fmt::Display| TransientError::Solver { time_s: t, state: seg.full(x, t), message: e.to_string() };
-    // samples at the start of the segment
-    while traj.samples.len() < times_s.len() && times_s[traj.samples.len()] <= t0 {
-        traj.samples.push(seg.sample(&x0, times_s[traj.samples.len()]));
-    }
-    if t0 >= t_end {
-        return Ok(None);
-    }
-    let nroots = seg.roots.len().max(1);
-    let problem = OdeBuilder::<Matrix>::new()
-        .t0(t0)
-        .h0(o.first_step_s.min(t_end - t0))
-        .rtol(o.rtol)
-        .atol(seg.atol(o))
-        .rhs_implicit(
-            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| seg.rhs(x, t, y),
-            |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| seg.jacobian_times(x, t, v, y),
-        )
-        .mass(|v: &[f64], _p: &[f64], _t: f64, beta: f64, y: &mut [f64]| seg.mass_times(v, beta, y))
-        .init(move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(&x0), n)
-        .root(
-            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
-                if seg.roots.is_empty() {
-                    y[0] = 1.0;
-                } else {
-                    seg.root_values(x, t, &o.hysteresis, y)
-                }
-            },
-            nroots,
-        )
-        .build()
-        .map_err(|e| fail(t0, &seg.state(u0), &e))?;
-    let mut solver = problem.bdf::<Lu>().map_err(|e| fail(t0, &seg.state(u0), &e))?;
-    solver.set_stop_time(t_end).map_err(|e| fail(t0, &seg.state(u0), &e))?;
-    let mut buffer = solver.state().y.clone();
-    loop {
-        if traj.steps >= o.max_steps {
-            let s = solver.state();
-            return Err(fail(s.t, s.y.batch_as_slice(0), &format!("more than {} steps", o.max_steps)));
-        }
-        traj.steps += 1;
-        let reason = solver.step().map_err(|e| {
-            let s = solver.state();
-            fail(s.t, s.y.batch_as_slice(0), &e)
-        })?;
-        let t_now = solver.state().t;
-        let (upto, root) = match reason {
-            OdeSolverStopReason::RootFound(tr, idx) if !seg.roots.is_empty() => (tr, Some(seg.roots[idx.min(seg.roots.len() - 1)])),
-            _ => (t_now, None),
-        };
-        while traj.samples.len() < times_s.len() && times_s[traj.samples.len()] <= upto {
-            let t = times_s[traj.samples.len()];
-            solver.interpolate_inplace(t, &mut buffer).map_err(|e| fail(t, &[], &e))?;
-            traj.samples.push(seg.sample(buffer.batch_as_slice(0), t));
-        }
-        if let Some(root) = root {
-            let x = solver.interpolate(upto).map_err(|e| fail(upto, &[], &e))?;
-            return Ok(Some((upto, root, x.batch_as_slice(0).to_vec())));
-        }
-        if matches!(reason, OdeSolverStopReason::TstopReached) || t_now >= t_end {
-            return Ok(None);
-        }
-    }
+    crate::segment::run_segment(seg, seg.state(u0), t0, t_end, times_s, o, &mut traj.samples, &mut traj.steps)
 }
 
 type Traj = Trajectory;
