@@ -23,5 +23,6 @@ pub mod segment;
 pub mod signal;
 pub mod table;
 pub mod transient;
+pub mod vehicle;
 
 pub use error::{CoreError, CoreResult};

@@ -13,7 +13,7 @@
 //! `T_t` is the torque delivered to the transmission (`turbine_torque_nm`).
 
 use crate::dynamics::{ConverterDynamics, FLOW, PUMP, STATOR, TURBINE};
-use crate::transient::Trajectory;
+use crate::transient::{Sample, Trajectory};
 
 /// Column names, in order.
 pub const COLUMNS: [&str; 27] = [
@@ -54,55 +54,59 @@ fn ratio(a: f64, b: f64) -> f64 {
     }
 }
 
-/// The run as columns in the order of [`COLUMNS`]. Coordinates the model lacks are NaN, and so
+/// One sample as a row in the order of [`COLUMNS`]. Coordinates the model lacks are NaN, and so
 /// are the stator mode (0 locked, 1 free-wheeling) and the flow direction (+1, −1, 0 held) of
 /// models without them.
-pub fn columns(model: &dyn ConverterDynamics, traj: &Trajectory) -> Vec<Vec<f64>> {
+pub fn row(model: &dyn ConverterDynamics, s: &Sample) -> [f64; 27] {
     let present = model.coordinates();
     let m = model.mass();
+    let coord = |c: usize, v: f64| if present[c] { v } else { f64::NAN };
+    let (u, ud) = (s.u, s.u_dot);
+    let pump = s.torque[0];
+    let turbine = -s.torque[1];
+    let inertia_p = m[PUMP][PUMP] * ud[PUMP];
+    let inertia_t = m[TURBINE][TURBINE] * ud[TURBINE];
+    let fluid_p = m[PUMP][FLOW] * ud[FLOW];
+    let fluid_t = m[TURBINE][FLOW] * ud[FLOW];
+    let eff_p = pump - inertia_p;
+    let eff_t = turbine + inertia_t;
+    let input = pump * u[PUMP] + s.torque[1] * u[TURBINE] + if present[STATOR] { s.torque[2] * u[STATOR] } else { 0.0 };
+    [
+        s.time_s,
+        u[PUMP],
+        u[TURBINE],
+        coord(STATOR, u[STATOR]),
+        coord(FLOW, u[FLOW]),
+        ud[PUMP],
+        ud[TURBINE],
+        coord(FLOW, ud[FLOW]),
+        pump,
+        turbine,
+        s.torque[2],
+        ratio(u[TURBINE], u[PUMP]),
+        ratio(turbine, pump),
+        if model.has_stator_clutch() { if s.mode.stator_locked { 0.0 } else { 1.0 } } else { f64::NAN },
+        if model.has_flow_sign() { s.mode.flow_sign } else { f64::NAN },
+        inertia_p,
+        fluid_p,
+        s.transferred.0,
+        inertia_t,
+        fluid_t,
+        s.transferred.1,
+        eff_p,
+        eff_t,
+        ratio(eff_t, eff_p),
+        s.loss_power_w,
+        s.stored_energy_j,
+        input,
+    ]
+}
+
+/// The run as columns in the order of [`COLUMNS`] (see [`row`]).
+pub fn columns(model: &dyn ConverterDynamics, traj: &Trajectory) -> Vec<Vec<f64>> {
     let mut cols: Vec<Vec<f64>> = (0..COLUMNS.len()).map(|_| Vec::with_capacity(traj.samples.len())).collect();
     for s in &traj.samples {
-        let coord = |c: usize, v: f64| if present[c] { v } else { f64::NAN };
-        let (u, ud) = (s.u, s.u_dot);
-        let pump = s.torque[0];
-        let turbine = -s.torque[1];
-        let inertia_p = m[PUMP][PUMP] * ud[PUMP];
-        let inertia_t = m[TURBINE][TURBINE] * ud[TURBINE];
-        let fluid_p = m[PUMP][FLOW] * ud[FLOW];
-        let fluid_t = m[TURBINE][FLOW] * ud[FLOW];
-        let eff_p = pump - inertia_p;
-        let eff_t = turbine + inertia_t;
-        let input = pump * u[PUMP] + s.torque[1] * u[TURBINE] + if present[STATOR] { s.torque[2] * u[STATOR] } else { 0.0 };
-        let row = [
-            s.time_s,
-            u[PUMP],
-            u[TURBINE],
-            coord(STATOR, u[STATOR]),
-            coord(FLOW, u[FLOW]),
-            ud[PUMP],
-            ud[TURBINE],
-            coord(FLOW, ud[FLOW]),
-            pump,
-            turbine,
-            s.torque[2],
-            ratio(u[TURBINE], u[PUMP]),
-            ratio(turbine, pump),
-            if model.has_stator_clutch() { if s.mode.stator_locked { 0.0 } else { 1.0 } } else { f64::NAN },
-            if model.has_flow_sign() { s.mode.flow_sign } else { f64::NAN },
-            inertia_p,
-            fluid_p,
-            s.transferred.0,
-            inertia_t,
-            fluid_t,
-            s.transferred.1,
-            eff_p,
-            eff_t,
-            ratio(eff_t, eff_p),
-            s.loss_power_w,
-            s.stored_energy_j,
-            input,
-        ];
-        for (c, v) in cols.iter_mut().zip(row) {
+        for (c, v) in cols.iter_mut().zip(row(model, s)) {
             c.push(v);
         }
     }

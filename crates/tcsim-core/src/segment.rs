@@ -27,6 +27,9 @@ pub trait SmoothSegment {
     fn coordinates(&self, x: &[f64], t: f64) -> Vec<f64>;
 }
 
+/// How a segment ended: the root that fired, its time and the state there (None at the end time).
+pub type SegmentEnd<R> = Option<(f64, R, Vec<f64>)>;
+
 /// Integrate one segment from `x0` at `t0`, pushing a sample for every time of `times_s` it
 /// covers. Returns the root that ended it, with its time and state, or None at `t_end`.
 #[allow(clippy::too_many_arguments)]
@@ -39,7 +42,7 @@ pub fn run_segment<S: SmoothSegment>(
     o: &SolverOptions,
     samples: &mut Vec<S::Sample>,
     steps: &mut usize,
-) -> TransientResult<Option<(f64, S::Root, Vec<f64>)>> {
+) -> TransientResult<SegmentEnd<S::Root>> {
     let n = seg.n_states();
     let fail = |t: f64, x: &[f64], e: &dyn std::fmt::Display| TransientError::Solver { time_s: t, state: if x.is_empty() { vec![] } else { seg.coordinates(x, t) }, message: e.to_string() };
     while samples.len() < times_s.len() && times_s[samples.len()] <= t0 {
