@@ -158,29 +158,32 @@ pub struct TransientJob {
 /// Columns of a run (see [`crate::outputs::COLUMNS`]) and its events.
 pub type RunOutput = (Vec<Vec<f64>>, Vec<crate::transient::Event>);
 
-/// Run one job; a panic inside the solver becomes a solver error instead of unwinding.
-pub fn run_transient_job(job: &TransientJob) -> crate::transient::TransientResult<RunOutput> {
-    use crate::transient::{simulate, TransientError};
-    let run = || {
-        let traj = simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
-        Ok((crate::outputs::columns(job.model.as_ref(), &traj), traj.events))
-    };
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|payload| {
+/// Run `f`, turning a panic into a solver error instead of unwinding.
+pub fn catch_panic<T>(f: impl FnOnce() -> crate::transient::TransientResult<T>) -> crate::transient::TransientResult<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
         let msg = payload.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| payload.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into());
-        Err(TransientError::Solver { time_s: f64::NAN, state: vec![], message: format!("internal error: {msg}") })
+        Err(crate::transient::TransientError::Solver { time_s: f64::NAN, state: vec![], message: format!("internal error: {msg}") })
     })
 }
 
-/// Run all jobs on `threads` worker threads (0: one per core). Results are in job order.
-pub fn run_transient_jobs(jobs: &[TransientJob], threads: usize) -> Vec<crate::transient::TransientResult<RunOutput>> {
+/// Run one job.
+pub fn run_transient_job(job: &TransientJob) -> crate::transient::TransientResult<RunOutput> {
+    catch_panic(|| {
+        let traj = crate::transient::simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
+        Ok((crate::outputs::columns(job.model.as_ref(), &traj), traj.events))
+    })
+}
+
+/// `f` over `jobs` on `threads` worker threads (0: one per core), results in job order.
+pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J) -> R + Sync) -> Vec<R> {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::Mutex;
     let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }.min(jobs.len()).max(1);
     if threads == 1 {
-        return jobs.iter().map(run_transient_job).collect();
+        return jobs.iter().map(&f).collect();
     }
     let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<crate::transient::TransientResult<RunOutput>>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
+    let results: Mutex<Vec<Option<R>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
     std::thread::scope(|scope| {
         for _ in 0..threads {
             scope.spawn(|| loop {
@@ -188,7 +191,7 @@ pub fn run_transient_jobs(jobs: &[TransientJob], threads: usize) -> Vec<crate::t
                 if i >= jobs.len() {
                     break;
                 }
-                let r = run_transient_job(&jobs[i]);
+                let r = f(&jobs[i]);
                 if let Ok(mut guard) = results.lock() {
                     guard[i] = Some(r);
                 }
@@ -196,4 +199,9 @@ pub fn run_transient_jobs(jobs: &[TransientJob], threads: usize) -> Vec<crate::t
         }
     });
     results.into_inner().unwrap_or_default().into_iter().map(|r| r.expect("every job ran")).collect()
+}
+
+/// Run all jobs on `threads` worker threads (0: one per core). Results are in job order.
+pub fn run_transient_jobs(jobs: &[TransientJob], threads: usize) -> Vec<crate::transient::TransientResult<RunOutput>> {
+    parallel_map(jobs, threads, run_transient_job)
 }

@@ -15,6 +15,7 @@ use tcsim_core::batch::{ht_ratio_gradients as core_ratio_gradients, ht_steady_st
 use tcsim_core::dynamics::{ConverterDynamics, HtDynamics, Inertias, QuasiDynamics, TableDynamics};
 use tcsim_core::signal::Signal;
 use tcsim_core::transient::{Drive, EventKind, InitialState, SolverOptions, TransientError, TurbineLoad};
+use tcsim_core::vehicle::{launch_column_names, simulate_launch, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres, Vehicle};
 use tcsim_core::capacity::CapacityConvention;
 use tcsim_core::hrovat_tobler::{coupling_point, HtGeometry, HtParam, N_PARAMS};
 use tcsim_core::table::Characteristic;
@@ -411,6 +412,149 @@ fn transient_runs<'py>(
     })
 }
 
+// ---------------------------------------------------------------------------------------------
+// Vehicle launch
+
+fn section<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyDict>> {
+    d.get_item(key)?
+        .ok_or_else(|| PyValueError::new_err(format!("missing section {key:?}")))?
+        .cast_into::<PyDict>()
+        .map_err(|_| PyValueError::new_err(format!("{key} must be a dict")))
+}
+
+fn vehicle_from(d: &Bound<'_, PyDict>) -> PyResult<Vehicle> {
+    let e = section(d, "engine")?;
+    let g = section(d, "gearbox")?;
+    let l = section(d, "lockup")?;
+    let dl = section(d, "driveline")?;
+    let ty = section(d, "tyres")?;
+    let b = section(d, "body")?;
+    let br = section(d, "brake")?;
+    Ok(Vehicle {
+        engine: Engine {
+            inertia_kg_m2: item(&e, "inertia_kg_m2")?,
+            idle_speed_rad_s: item(&e, "idle_speed_rad_s")?,
+            full_load: Curve::new("engine.full_load_speed_rad_s", item(&e, "full_load_speed_rad_s")?, item(&e, "full_load_torque_nm")?).map_err(input_error)?,
+            drag_torque_nm: item(&e, "drag_torque_nm")?,
+            drag_nm_s_per_rad: item(&e, "drag_nm_s_per_rad")?,
+            fast_time_constant_s: item(&e, "fast_time_constant_s")?,
+            boost_time_constant_s: item(&e, "boost_time_constant_s")?,
+            boost_fraction: item(&e, "boost_fraction")?,
+            idle_governor_gain_nm_s_per_rad: item(&e, "idle_governor_gain_nm_s_per_rad")?,
+        },
+        gearbox: Gearbox {
+            ratios: item(&g, "ratios")?,
+            efficiencies: item(&g, "efficiencies")?,
+            input_inertia_kg_m2: item(&g, "input_inertia_kg_m2")?,
+            output_inertia_kg_m2: item(&g, "output_inertia_kg_m2")?,
+            shift_clutch_capacity_nm: item(&g, "shift_clutch_capacity_nm")?,
+            shift_handover_s: item(&g, "shift_handover_s")?,
+            upshift_speed_zero_pedal_m_s: item(&g, "upshift_speed_zero_pedal_m_s")?,
+            upshift_speed_full_pedal_m_s: item(&g, "upshift_speed_full_pedal_m_s")?,
+            downshift_speed_zero_pedal_m_s: item(&g, "downshift_speed_zero_pedal_m_s")?,
+            downshift_speed_full_pedal_m_s: item(&g, "downshift_speed_full_pedal_m_s")?,
+        },
+        lockup: Lockup {
+            capacity_nm: item(&l, "capacity_nm")?,
+            static_to_kinetic: item(&l, "static_to_kinetic")?,
+            engage_time_s: item(&l, "engage_time_s")?,
+            min_gear: item(&l, "min_gear")?,
+            engage_speed_zero_pedal_m_s: item(&l, "engage_speed_zero_pedal_m_s")?,
+            engage_speed_full_pedal_m_s: item(&l, "engage_speed_full_pedal_m_s")?,
+        },
+        driveline: Driveline {
+            final_drive_ratio: item(&dl, "final_drive_ratio")?,
+            shaft_stiffness_nm_per_rad: [item(&dl, "front_shaft_stiffness_nm_per_rad")?, item(&dl, "rear_shaft_stiffness_nm_per_rad")?],
+            shaft_damping_nm_s_per_rad: [item(&dl, "front_shaft_damping_nm_s_per_rad")?, item(&dl, "rear_shaft_damping_nm_s_per_rad")?],
+            axle_inertia_kg_m2: [item(&dl, "front_axle_inertia_kg_m2")?, item(&dl, "rear_axle_inertia_kg_m2")?],
+        },
+        tyres: Tyres {
+            rolling_radius_m: item(&ty, "rolling_radius_m")?,
+            friction_coefficient: item(&ty, "friction_coefficient")?,
+            slip_stiffness: item(&ty, "slip_stiffness")?,
+            front_load_fraction: item(&ty, "front_load_fraction")?,
+        },
+        body: Body {
+            mass_kg: item(&b, "mass_kg")?,
+            drag_area_m2: item(&b, "drag_area_m2")?,
+            rolling_resistance: item(&b, "rolling_resistance")?,
+            air_density_kg_m3: item(&b, "air_density_kg_m3")?,
+            grade_percent: item(&b, "grade_percent")?,
+        },
+        brake: Brake { capacity_nm: item(&br, "capacity_nm")?, front_fraction: item(&br, "front_fraction")? },
+    })
+}
+
+fn scenario_from(d: &Bound<'_, PyDict>) -> PyResult<Scenario> {
+    let t: Vec<f64> = item(d, "time_s")?;
+    let signal = |key: &str| -> PyResult<Signal> { Signal::new(key, t.clone(), item(d, key)?, 0.0).map_err(input_error) };
+    Ok(Scenario {
+        accelerator_pedal: signal("accelerator_pedal")?,
+        brake_pedal: signal("brake_pedal")?,
+        end_time_s: item(d, "end_time_s")?,
+        stop_speed_m_s: opt_item(d, "stop_speed_m_s")?,
+    })
+}
+
+/// Output column names of a launch run.
+#[pyfunction]
+fn launch_columns() -> Vec<&'static str> {
+    launch_column_names()
+}
+
+/// Launch runs: each model dict (as for transient_runs) in the same vehicle and scenario, from the
+/// braked standstill, GIL released, `threads` workers. `options` takes the solver options of
+/// transient_runs and `output_step_s` (default 0.01). Entries as transient_runs': ("ok", columns,
+/// [(time_s, kind, gear)]), ("input", message, field, value, expected) or ("solver", message).
+#[pyfunction]
+#[pyo3(signature = (models, vehicle, scenario, options=None, threads=0))]
+fn launch_runs<'py>(
+    py: Python<'py>,
+    models: Vec<Bound<'py, PyDict>>,
+    vehicle: Bound<'py, PyDict>,
+    scenario: Bound<'py, PyDict>,
+    options: Option<Bound<'py, PyDict>>,
+    threads: usize,
+) -> PyResult<Vec<Py<PyAny>>> {
+    guard(|| {
+        let v = vehicle_from(&vehicle)?;
+        v.validate().map_err(input_error)?;
+        let sc = scenario_from(&scenario)?;
+        let solver = options_from(options.as_ref())?;
+        let step: f64 = match options.as_ref() {
+            Some(o) => opt_item(o, "output_step_s")?.unwrap_or(0.01),
+            None => 0.01,
+        };
+        let parsed = models.iter().map(|m| model_from(m)).collect::<PyResult<Vec<_>>>()?;
+        let results = py.detach(|| {
+            tcsim_core::batch::parallel_map(&parsed, threads, |m| {
+                tcsim_core::batch::catch_panic(|| {
+                    let traj = simulate_launch(m.as_ref(), &v, &sc, step, &solver)?;
+                    Ok((tcsim_core::vehicle::launch_columns(m.as_ref(), &sc, &traj), traj.events))
+                })
+            })
+        });
+        let names = launch_column_names();
+        results
+            .into_iter()
+            .map(|r| -> PyResult<Py<PyAny>> {
+                Ok(match r {
+                    Ok((cols, events)) => {
+                        let d = PyDict::new(py);
+                        for (name, col) in names.iter().zip(cols) {
+                            d.set_item(*name, col.into_pyarray(py))?;
+                        }
+                        let ev: Vec<(f64, &str, usize)> = events.iter().map(|e| (e.time_s, e.kind, e.gear)).collect();
+                        ("ok", d, ev).into_pyobject(py)?.into_any().unbind()
+                    }
+                    Err(TransientError::Input(e)) => ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind(),
+                    Err(e @ TransientError::Solver { .. }) => ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind(),
+                })
+            })
+            .collect()
+    })
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
@@ -426,6 +570,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(table_steady_states, m)?)?;
     m.add_function(wrap_pyfunction!(transient_columns, m)?)?;
     m.add_function(wrap_pyfunction!(smoothed_rate, m)?)?;
+    m.add_function(wrap_pyfunction!(launch_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(launch_runs, m)?)?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
     Ok(())
 }
