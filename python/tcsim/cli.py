@@ -131,6 +131,20 @@ def fit_shapes(
     stdout.print(shape_fit_command(converter, measurement, out, model, target, channel or [], drive, equal))
 
 
+@app.command()
+def launch(
+    vehicle: Annotated[Optional[str], typer.Argument(help="bundled vehicle name or vehicle .toml (default: midsize-awd-8at)")] = None,
+    out: OutOpt = Path("launch"),
+    scenario: Annotated[str, typer.Option("--scenario", help="flip-flop | part-pedal | FILE with time_s, accelerator_pedal, brake_pedal")] = "flip-flop",
+    model: Annotated[Optional[list[str]], typer.Option("--model", "-m", help="table | hrovat-tobler | quasi-dynamic, repeatable (default: every model the converter supports)")] = None,
+    sweep_shape_effects: Annotated[bool, typer.Option("--sweep-shape-effects", help="also sweep S_p = S_t of the dynamic models (like thesis figs 4.3–4.6)")] = False,
+) -> None:
+    """Vehicle take-off with every converter model: DIR/summary.csv, DIR/<model>.csv, plots like thesis figs 3.5, 3.6, 3.20."""
+    from .launch import launch_command
+
+    stdout.print(launch_command(vehicle, out, scenario, model or [], sweep_shape_effects))
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     if issubclass(category, TcsimWarning):
         console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True)
