@@ -344,8 +344,10 @@ pub struct Scenario {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum LockupState {
     Open,
-    /// Capacity ramping in since `since_s`, slipping.
-    Engaging { since_s: f64 },
+    /// Capacity ramping in since `since_s` (full once `ramped`), slipping. An `armed` clutch locks
+    /// when the slip falls below the sync threshold; one that broke away from locked is armed once
+    /// its slip has grown past twice that.
+    Engaging { since_s: f64, ramped: bool, armed: bool },
     Locked,
 }
 
@@ -354,6 +356,8 @@ pub struct Shift {
     pub from: usize,
     pub to: usize,
     pub since_s: f64,
+    /// The torque handover is over: the on-coming clutch has its full capacity.
+    pub handed_over: bool,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -374,12 +378,17 @@ enum Root {
     FlowStartsPositive,
     FlowStartsNegative,
     BrakeRelease,
+    BrakeHold,
     Upshift,
     Downshift,
+    ShiftHandover,
     ShiftSync,
     LockupEngage,
+    LockupRamped,
+    LockupArm,
     LockupLock,
     LockupSlip,
+    LockupRelease,
     Stop,
 }
 
@@ -397,7 +406,12 @@ const CLUTCH_SLIP_RAD_S: f64 = 0.2;
 /// carrying 96 % of its capacity slips by 2·CLUTCH_SLIP_RAD_S, so a smaller slip means it holds.
 const SYNC_SLIP_RAD_S: f64 = 0.5;
 /// Scale of the regularised brake and drag signs, rad/s and m/s.
-const BRAKE_SPEED_RAD_S: f64 = 0.5;
+const BRAKE_SPEED_RAD_S: f64 = 0.01;
+/// The lock-up clutch opens below this fraction of its engage speed (hysteresis), and on a
+/// downshift.
+const LOCKUP_RELEASE_FRACTION: f64 = 0.7;
+/// Axle and wheel-rim speed below which a braked axle is held (exact standstill), rad/s.
+const HOLD_SPEED_RAD_S: f64 = 0.005;
 const ROLL_SPEED_M_S: f64 = 0.01;
 
 // ---------------------------------------------------------------------------------------------
@@ -502,11 +516,9 @@ impl<'a> Plant<'a> {
                 roots.push(Root::Flow);
             }
         }
-        if mode.wheels_held {
-            roots.push(Root::BrakeRelease);
-        }
+        roots.push(if mode.wheels_held { Root::BrakeRelease } else { Root::BrakeHold });
         match mode.shift {
-            Some(_) => roots.push(Root::ShiftSync),
+            Some(s) => roots.push(if s.handed_over { Root::ShiftSync } else { Root::ShiftHandover }),
             None => {
                 if mode.gear + 1 < v.gearbox.ratios.len() {
                     roots.push(Root::Upshift);
@@ -518,9 +530,14 @@ impl<'a> Plant<'a> {
         }
         match mode.lockup {
             LockupState::Open if mode.gear + 1 >= v.lockup.min_gear && mode.shift.is_none() => roots.push(Root::LockupEngage),
+            LockupState::Engaging { ramped: false, .. } => roots.push(Root::LockupRamped),
+            LockupState::Engaging { armed: false, .. } => roots.push(Root::LockupArm),
             LockupState::Engaging { .. } => roots.push(Root::LockupLock),
             LockupState::Locked => roots.push(Root::LockupSlip),
             _ => {}
+        }
+        if mode.lockup != LockupState::Open {
+            roots.push(Root::LockupRelease);
         }
         if sc.stop_speed_m_s.is_some() {
             roots.push(Root::Stop);
@@ -545,7 +562,7 @@ impl<'a> Plant<'a> {
 
     fn lockup_capacity(&self, t: f64) -> f64 {
         match self.mode.lockup {
-            LockupState::Engaging { since_s } => self.v.lockup.capacity_nm * ((t - since_s) / self.v.lockup.engage_time_s).clamp(0.0, 1.0),
+            LockupState::Engaging { since_s, .. } => self.v.lockup.capacity_nm * ((t - since_s) / self.v.lockup.engage_time_s).clamp(0.0, 1.0),
             _ => 0.0,
         }
     }
@@ -672,6 +689,20 @@ impl<'a> Plant<'a> {
         std::array::from_fn(|r| (0..N).map(|c| self.mass[r][c] * ud[c]).sum::<f64>() - f[r])
     }
 
+    /// Front and rear shaft torques.
+    fn shaft_torques(&self, u: &[f64; N], f: &[f64; N]) -> [f64; 2] {
+        let d = &self.v.driveline;
+        [(TWIST_F, 0), (TWIST_R, 1)].map(|(tw, i)| d.shaft_stiffness_nm_per_rad[i] * u[tw] + d.shaft_damping_nm_s_per_rad[i] * f[tw])
+    }
+
+    /// Brake capacity left on the weaker held axle (negative: the brake cannot hold).
+    fn brake_margin(&self, ud: &[f64; N], f: &[f64; N], t: f64) -> f64 {
+        let r = self.reactions(ud, f);
+        let cap = self.sc.brake_pedal.value(t).clamp(0.0, 1.0) * self.v.brake.capacity_nm;
+        let share = self.v.brake.front_fraction;
+        (cap * share - r[FRONT].abs()).min(cap * (1.0 - share) - r[REAR].abs())
+    }
+
     fn held_flow_balance(&self, u: &[f64; N], ud: &[f64; N]) -> (f64, f64) {
         let (head, shock) = self.model.zero_flow_head(&[u[0], u[1], u[2], u[3]]);
         let inertial: f64 = (0..N).map(|c| self.mass[FLOW][c] * ud[c]).sum();
@@ -795,38 +826,35 @@ impl SmoothSegment for Plant<'_> {
                     let (d, p0) = self.held_flow_balance(&u, &ud);
                     p0 + d + h.head_pa
                 }
-                Root::BrakeRelease => {
-                    let r = self.reactions(&ud, &f);
+                Root::BrakeRelease => self.brake_margin(&ud, &f, t) + 1e-9,
+                Root::BrakeHold => {
+                    // hold once the axles have (nearly) stopped and the brake can hold the driveline
+                    let rim = u[SPEED] / self.v.tyres.rolling_radius_m;
+                    let spin = (u[FRONT] * u[FRONT] + u[REAR] * u[REAR] + rim * rim).sqrt() - HOLD_SPEED_RAD_S;
                     let cap = self.sc.brake_pedal.value(t).clamp(0.0, 1.0) * self.v.brake.capacity_nm;
-                    let share = self.v.brake.front_fraction;
-                    (cap * share - r[FRONT].abs()).min(cap * (1.0 - share) - r[REAR].abs()) + 1e-9
+                    let (share, fd) = (self.v.brake.front_fraction, self.v.driveline.final_drive_ratio);
+                    let shaft = self.shaft_torques(&u, &f);
+                    // with a 20 % margin, so that a brake that just let go does not grab again
+                    let short = (fd * shaft[0].abs() - 0.8 * cap * share).max(fd * shaft[1].abs() - 0.8 * cap * (1.0 - share));
+                    spin.max(short)
                 }
                 Root::Upshift => gb.upshift_speed(self.mode.gear, p) - u[SPEED],
                 Root::Downshift => u[SPEED] - gb.downshift_speed(self.mode.gear, p),
-                Root::ShiftSync => {
-                    let s = self.mode.shift.map_or(0.0, |s| u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT]);
-                    // sync once the handover is over and the on-coming slip has closed
-                    let done = self.mode.shift.is_none_or(|s| t - s.since_s >= gb.shift_handover_s);
-                    if done {
-                        self.sync_sign * s - SYNC_SLIP_RAD_S
-                    } else {
-                        1.0 + (self.sync_sign * s).abs()
-                    }
-                }
-                Root::LockupEngage => u[SPEED] - self.v.lockup.engage_speed(p),
-                Root::LockupLock => {
-                    let done = matches!(self.mode.lockup, LockupState::Engaging { since_s } if t - since_s >= self.v.lockup.engage_time_s);
-                    if done {
-                        self.sync_sign * (u[PUMP] - u[TURBINE]) - SYNC_SLIP_RAD_S
-                    } else {
-                        1.0 + (u[PUMP] - u[TURBINE]).abs()
-                    }
-                }
+                Root::ShiftHandover => self.mode.shift.map_or(1.0, |s| s.since_s + gb.shift_handover_s - t),
+                Root::ShiftSync => self.mode.shift.map_or(1.0, |s| self.sync_sign * (u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT]) - SYNC_SLIP_RAD_S),
+                Root::LockupEngage => self.v.lockup.engage_speed(p) - u[SPEED],
+                Root::LockupRamped => match self.mode.lockup {
+                    LockupState::Engaging { since_s, .. } => since_s + self.v.lockup.engage_time_s - t,
+                    _ => 1.0,
+                },
+                Root::LockupArm => 2.0 * SYNC_SLIP_RAD_S - self.sync_sign * (u[PUMP] - u[TURBINE]),
+                Root::LockupLock => self.sync_sign * (u[PUMP] - u[TURBINE]) - SYNC_SLIP_RAD_S,
                 Root::LockupSlip => {
                     // torque through the locked clutch: the engine side's constraint torque
                     let r = self.reactions(&ud, &f);
                     self.v.lockup.static_to_kinetic * self.v.lockup.capacity_nm - r[PUMP].abs()
                 }
+                Root::LockupRelease => u[SPEED] - LOCKUP_RELEASE_FRACTION * self.v.lockup.engage_speed(p),
                 Root::Stop => self.sc.stop_speed_m_s.unwrap_or(f64::INFINITY) - u[SPEED],
             };
         }
@@ -858,10 +886,7 @@ impl SmoothSegment for Plant<'_> {
         let d = &self.v.driveline;
         let kinetic: f64 = 0.5 * (0..=SPEED).map(|r| u[r] * (0..=SPEED).map(|c| self.mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
         let spring = 0.5 * (d.shaft_stiffness_nm_per_rad[0] * u[TWIST_F].powi(2) + d.shaft_stiffness_nm_per_rad[1] * u[TWIST_R].powi(2));
-        let shaft = [TWIST_F, TWIST_R].map(|tw| {
-            let i = if tw == TWIST_F { 0 } else { 1 };
-            d.shaft_stiffness_nm_per_rad[i] * u[tw] + d.shaft_damping_nm_s_per_rad[i] * f[tw]
-        });
+        let shaft = self.shaft_torques(&u, &f);
         let ty = &self.v.tyres;
         let tyre = [FRONT, REAR].map(|a| {
             let load = if a == FRONT { ty.front_load_fraction } else { 1.0 - ty.front_load_fraction };
@@ -947,12 +972,17 @@ fn event_name(root: Root) -> &'static str {
         Root::Flow => "flow-zero",
         Root::FlowStartsPositive | Root::FlowStartsNegative => "flow-start",
         Root::BrakeRelease => "brake-release",
+        Root::BrakeHold => "brake-hold",
         Root::Upshift => "upshift-start",
         Root::Downshift => "downshift-start",
+        Root::ShiftHandover => "shift-handover",
         Root::ShiftSync => "shift-end",
         Root::LockupEngage => "lockup-engage",
+        Root::LockupRamped => "lockup-applied",
+        Root::LockupArm => "lockup-slipping",
         Root::LockupLock => "lockup-lock",
         Root::LockupSlip => "lockup-slip",
+        Root::LockupRelease => "lockup-release",
         Root::Stop => "stop-speed",
     }
 }
@@ -975,13 +1005,24 @@ fn switch(plant: &Plant, root: Root, u: &mut [f64; N], t: f64) -> (VehicleMode, 
         Root::FlowStartsPositive => m.converter.flow_sign = 1.0,
         Root::FlowStartsNegative => m.converter.flow_sign = -1.0,
         Root::BrakeRelease => m.wheels_held = false,
+        Root::BrakeHold => m.wheels_held = true,
         Root::Upshift | Root::Downshift => {
             let to = if root == Root::Upshift { m.gear + 1 } else { m.gear - 1 };
-            m.shift = Some(Shift { from: m.gear, to, since_s: t });
-            let s = u[TURBINE] - gb.ratios[to] * u[GEARBOX_OUT];
-            sync = if s >= 0.0 { 1.0 } else { -1.0 };
-            if m.lockup != LockupState::Locked {
+            m.shift = Some(Shift { from: m.gear, to, since_s: t, handed_over: false });
+            // an engaging clutch restarts after an upshift; a downshift opens it
+            if m.lockup != LockupState::Locked || root == Root::Downshift {
                 m.lockup = LockupState::Open;
+            }
+        }
+        Root::ShiftHandover => {
+            let to = m.shift.map_or(m.gear, |s| s.to);
+            let slip = u[TURBINE] - gb.ratios[to] * u[GEARBOX_OUT];
+            if slip.abs() <= SYNC_SLIP_RAD_S {
+                m.gear = to;
+                m.shift = None;
+            } else {
+                m.shift = m.shift.map(|s| Shift { handed_over: true, ..s });
+                sync = slip.signum();
             }
         }
         Root::ShiftSync => {
@@ -990,14 +1031,25 @@ fn switch(plant: &Plant, root: Root, u: &mut [f64; N], t: f64) -> (VehicleMode, 
             }
             m.shift = None;
         }
-        Root::LockupEngage => {
-            m.lockup = LockupState::Engaging { since_s: t };
-            sync = if u[PUMP] >= u[TURBINE] { 1.0 } else { -1.0 };
+        Root::LockupEngage => m.lockup = LockupState::Engaging { since_s: t, ramped: false, armed: false },
+        Root::LockupRamped => {
+            let slip = u[PUMP] - u[TURBINE];
+            if slip.abs() <= SYNC_SLIP_RAD_S {
+                m.lockup = LockupState::Locked;
+            } else {
+                m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: true };
+                sync = slip.signum();
+            }
         }
+        Root::LockupArm => m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: true },
         Root::LockupLock => m.lockup = LockupState::Locked,
+        Root::LockupRelease => m.lockup = LockupState::Open,
         Root::LockupSlip => {
-            m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s };
-            sync = if u[PUMP] >= u[TURBINE] { 1.0 } else { -1.0 };
+            // the slip develops in the direction of the torque the clutch could not hold
+            let (_, ud, f, _) = plant.kinematics(&plant.state_of(u), t);
+            let through = -plant.reactions(&ud, &f)[PUMP];
+            m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: false };
+            sync = if through >= 0.0 { 1.0 } else { -1.0 };
         }
         Root::Stop => {}
     }
@@ -1016,6 +1068,38 @@ fn flow_sign_at_zero(plant: &Plant, u: &[f64; N], t: f64) -> f64 {
     } else {
         0.0
     }
+}
+
+/// A switch whose condition already holds when a mode starts (root functions only see
+/// crossings): the stop speed, a due shift, a due lock-up engagement.
+fn due(plant: &Plant, u: &[f64; N], t: f64) -> Option<Root> {
+    let m = &plant.mode;
+    let p = plant.sc.accelerator_pedal.value(t);
+    let gb = &plant.v.gearbox;
+    if plant.sc.stop_speed_m_s.is_some_and(|v| u[SPEED] >= v) {
+        return Some(Root::Stop);
+    }
+    if m.wheels_held {
+        let (_, ud, f, _) = plant.kinematics(&plant.state_of(u), t);
+        if plant.brake_margin(&ud, &f, t) < 0.0 {
+            return Some(Root::BrakeRelease);
+        }
+    }
+    if m.lockup != LockupState::Open && (m.gear + 1 < plant.v.lockup.min_gear || u[SPEED] < LOCKUP_RELEASE_FRACTION * plant.v.lockup.engage_speed(p)) {
+        return Some(Root::LockupRelease);
+    }
+    if m.shift.is_none() && !m.wheels_held {
+        if m.gear + 1 < gb.ratios.len() && u[SPEED] > gb.upshift_speed(m.gear, p) {
+            return Some(Root::Upshift);
+        }
+        if m.gear > 0 && u[SPEED] < gb.downshift_speed(m.gear, p) {
+            return Some(Root::Downshift);
+        }
+        if m.lockup == LockupState::Open && m.gear + 1 >= plant.v.lockup.min_gear && u[SPEED] > plant.v.lockup.engage_speed(p) {
+            return Some(Root::LockupEngage);
+        }
+    }
+    None
 }
 
 /// Kinetic energy of `u` with `plant`'s masses.
@@ -1058,7 +1142,11 @@ pub fn simulate_launch(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario
             // gearbox's inertia with the gear changes it too: both are booked here
             traj.event_loss_j.push((t, before - kinetic_energy(&plant, &plant.full(&x0))));
         }
-        match run_segment(&plant, x0, t, sc.end_time_s, &times, options, &mut traj.samples, &mut traj.steps)? {
+        let end = match due(&plant, &plant.full(&x0), t) {
+            Some(root) => Some((t, root, x0)),
+            None => run_segment(&plant, x0, t, sc.end_time_s, &times, options, &mut traj.samples, &mut traj.steps)?,
+        };
+        match end {
             None => return Ok(traj),
             Some((t_root, root, x)) => {
                 let mut next = plant.full(&x);
@@ -1069,7 +1157,12 @@ pub fn simulate_launch(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario
                 }
                 let (new_mode, new_sync) = switch(&plant, root, &mut next, t_root);
                 energy_before = Some(kinetic_energy(&plant, &next));
-                traj.events.push(VehicleEvent { time_s: t_root, kind: event_name(root), gear: new_mode.gear + 1 });
+                let kind = match root {
+                    Root::ShiftHandover if new_mode.shift.is_none() => "shift-end",
+                    Root::LockupRamped if new_mode.lockup == LockupState::Locked => "lockup-lock",
+                    _ => event_name(root),
+                };
+                traj.events.push(VehicleEvent { time_s: t_root, kind, gear: new_mode.gear + 1 });
                 if traj.events.len() > options.max_events {
                     return Err(TransientError::Solver { time_s: t_root, state: next.to_vec(), message: format!("more than {} events: events chatter", options.max_events) });
                 }
@@ -1157,4 +1250,84 @@ pub fn launch_columns(model: &dyn ConverterDynamics, sc: &Scenario, traj: &Launc
         }
     }
     cols
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn engine() -> Engine {
+        Engine {
+            inertia_kg_m2: 0.2,
+            idle_speed_rad_s: 78.5,
+            full_load: Curve::new("full_load", vec![60.0, 230.0, 500.0, 700.0], vec![150.0, 400.0, 400.0, 280.0]).unwrap(),
+            drag_torque_nm: 15.0,
+            drag_nm_s_per_rad: 0.05,
+            fast_time_constant_s: 0.06,
+            boost_time_constant_s: 0.8,
+            boost_fraction: 0.4,
+            idle_governor_gain_nm_s_per_rad: 10.0,
+        }
+    }
+
+    #[test]
+    fn curve_interpolates_holds_ends_and_refuses_bad_tables() {
+        let c = Curve::new("c", vec![0.0, 1.0, 3.0], vec![0.0, 2.0, 6.0]).unwrap();
+        assert_eq!((c.at(-1.0), c.at(0.5), c.at(2.0), c.at(9.0)), (0.0, 1.0, 4.0, 6.0));
+        assert_eq!(Curve::new("c", vec![0.0, 1.0, 1.0], vec![0.0; 3]).unwrap_err().field, "c[2]");
+    }
+
+    #[test]
+    fn engine_splits_pedal_torque_and_governs_idle() {
+        let e = engine();
+        // full pedal at 230 rad/s: 400 N·m, 40 % of it through the boost path
+        let (fast, boost) = e.targets(1.0, 230.0);
+        assert!((fast - 240.0).abs() < 1e-12 && (boost - 160.0).abs() < 1e-12);
+        // no pedal above idle: nothing; below idle the governor pushes, limited by full load
+        assert_eq!(e.targets(0.0, 100.0), (0.0, 0.0));
+        let (fast, boost) = e.targets(0.0, 70.0);
+        assert!((fast - 85.0).abs() < 1e-12 && boost == 0.0);
+        assert!((e.targets(0.0, 0.0).0 - 150.0).abs() < 1e-12);
+        // drag opposes rotation and vanishes at rest
+        assert!(e.drag(100.0) > 15.0 && e.drag(0.0) == 0.0 && e.drag(-100.0) < 0.0);
+        let mut bad = engine();
+        bad.boost_fraction = 1.5;
+        assert_eq!(bad.validate().unwrap_err().field, "engine.boost_fraction");
+    }
+
+    #[test]
+    fn gearbox_schedule_interpolates_in_pedal_and_is_validated() {
+        let g = Gearbox {
+            ratios: vec![4.0, 2.0, 1.0],
+            efficiencies: vec![0.95, 0.96, 0.97],
+            input_inertia_kg_m2: vec![0.05, 0.04, 0.03],
+            output_inertia_kg_m2: 0.05,
+            shift_clutch_capacity_nm: 500.0,
+            shift_handover_s: 0.25,
+            upshift_speed_zero_pedal_m_s: vec![4.0, 8.0],
+            upshift_speed_full_pedal_m_s: vec![12.0, 24.0],
+            downshift_speed_zero_pedal_m_s: vec![2.0, 5.0],
+            downshift_speed_full_pedal_m_s: vec![8.0, 16.0],
+        };
+        g.validate().unwrap();
+        assert_eq!((g.upshift_speed(0, 0.5), g.upshift_speed(1, 1.0), g.downshift_speed(2, 0.0)), (8.0, 24.0, 5.0));
+        let mut bad = g.clone();
+        bad.downshift_speed_full_pedal_m_s[1] = 30.0;
+        assert_eq!(bad.validate().unwrap_err().field, "gearbox.downshift_speed_full_pedal_m_s[1]");
+        let mut bad = g.clone();
+        bad.efficiencies.pop();
+        assert_eq!(bad.validate().unwrap_err().field, "gearbox.efficiencies");
+        let mut bad = g;
+        bad.ratios[1] = -2.0;
+        assert_eq!(bad.validate().unwrap_err().field, "gearbox.ratios[1]");
+    }
+
+    #[test]
+    fn lockup_engage_speed_and_validation() {
+        let l = Lockup { capacity_nm: 600.0, static_to_kinetic: 1.2, engage_time_s: 0.5, min_gear: 3, engage_speed_zero_pedal_m_s: 12.0, engage_speed_full_pedal_m_s: 25.0 };
+        assert_eq!(l.engage_speed(0.0), 12.0);
+        assert_eq!(l.engage_speed(2.0), 25.0);
+        let bad = Lockup { static_to_kinetic: 0.9, ..l };
+        assert_eq!(bad.validate().unwrap_err().field, "lockup.static_to_kinetic");
+    }
 }

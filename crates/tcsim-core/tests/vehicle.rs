@@ -153,3 +153,49 @@ fn shifts_and_lockup_are_events_and_speeds_stay_continuous() {
         assert!(r.samples.iter().map(|s| s.mode.gear).collect::<Vec<_>>().windows(2).all(|g| g[1] >= g[0]));
     }
 }
+
+#[test]
+fn braked_driveline_winds_up_by_the_stall_torque_and_tyres_limit_the_acceleration() {
+    let sc = flip_flop(1.0, 30.0, 100.0 / 3.6);
+    let model = table();
+    let r = run(&model, &sc);
+    let v = sedan();
+    for s in r.samples.iter().filter(|s| s.time_s > 1.0 && s.time_s < 5.0) {
+        // the shafts carry the stalled turbine torque through first gear (thesis §4.3.1)
+        let turbine = -s.converter.torque[1];
+        let shafts = s.shaft_torque_nm[0] + s.shaft_torque_nm[1];
+        assert!((shafts - turbine * v.gearbox.ratios[0]).abs() < 1e-3 * shafts, "t {}: {shafts} vs {}", s.time_s, turbine * v.gearbox.ratios[0]);
+        // split by stiffness, and no tyre force while the axles are held
+        let split = s.shaft_torque_nm[0] / shafts;
+        assert!((split - 6000.0 / 15000.0).abs() < 1e-6);
+        assert_eq!(s.tyre_force_n, [0.0, 0.0]);
+    }
+    // no sample accelerates beyond the tyres' friction limit μg
+    let limit = v.tyres.friction_coefficient * 9.81;
+    assert!(r.samples.iter().all(|s| s.u_dot[SPEED] < limit));
+}
+
+#[test]
+fn coasting_slows_down_and_the_brake_stops_and_holds_the_vehicle() {
+    // pedal 0 after a short launch: aero, rolling resistance and engine braking slow it; the brake
+    // then brings it to rest
+    let t = vec![0.0, 5.0, 5.05, 8.0, 8.05, 20.0, 20.5, 40.0];
+    let sc = Scenario {
+        accelerator_pedal: Signal::new("accelerator_pedal", t.clone(), vec![0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0], 0.0).unwrap(),
+        brake_pedal: Signal::new("brake_pedal", t, vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.6, 0.6], 0.0).unwrap(),
+        end_time_s: 40.0,
+        stop_speed_m_s: None,
+    };
+    let r = run(&table(), &sc);
+    let speed_at = |time: f64| r.samples.iter().find(|s| s.time_s >= time).unwrap().u[SPEED];
+    assert!(speed_at(8.0) > 5.0);
+    assert!(speed_at(19.0) < speed_at(9.0), "{} {}", speed_at(9.0), speed_at(19.0));
+    // the brake holds the axles once they have stopped: an exact standstill, as at the start
+    assert!(r.events.iter().any(|e| e.kind == "brake-hold" && e.time_s > 20.0), "{:?}", r.events);
+    assert!(speed_at(40.0).abs() < 1e-9, "{}", speed_at(40.0));
+    // lifting the pedal upshifts, slowing down downshifts and opens the lock-up clutch
+    let kinds: Vec<&str> = r.events.iter().map(|e| e.kind).collect();
+    assert!(kinds.contains(&"downshift-start") && kinds.contains(&"lockup-lock"));
+    assert_eq!(r.samples.last().unwrap().mode.gear, 0);
+    assert_eq!(r.samples.last().unwrap().mode.lockup, LockupState::Open);
+}
