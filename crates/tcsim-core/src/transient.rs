@@ -177,7 +177,7 @@ impl std::fmt::Display for TransientError {
         match self {
             TransientError::Input(e) => write!(f, "{e}"),
             TransientError::Solver { time_s, state, message } => {
-                let names = ["ω_p", "ω_t", "ω_s", "Q"];
+                let names = ["ω_p", "ω_t", "ω_s", "Q", "ω_o", "ω_f", "ω_r", "v", "θ_f", "θ_r", "T_fast", "T_boost"];
                 let shown: Vec<String> = state.iter().enumerate().map(|(i, v)| format!("{} = {v:.6}", names.get(i).copied().unwrap_or("x"))).collect();
                 write!(f, "solver failed at t = {time_s:.6} s ({}): {message}", shown.join(", "))
             }
