@@ -71,13 +71,15 @@ def plot_ratios(result: "Launch", out_dir: Path) -> list[Path]:
     for name, f in result.frames.items():
         w = _window(f, a, b)
         style = _style(name)
-        ax.plot(w["time_s"], w["torque_ratio"], lw=1.3, **style)
+        # the effective TR (eqs 3.1–3.4): the table's TR(SR) for the table model; the plain ratio
+        # of external torques would also carry the pump's and turbine's inertia torques
+        ax.plot(w["time_s"], w["effective_torque_ratio"], lw=1.3, **style)
         ax.plot(w["time_s"], w["speed_ratio"], lw=1.1, ls="--", color=style["color"])
     _release_line(ax, release)
     ax.set_ylabel("Ratio [-]")
     ax.set_ylim(bottom=0)
     p1 = _save(fig, ax, Path(out_dir) / "torque_speed_ratio.png",
-               "Torque ratio (solid) and speed ratio (dashed), cf. thesis fig. 3.5")
+               "Effective torque ratio (solid) and speed ratio (dashed), cf. thesis fig. 3.5")
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
     for name, f in result.frames.items():

@@ -100,12 +100,15 @@ fn dynamic_models_accelerate_less_at_first_and_rejoin_the_table_model() {
     println!("mean acceleration in the first 0.3 s after the release (table, quasi-dynamic, H&T): {first:?}");
     assert!(first[1] < first[0] && first[2] < first[0], "{first:?}");
     // TR of the three models within 5 % of each other about 1 s after the release
-    let tr = |r: &LaunchTrajectory, t: f64| {
+    // effective TR (eqs 3.1–3.4): the table's TR(SR) for the table model
+    let effective = tcsim_core::outputs::COLUMNS.iter().position(|c| *c == "effective_torque_ratio").unwrap();
+    let models = models();
+    let tr = |i: usize, r: &LaunchTrajectory, t: f64| {
         let s = r.samples.iter().find(|s| s.time_s >= t).unwrap();
-        -s.converter.torque[1] / s.converter.torque[0]
+        tcsim_core::outputs::row(models[i].1.as_ref(), &s.converter)[effective]
     };
     for dt in [0.6, 0.8, 1.0, 1.5, 2.0] {
-        let v: Vec<f64> = runs.iter().map(|(_, r)| tr(r, release + dt)).collect();
+        let v: Vec<f64> = runs.iter().enumerate().map(|(i, (_, r))| tr(i, r, release + dt)).collect();
         let spread = (v.iter().cloned().fold(f64::MIN, f64::max) - v.iter().cloned().fold(f64::MAX, f64::min)) / v[0];
         println!("TR {dt} s after the release: {v:?}, spread {spread:.3}");
         if dt >= 1.0 {
