@@ -29,6 +29,8 @@ import pandas as pd  # noqa: E402
 if TYPE_CHECKING:  # pragma: no cover
     from .launch import Launch
 
+from .plots import finish_figure  # noqa: E402
+
 COLOURS = {"table": "C0", "hrovat-tobler": "C1", "quasi-dynamic": "C2"}
 LABELS = {"table": "SS (table) model", "hrovat-tobler": "H&T model", "quasi-dynamic": "quasi-dynamic model"}
 #: Window around the brake release of figures 3.5 and 3.6: (before, after), s.
@@ -48,15 +50,7 @@ def _window(df: pd.DataFrame, start: float, end: float) -> pd.DataFrame:
     return df[(t >= start) & (t <= end)]
 
 
-def _save(fig, ax, path: Path, title: str, xlabel: str = "Time [s]") -> Path:
-    ax.set_xlabel(xlabel)
-    ax.set_title(title, fontsize="medium")
-    ax.grid(True, alpha=0.3)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize="small")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+_save = finish_figure
 
 
 def _release_line(ax, release: float) -> None:

@@ -22,6 +22,18 @@ QUANTITIES = {
 }
 
 
+def finish_figure(fig, ax, path: Path, title: str, xlabel: str = "Time [s]") -> Path:
+    """Label, grid, legend (when there are labelled lines), save at 120 dpi and close."""
+    ax.set_xlabel(xlabel)
+    ax.set_title(title, fontsize="medium")
+    ax.grid(True, alpha=0.3)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(fontsize="small")
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
 def table_columns(table: Characteristic) -> pd.DataFrame:
     sr, tr, cf = table.arrays()
     with np.errstate(divide="ignore", invalid="ignore"):

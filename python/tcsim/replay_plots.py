@@ -26,19 +26,13 @@ FIGURES = {
     "effective_turbine_torque_nm": ("Effective turbine output torque [N·m]", "effective_turbine_torque.png",
                                     "T_t + I_t·dω_t/dt, thesis eq 3.4, fig. 3.17"),
 }
+from .plots import finish_figure  # noqa: E402
+
 INPUT_LABELS = {"pump_torque_nm": "Pump torque [N·m]", "pump_speed_rad_s": "Pump speed [rad/s]",
                 "turbine_speed_rad_s": "Turbine speed [rad/s]"}
 
 
-def _finish(fig, ax, path: Path, title: str) -> Path:
-    ax.set_xlabel("Time [s]")
-    ax.set_title(title, fontsize="medium")
-    ax.grid(True, alpha=0.3)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize="small")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+_finish = finish_figure
 
 
 def plot_inputs(rep: "Replay", out_dir: Path) -> Path:

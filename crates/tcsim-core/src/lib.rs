@@ -17,6 +17,7 @@ pub mod capacity;
 pub mod dynamics;
 pub mod error;
 pub mod hrovat_tobler;
+pub mod linalg;
 pub mod outputs;
 pub mod scalar;
 pub mod segment;

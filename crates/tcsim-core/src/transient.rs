@@ -461,36 +461,15 @@ impl<'a> Segment<'a> {
     }
 }
 
-/// Inverse of the leading n×n block (Gauss–Jordan with partial pivoting).
+/// Inverse of the leading n×n block.
 fn invert(n: usize, a: &Mat4) -> Option<Mat4> {
-    let mut m = *a;
-    let mut inv = [[0.0; 4]; 4];
-    for (i, row) in inv.iter_mut().enumerate().take(n) {
-        row[i] = 1.0;
+    let block: Vec<Vec<f64>> = a.iter().take(n).map(|row| row[..n].to_vec()).collect();
+    let inv = crate::linalg::invert(&block)?;
+    let mut out = [[0.0; 4]; 4];
+    for (r, row) in inv.iter().enumerate() {
+        out[r][..n].copy_from_slice(row);
     }
-    for col in 0..n {
-        let p = (col..n).max_by(|&i, &j| m[i][col].abs().total_cmp(&m[j][col].abs()))?;
-        if m[p][col] == 0.0 || !m[p][col].is_finite() {
-            return None;
-        }
-        m.swap(col, p);
-        inv.swap(col, p);
-        let d = m[col][col];
-        for k in 0..n {
-            m[col][k] /= d;
-            inv[col][k] /= d;
-        }
-        for r in 0..n {
-            if r != col {
-                let f = m[r][col];
-                for k in 0..n {
-                    m[r][k] -= f * m[col][k];
-                    inv[r][k] -= f * inv[col][k];
-                }
-            }
-        }
-    }
-    Some(inv)
+    Some(out)
 }
 
 // ---------------------------------------------------------------------------------------------
