@@ -14,10 +14,15 @@ Not part of the test suite. Run: ``python3 bench/bench_launch.py`` (tcsim instal
 * **SciPy** (``bench/scipy_vehicle.py``): the same vehicle, scenario, modes, events and table
   model written with ``solve_ivp`` (LSODA and Radau, rtol 1e-6, per-state absolute tolerances as
   the core's, finite-difference Jacobian), same samples. Median of ``SCIPY_REPEATS``.
-* **Agreement** is checked before any ratio is printed: the same converter table and inertias on
-  both sides; the same event kinds in the same order, event times within 1e-3 s (so the time to
-  100 km/h too); the speed traces on the common 0.01 s samples within 0.01 m/s (the maximum
-  difference is printed).
+* **Agreement** is checked before any ratio is printed, in two scenarios: the flip-flop launch above
+  and ``coast_and_brake()`` (the core's coasting test: full pedal 5.05–8.0 s, pedal off, coasting,
+  brake ramped to 0.6 over 20–20.5 s and held to the end at 40 s, no stop speed; upshifts on the pedal lift, lock-up, then
+  downshifts that open the lock-up clutch, and the brake re-holding the stopped axles). Checked: the
+  same converter table and inertias on both sides; the same event kinds, in the same order, with the
+  same gears; event times within 1e-3 s (so the time to 100 km/h too); the speed traces on the
+  common 0.01 s samples within 0.01 m/s (the maximum difference is printed).
+* The coasting scenario is also timed (tcsim table alone and three models, SciPy LSODA and Radau),
+  for information.
 
 Target (issue 4): the three-model comparison under 50 ms of compute.
 """
@@ -76,8 +81,9 @@ def check_same_table(spec: dict, params: dict) -> None:
     assert spec["inertia_kg_m2"][:2] == [c["pump_kg_m2"], c["turbine_kg_m2"]], (spec["inertia_kg_m2"], c)
 
 
-def agreement(ours: tuple, theirs: dict, label: str) -> dict:
-    """Events and speed trace of tcsim's table run against a SciPy run; stops on a disagreement."""
+def agreement(ours: tuple, theirs: dict, label: str, stops: bool) -> dict:
+    """Events and speed trace of tcsim's table run against a SciPy run; stops on a disagreement.
+    ``stops``: the run ends at the stop speed (its last event)."""
     cols, ev_ours = ours[1], ours[2]
     ev_theirs = theirs["events"]
     kinds_ours, kinds_theirs = [e[1] for e in ev_ours], [e[1] for e in ev_theirs]
@@ -86,10 +92,10 @@ def agreement(ours: tuple, theirs: dict, label: str) -> dict:
     dt_events = max(abs(a[0] - b[0]) for a, b in zip(ev_ours, ev_theirs))
     if dt_events > EVENT_TOL_S:
         raise SystemExit(f"{label}: event times differ by {dt_events:.2e} s\n  tcsim {ev_ours}\n  scipy {ev_theirs}")
-    stop_ours, stop_theirs = ev_ours[-1][0], ev_theirs[-1][0]
-    # common samples: the 0.01 s grid (each side adds one sample at its own stop time)
+    stop_ours, stop_theirs = (ev_ours[-1][0], ev_theirs[-1][0]) if stops else (None, None)
+    # common samples: the 0.01 s grid (at a stop, each side adds one sample at its own stop time)
     t_a, t_b = np.asarray(cols["time_s"]), theirs["time_s"]
-    n = min(len(t_a), len(t_b)) - 1
+    n = min(len(t_a), len(t_b)) - (1 if stops else 0)
     assert np.allclose(t_a[:n], t_b[:n], rtol=0, atol=1e-12), "sample times differ"
     dv = np.abs(np.asarray(cols["vehicle_speed_m_s"])[:n] - theirs["vehicle_speed_m_s"][:n])
     dwp = np.abs(np.asarray(cols["pump_speed_rad_s"])[:n] - theirs["pump_speed_rad_s"][:n])
@@ -101,7 +107,22 @@ def agreement(ours: tuple, theirs: dict, label: str) -> dict:
         raise SystemExit(f"{label}: speed traces differ by {dv.max():.3e} m/s at {t_a[int(dv.argmax())]:.2f} s")
     return {"events": len(ev_ours), "dt_events": dt_events, "stop_ours": stop_ours, "stop_theirs": stop_theirs,
             "dv": dv.max(), "dv_at": t_a[int(dv.argmax())], "dwp": dwp.max(), "dwt": dwt.max(), "da": da.max(),
-            "mode_diff": mode_diff, "samples": n}
+            "mode_diff": mode_diff, "samples": n, "kinds": sorted(set(kinds_ours)),
+            "v_end": (cols["vehicle_speed_m_s"][-1], theirs["vehicle_speed_m_s"][-1])}
+
+
+def print_agreement(agree: dict) -> None:
+    for m, a in agree.items():
+        line = f"  {m:<6} {a['events']} events, same kinds, order and gears; max event-time difference {a['dt_events']:.2e} s"
+        if a["stop_ours"] is not None:
+            line += (f"; 100 km/h at {a['stop_ours']:.5f} s (tcsim) vs {a['stop_theirs']:.5f} s (SciPy), "
+                     f"difference {abs(a['stop_ours'] - a['stop_theirs']):.2e} s")
+        else:
+            line += f"; final speed {a['v_end'][0]:.3g} m/s (tcsim) vs {a['v_end'][1]:.3g} m/s (SciPy)"
+        print(line)
+        print(f"         over {a['samples']} common samples: max |Δv| {a['dv']:.2e} m/s (at {a['dv_at']:.2f} s), "
+              f"|Δω_p| {a['dwp']:.2e} rad/s, |Δω_t| {a['dwt']:.2e} rad/s, |Δa| {a['da']:.2e} m/s², "
+              f"{a['mode_diff']} samples with another gear or lock-up state")
 
 
 def bundled_timing():
@@ -120,14 +141,20 @@ def bundled_timing():
 
 def main() -> None:
     params, scenario = ref.sedan_params(), ref.flip_flop(1.0, 30.0, 100.0 / 3.6)
+    coast = ref.coast_and_brake()
     vehicle = {k: v for k, v in params.items() if k != "converter"}
     specs = [dynamic_model(CONVERTER, m).spec for m in MODELS]
     check_same_table(specs[0], params)
 
+    # agreement first, in both scenarios
     runs = tcsim_runs(specs, vehicle, scenario)
     table = runs[0]
     sp = {m: ref.simulate(params, scenario, method=m) for m in ("LSODA", "Radau")}
-    agree = {m: agreement(table, sp[m], f"tcsim table vs SciPy {m}") for m in sp}
+    agree = {m: agreement(table, sp[m], f"flip-flop: tcsim table vs SciPy {m}", True) for m in sp}
+    coast_runs = tcsim_runs(specs, vehicle, coast)
+    sp_coast = {m: ref.simulate(params, coast, method=m) for m in ("LSODA", "Radau")}
+    agree_coast = {m: agreement(coast_runs[0], sp_coast[m], f"coast and brake: tcsim table vs SciPy {m}", False)
+                   for m in sp_coast}
 
     def timed(fn, repeats):
         med = median_time(fn, repeats)
@@ -137,6 +164,9 @@ def main() -> None:
     (t3_1, f3_1) = timed(lambda: tcsim_runs(specs, vehicle, scenario, threads=1), REPEATS)
     (t1, f1) = timed(lambda: tcsim_runs(specs[:1], vehicle, scenario), REPEATS)
     scipy = {m: timed(lambda m=m: ref.simulate(params, scenario, method=m), SCIPY_REPEATS) for m in sp}
+    (c3, g3) = timed(lambda: tcsim_runs(specs, vehicle, coast), REPEATS)
+    (c1, g1) = timed(lambda: tcsim_runs(specs[:1], vehicle, coast), REPEATS)
+    scipy_coast = {m: timed(lambda m=m: ref.simulate(params, coast, method=m), SCIPY_REPEATS) for m in sp_coast}
     bundled = bundled_timing()
 
     release = table[2][0][0]
@@ -146,16 +176,15 @@ def main() -> None:
         stop, rel = r[2][-1][0], r[2][0][0]
         print(f"  {name:<14} {len(r[2])} events, 100 km/h at {stop:.4f} s / {stop - rel:.4f} s, "
               f"{len(r[1]['time_s'])} samples")
-    print("\nAgreement, tcsim table model vs SciPy (same vehicle, scenario and table):")
-    for m, a in agree.items():
-        print(f"  {m:<6} {a['events']} events, same kinds and order; max event-time difference {a['dt_events']:.2e} s; "
-              f"100 km/h at {a['stop_ours']:.5f} s (tcsim) vs {a['stop_theirs']:.5f} s (SciPy), "
-              f"difference {abs(a['stop_ours'] - a['stop_theirs']):.2e} s")
-        print(f"         over {a['samples']} common samples: max |Δv| {a['dv']:.2e} m/s (at {a['dv_at']:.2f} s), "
-              f"|Δω_p| {a['dwp']:.2e} rad/s, |Δω_t| {a['dwt']:.2e} rad/s, |Δa| {a['da']:.2e} m/s², "
-              f"{a['mode_diff']} samples with another gear or lock-up state")
+    print("\nAgreement, tcsim table model vs SciPy (same vehicle, scenario and table), flip-flop to 100 km/h:")
+    print_agreement(agree)
     print(f"  (brake release at {release:.5f} s)")
+    print("\nAgreement, coast and brake to a stop (pedal 1 over 5.05–8.0 s, brake 0.6 from 20–20.5 s on, 40 s):")
+    print_agreement(agree_coast)
+    print(f"  event kinds: {', '.join(agree_coast['LSODA']['kinds'])}")
+    print("  tcsim events per model: " + ", ".join(f"{name} {len(r[2])}" for name, r in zip(MODELS, coast_runs)))
     print(f"\nTimings, median (fastest) of {REPEATS} after a warm-up; SciPy of {SCIPY_REPEATS}:")
+    print("  flip-flop to 100 km/h")
     print(f"  tcsim, three models, one launch_runs call, {os.cpu_count()} workers: {t3 * 1e3:8.2f} ms ({f3 * 1e3:.2f})  "
           f"target < {TARGET_MS:.0f} ms: {'met' if t3 * 1e3 < TARGET_MS else 'NOT met'}")
     print(f"  tcsim, three models, one worker:                 {t3_1 * 1e3:8.2f} ms ({f3_1 * 1e3:.2f})  "
@@ -164,6 +193,12 @@ def main() -> None:
     for m, (t, f) in scipy.items():
         print(f"  SciPy solve_ivp {m:<5}, table model alone:       {t * 1e3:8.2f} ms ({f * 1e3:.2f})  "
               f"ratio to tcsim table {t / t1:5.1f}×, to tcsim's three models {t / t3:5.1f}×")
+    print("  coast and brake, 40 s")
+    print(f"  tcsim, three models, one launch_runs call, {os.cpu_count()} workers: {c3 * 1e3:8.2f} ms ({g3 * 1e3:.2f})")
+    print(f"  tcsim, table model alone:                        {c1 * 1e3:8.2f} ms ({g1 * 1e3:.2f})")
+    for m, (t, f) in scipy_coast.items():
+        print(f"  SciPy solve_ivp {m:<5}, table model alone:       {t * 1e3:8.2f} ms ({f * 1e3:.2f})  "
+              f"ratio to tcsim table {t / c1:5.1f}×, to tcsim's three models {t / c3:5.1f}×")
     if bundled is not None:
         name, conv, tb = bundled
         print(f"  tcsim, three models, bundled vehicle {name} ({conv}), flip-flop: {tb * 1e3:.2f} ms")

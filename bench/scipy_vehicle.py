@@ -20,13 +20,25 @@ here  core index              unit        mass-matrix entry
 8, 9  10, 11  T_fast, T_boost N·m         1
 ====  ======================  ==========  =========================================
 
-A *mode* (gear, shift, lock-up state, wheels held) links or holds coordinates: a gear in mesh
-links ω_t = i_k ω_o, a locked lock-up clutch ω_p = ω_t, held wheels hold ω_f = ω_r = 0. The free
+A *mode* (:class:`State`: gear, shift and its phase, lock-up state and its phase, wheels held, and
+the sign of the slip to synchronise) links or holds coordinates: a gear in mesh links
+ω_t = i_k ω_o, a locked lock-up clutch ω_p = ω_t, held wheels hold ω_f = ω_r = 0. The free
 coordinates are ``x`` with ``u = P x``; each mode integrates ``(PᵀMP) ẋ = PᵀF(Px, t)`` with
 ``solve_ivp`` (LSODA or Radau, finite-difference Jacobian) and terminal events (the root functions
 of the core, any sign change), then restarts in the next mode from the momentum-conserving
-projection ``(PᵀMP) x = PᵀM u``. Runs also restart (same mode) at the breakpoints of the pedal
-signals, where the forcing has a kink (a documented choice; the core steps over them).
+projection ``(PᵀMP) x = PᵀM u``. Before a mode is integrated, a switch whose condition already
+holds fires at once (:meth:`Mode.due`: stop speed, a brake that cannot hold, lock-up release, a due
+shift or lock-up engagement). Runs also restart (same mode, no such check) at the breakpoints of
+the pedal signals, where the forcing has a kink (a documented choice; the core steps over them).
+
+Phases, as in the core: a shift hands the torque over during ``shift_handover_s`` (a time root);
+if the on-coming slip is then within 0.5 rad/s the shift is over ("shift-end"), else it ends when
+that slip, signed at the handover, falls below 0.5 rad/s. The lock-up clutch ramps its capacity in
+over ``engage_time_s`` (a time root): it locks at once within 0.5 rad/s ("lockup-lock"), else it is
+armed with the sign of the slip ("lockup-applied") and locks when the slip closes. A locked clutch
+that breaks away ("lockup-slip") slips at full capacity for 0.1 s, then locks at once within
+0.5 rad/s or is armed with the sign of the slip ("lockup-slipping"). It opens ("lockup-release") below 0.7 × its engage speed and on
+a downshift. Braked axles that have (nearly) stopped are held again ("brake-hold").
 
 Run: ``python3 bench/scipy_vehicle.py`` (needs only NumPy and SciPy; prints the events).
 """
@@ -36,6 +48,7 @@ from __future__ import annotations
 import bisect
 import math
 import tomllib
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -47,7 +60,10 @@ G = 9.81
 # Regularisation scales of vehicle.rs
 CLUTCH_SLIP_RAD_S = 0.2  # tanh(slip/0.2) of the lock-up and shift clutches
 SYNC_SLIP_RAD_S = 0.5  # a synchronising clutch locks below this slip
-BRAKE_SPEED_RAD_S = 0.5  # tanh(ω/0.5) of the brake on a moving axle
+BRAKE_SPEED_RAD_S = 0.002  # tanh(ω/0.002) of the brake on a moving axle
+REARM_DELAY_S = 0.1  # after a breakaway the lock-up clutch slips this long before it may lock again
+LOCKUP_RELEASE_FRACTION = 0.7  # the lock-up clutch opens below 0.7 × its engage speed
+HOLD_SPEED_RAD_S = 0.005  # braked axles are held again below this axle and wheel-rim speed
 ROLL_SPEED_M_S = 0.01  # tanh(v/0.01) of the rolling resistance
 SLIP_SPEED_M_S = 0.5  # v₀ of the tyre slip κ = (rω − v)/√(v² + v₀²)
 
@@ -133,6 +149,15 @@ def flip_flop(pedal: float = 1.0, end_time_s: float = 30.0, stop_speed_m_s: floa
             "end_time_s": end_time_s, "stop_speed_m_s": stop_speed_m_s}
 
 
+def coast_and_brake(end_time_s: float = 40.0) -> dict:
+    """``coasting_slows_down_and_the_brake_stops_and_holds_the_vehicle`` of the core's tests: braked
+    at idle for 5 s, full pedal from 5.05 s (brake off over 5.00–5.05 s), pedal off over 8.00–8.05 s,
+    coasting, then the brake ramped to 0.6 over 20–20.5 s and held; no stop speed."""
+    t = [0.0, 5.0, 5.05, 8.0, 8.05, 20.0, 20.5, end_time_s]
+    return {"time_s": t, "accelerator_pedal": [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+            "brake_pedal": [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.6, 0.6], "end_time_s": end_time_s, "stop_speed_m_s": None}
+
+
 def _lerp_held(xs, ys, x):
     """Linear interpolation, end values held (``Curve::at``, ``Signal::value``, ``lookup``)."""
     n = len(xs)
@@ -182,6 +207,10 @@ class Vehicle:
     def brake(self, t):
         return _lerp_held(self.sc_t, self.sc_brake, t)
 
+    def brake_torque(self, t):
+        """b(t)·capacity, both axles together."""
+        return min(max(self.brake(t), 0.0), 1.0) * self.C_brake
+
     # converter: table model
     def table_torques(self, wp, wt):
         """(T_p,tr, T_t,tr) = (CF ω_p|ω_p|, TR·CF ω_p|ω_p|), SR = ω_t/ω_p (0 when ω_p = 0)."""
@@ -210,12 +239,45 @@ class Vehicle:
         return self.lu_v0 + min(max(p, 0.0), 1.0) * (self.lu_v1 - self.lu_v0)
 
 
-class Mode:
-    """One smooth mode: masses, generalised coordinates, forces and root functions."""
+@dataclass(frozen=True)
+class State:
+    """What a mode is: ``VehicleMode`` of the core plus the sync sign that ``simulate_launch`` carries."""
 
-    def __init__(self, veh: Vehicle, gear: int, shift, lockup: int, lockup_since: float, wheels_held: bool, sync: float):
-        self.veh, self.gear, self.shift, self.lockup = veh, gear, shift, lockup
-        self.lockup_since, self.wheels_held, self.sync = lockup_since, wheels_held, sync
+    gear: int = 0  # gear in mesh (0-based); during a shift, the off-going gear
+    shift: tuple | None = None  # (from, to, since_s, handed_over) while shifting
+    lockup: int = OPEN  # OPEN, ENGAGING or LOCKED
+    lockup_since: float = 0.0  # ENGAGING: start of the capacity ramp
+    ramped: bool = False  # ENGAGING: the ramp is over (full capacity)
+    armed: bool = False  # ENGAGING: locks when the slip closes (after a breakaway: once it has slipped)
+    wheels_held: bool = False
+    sync: float = 1.0  # sign of the slip to synchronise (on-coming shift clutch, armed lock-up clutch)
+
+
+#: Event name of each root (``event_name`` of the core). Two depend on the outcome (``switch``): a
+#: handover that completes the shift is a "shift-end", a ramp end that locks is a "lockup-lock".
+EVENT_NAME = {
+    "brake-release": "brake-release",
+    "brake-hold": "brake-hold",
+    "upshift": "upshift-start",
+    "downshift": "downshift-start",
+    "shift-handover": "shift-handover",
+    "shift-sync": "shift-end",
+    "lockup-engage": "lockup-engage",
+    "lockup-ramped": "lockup-applied",
+    "lockup-arm": "lockup-slipping",
+    "lockup-lock": "lockup-lock",
+    "lockup-slip": "lockup-slip",
+    "lockup-release": "lockup-release",
+    "stop": "stop-speed",
+}
+
+
+class Mode:
+    """One smooth mode: masses, generalised coordinates, forces, root functions and switches."""
+
+    def __init__(self, veh: Vehicle, st: State):
+        self.veh, self.st = veh, st
+        gear, shift, lockup = st.gear, st.shift, st.lockup
         # mass matrix (diagonal for the table model); per-gear input inertia, the off-going gear
         # during a shift
         i_gear = veh.I_in[shift[0] if shift else gear]
@@ -237,7 +299,7 @@ class Mode:
             rep[WP] = rep[WT]
         else:
             own(WP)
-        if not wheels_held:
+        if not st.wheels_held:
             own(WF)
             own(WR)
         for c in (V, TF, TR_, QF, QB):
@@ -252,24 +314,25 @@ class Mode:
         self.A = np.linalg.solve(self.PtMP, P.T)  # ẋ = A F
         self.Minv_full = P @ self.A  # u̇ = P ẋ = P A F
         # root functions, as Plant::new lists them
-        roots = []
-        if wheels_held:
-            roots.append("brake-release")
+        roots = ["brake-release" if st.wheels_held else "brake-hold"]
         if shift:
-            roots.append("shift-end")
+            roots.append("shift-sync" if shift[3] else "shift-handover")
         else:
             if gear + 1 < len(veh.ratios):
-                roots.append("upshift-start")
+                roots.append("upshift")
             if gear > 0:
-                roots.append("downshift-start")
-        if lockup == OPEN and gear + 1 >= veh.lu_min_gear and not shift:
-            roots.append("lockup-engage")
+                roots.append("downshift")
+        if lockup == OPEN:
+            if gear + 1 >= veh.lu_min_gear and not shift:
+                roots.append("lockup-engage")
         elif lockup == ENGAGING:
-            roots.append("lockup-lock")
-        elif lockup == LOCKED:
+            roots.append("lockup-ramped" if not st.ramped else "lockup-arm" if not st.armed else "lockup-lock")
+        else:
             roots.append("lockup-slip")
+        if lockup != OPEN:
+            roots.append("lockup-release")
         if veh.stop_speed is not None:
-            roots.append("stop-speed")
+            roots.append("stop")
         self.roots = roots
         self._cache_key = None
 
@@ -283,12 +346,12 @@ class Mode:
 
     # ---- forces
     def lockup_capacity(self, t):
-        if self.lockup == ENGAGING:
-            return self.veh.C_lu * min(max((t - self.lockup_since) / self.veh.t_engage, 0.0), 1.0)
+        if self.st.lockup == ENGAGING:
+            return self.veh.C_lu * min(max((t - self.st.lockup_since) / self.veh.t_engage, 0.0), 1.0)
         return 0.0
 
     def forces(self, u, t):
-        veh = self.veh
+        veh, st = self.veh, self.st
         wp, wt, wo, wf, wr, v, thf, thr, tq_f, tq_b = (float(a) for a in u)
         f = [0.0] * N
         # converter (table model)
@@ -309,12 +372,12 @@ class Mode:
         f[WP] -= t_lu
         f[WT] += t_lu
         # gearbox
-        if self.shift is None:
-            k = self.gear
-            t_in = indicated - drag if self.lockup == LOCKED else tt + t_lu
+        if st.shift is None:
+            k = st.gear
+            t_in = indicated - drag if st.lockup == LOCKED else tt + t_lu
             f[WT] -= (1.0 - veh.eff[k]) * max(t_in, 0.0) * math.tanh(wt / 1.0)
         else:
-            frm, to, since = self.shift
+            frm, to, since, _ = st.shift
             w = min(max((t - since) / veh.t_handover, 0.0), 1.0)
             c_off, c_on = veh.C_shift * (1.0 - w), veh.C_shift * w
             t_off = c_off * math.tanh((wt - veh.ratios[frm] * wo) / CLUTCH_SLIP_RAD_S)
@@ -330,14 +393,14 @@ class Mode:
             f[axle] += veh.i_fd * torque
         # tyres, brake, body
         weight = veh.m * G * veh.cos_g
-        brake = min(max(veh.brake(t), 0.0), 1.0) * veh.C_brake
+        brake = veh.brake_torque(t)
         root = math.sqrt(v * v + SLIP_SPEED_M_S * SLIP_SPEED_M_S)
         for axle, load, share in ((WF, veh.front_load, veh.brake_front), (WR, 1.0 - veh.front_load, 1.0 - veh.brake_front)):
             kappa = (veh.r_w * u[axle] - v) / root
             force = veh.mu * load * weight * math.tanh(veh.C_slip * kappa / veh.mu)
             f[axle] -= veh.r_w * force
             f[V] += force
-            if not self.wheels_held:
+            if not st.wheels_held:
                 f[axle] -= brake * share * math.tanh(u[axle] / BRAKE_SPEED_RAD_S)
         aero = 0.5 * veh.rho_air * veh.CdA * v * abs(v)
         roll = veh.Crr * weight * math.tanh(v / ROLL_SPEED_M_S)
@@ -359,39 +422,57 @@ class Mode:
         return self._cache
 
     def reactions(self, ud, f):
-        """M u̇ − F: the constraint torque on each coordinate."""
+        """M u̇ − F: the constraint torque on each coordinate (brake holding torque on a held
+        axle, torque through a locked clutch on ω_p)."""
         return self.mdiag * ud - f
 
-    # ---- root functions: zero at the switch (either direction of crossing, as diffsol)
-    def root_value(self, kind, t, x):
+    def shaft_torques(self, u, f):
         veh = self.veh
+        return [veh.k[i] * u[tw] + veh.c[i] * f[tw] for tw, i in ((TF, 0), (TR_, 1))]
+
+    def brake_margin(self, ud, f, t):
+        """Brake capacity left on the weaker held axle (negative: the brake cannot hold)."""
+        r = self.reactions(ud, f)
+        cap, s = self.veh.brake_torque(t), self.veh.brake_front
+        return min(cap * s - abs(r[WF]), cap * (1.0 - s) - abs(r[WR]))
+
+    # ---- root functions: positive while the mode holds, a switch at any sign change (as diffsol)
+    def root_value(self, kind, t, x):
+        veh, st = self.veh, self.st
         u, ud, f = self.kinematics(t, x)
         p = veh.pedal(t)
         if kind == "brake-release":
-            r = self.reactions(ud, f)
-            cap = min(max(veh.brake(t), 0.0), 1.0) * veh.C_brake
-            s = veh.brake_front
-            return min(cap * s - abs(r[WF]), cap * (1.0 - s) - abs(r[WR])) + 1e-9
-        if kind == "upshift-start":
-            return veh.upshift_speed(self.gear, p) - u[V]
-        if kind == "downshift-start":
-            return u[V] - veh.downshift_speed(self.gear, p)
-        if kind == "shift-end":
-            frm, to, since = self.shift
-            s = u[WT] - veh.ratios[to] * u[WO]
-            if t - since >= veh.t_handover:
-                return self.sync * s - SYNC_SLIP_RAD_S
-            return 1.0 + abs(self.sync * s)
+            return self.brake_margin(ud, f, t) + 1e-9
+        if kind == "brake-hold":
+            # axles and wheel rim (nearly) stopped, and the brake holds the shafts with 20 % margin
+            rim = u[V] / veh.r_w
+            spin = math.sqrt(u[WF] ** 2 + u[WR] ** 2 + rim * rim) - HOLD_SPEED_RAD_S
+            cap, s = veh.brake_torque(t), veh.brake_front
+            shaft = self.shaft_torques(u, f)
+            short = max(veh.i_fd * abs(shaft[0]) - 0.8 * cap * s, veh.i_fd * abs(shaft[1]) - 0.8 * cap * (1.0 - s))
+            return max(spin, short)
+        if kind == "upshift":
+            return veh.upshift_speed(st.gear, p) - u[V]
+        if kind == "downshift":
+            return u[V] - veh.downshift_speed(st.gear, p)
+        if kind == "shift-handover":
+            return st.shift[2] + veh.t_handover - t
+        if kind == "shift-sync":
+            return st.sync * (u[WT] - veh.ratios[st.shift[1]] * u[WO]) - SYNC_SLIP_RAD_S
         if kind == "lockup-engage":
-            return u[V] - veh.engage_speed(p)
+            return veh.engage_speed(p) - u[V]
+        if kind == "lockup-ramped":
+            return st.lockup_since + veh.t_engage - t
+        if kind == "lockup-arm":
+            return st.lockup_since + veh.t_engage + REARM_DELAY_S - t
         if kind == "lockup-lock":
-            if t - self.lockup_since >= veh.t_engage:
-                return self.sync * (u[WP] - u[WT]) - SYNC_SLIP_RAD_S
-            return 1.0 + abs(u[WP] - u[WT])
+            return st.sync * (u[WP] - u[WT]) - SYNC_SLIP_RAD_S
         if kind == "lockup-slip":
             r = self.reactions(ud, f)
             return veh.lu_static * veh.C_lu - abs(r[WP])
-        if kind == "stop-speed":
+        if kind == "lockup-release":
+            return u[V] - LOCKUP_RELEASE_FRACTION * veh.engage_speed(p)
+        if kind == "stop":
             return veh.stop_speed - u[V]
         raise ValueError(kind)
 
@@ -415,29 +496,73 @@ class Mode:
                 a[col[0]] = per.get(c, a[col[0]])
         return a * scale
 
+    # ---- switches
+    def due(self, t, x):
+        """A switch whose condition already holds as the mode starts (``due`` of the core; root
+        functions only see crossings), or None."""
+        veh, st = self.veh, self.st
+        u, ud, f = self.kinematics(t, x)
+        p = veh.pedal(t)
+        if veh.stop_speed is not None and u[V] >= veh.stop_speed:
+            return "stop"
+        if st.wheels_held and self.brake_margin(ud, f, t) < 0.0:
+            return "brake-release"
+        if st.lockup != OPEN and (st.gear + 1 < veh.lu_min_gear or u[V] < LOCKUP_RELEASE_FRACTION * veh.engage_speed(p)):
+            return "lockup-release"
+        if st.shift is None and not st.wheels_held:
+            if st.gear + 1 < len(veh.ratios) and u[V] > veh.upshift_speed(st.gear, p):
+                return "upshift"
+            if st.gear > 0 and u[V] < veh.downshift_speed(st.gear, p):
+                return "downshift"
+            if st.lockup == OPEN and st.gear + 1 >= veh.lu_min_gear and u[V] > veh.engage_speed(p):
+                return "lockup-engage"
+        return None
+
     def switch(self, kind, u, t):
-        """The next mode after root ``kind`` at (t, u): (gear, shift, lockup, since, held, sync)."""
-        veh = self.veh
-        gear, shift, lockup, since, held, sync = self.gear, self.shift, self.lockup, self.lockup_since, self.wheels_held, self.sync
+        """The next state after root ``kind`` at (t, u), and the event's name."""
+        veh, st = self.veh, self.st
+        name = EVENT_NAME[kind]
+        ramped_since = t - veh.t_engage  # an engaging clutch at full capacity
         if kind == "brake-release":
-            held = False
-        elif kind in ("upshift-start", "downshift-start"):
-            to = gear + 1 if kind == "upshift-start" else gear - 1
-            shift = (gear, to, t)
-            sync = 1.0 if u[WT] - veh.ratios[to] * u[WO] >= 0.0 else -1.0
-            if lockup != LOCKED:
-                lockup = OPEN
-        elif kind == "shift-end":
-            gear, shift = shift[1], None
-        elif kind == "lockup-engage":
-            lockup, since = ENGAGING, t
-            sync = 1.0 if u[WP] >= u[WT] else -1.0
-        elif kind == "lockup-lock":
-            lockup = LOCKED
-        elif kind == "lockup-slip":
-            lockup, since = ENGAGING, t - veh.t_engage
-            sync = 1.0 if u[WP] >= u[WT] else -1.0
-        return gear, shift, lockup, since, held, sync
+            return replace(st, wheels_held=False), name
+        if kind == "brake-hold":
+            return replace(st, wheels_held=True), name
+        if kind in ("upshift", "downshift"):
+            to = st.gear + 1 if kind == "upshift" else st.gear - 1
+            new = replace(st, shift=(st.gear, to, t, False))
+            # an engaging clutch restarts after an upshift; a downshift opens it
+            if st.lockup != LOCKED or kind == "downshift":
+                new = replace(new, lockup=OPEN)
+            return new, name
+        if kind == "shift-handover":
+            slip = u[WT] - veh.ratios[st.shift[1]] * u[WO]
+            if abs(slip) <= SYNC_SLIP_RAD_S:  # the on-coming clutch holds already: the shift is over
+                return replace(st, gear=st.shift[1], shift=None), "shift-end"
+            return replace(st, shift=st.shift[:3] + (True,), sync=math.copysign(1.0, slip)), name
+        if kind == "shift-sync":
+            return replace(st, gear=st.shift[1], shift=None), name
+        if kind == "lockup-engage":
+            return replace(st, lockup=ENGAGING, lockup_since=t, ramped=False, armed=False), name
+        if kind == "lockup-ramped":
+            slip = u[WP] - u[WT]
+            if abs(slip) <= SYNC_SLIP_RAD_S:
+                return replace(st, lockup=LOCKED), "lockup-lock"
+            return replace(st, lockup=ENGAGING, lockup_since=ramped_since, ramped=True, armed=True,
+                           sync=math.copysign(1.0, slip)), name
+        if kind == "lockup-arm":
+            slip = u[WP] - u[WT]
+            if abs(slip) <= SYNC_SLIP_RAD_S:
+                return replace(st, lockup=LOCKED), "lockup-lock"
+            return replace(st, lockup=ENGAGING, lockup_since=ramped_since, ramped=True, armed=True,
+                           sync=math.copysign(1.0, slip)), name
+        if kind == "lockup-lock":
+            return replace(st, lockup=LOCKED), name
+        if kind == "lockup-release":
+            return replace(st, lockup=OPEN), name
+        if kind == "lockup-slip":
+            # it slips for REARM_DELAY_S at full capacity before it may lock again
+            return replace(st, lockup=ENGAGING, lockup_since=ramped_since, ramped=True, armed=False), name
+        raise ValueError(kind)
 
 
 def initial_state(veh: Vehicle) -> np.ndarray:
@@ -486,7 +611,7 @@ def simulate(params: dict, scenario: dict, method: str = "LSODA", rtol: float = 
     times = np.minimum(np.arange(n_out) * output_step_s, end)
     breaks = sorted({b for b in veh.sc_t if 0.0 < b < end} | {end})
     u = initial_state(veh)
-    state = (0, None, OPEN, 0.0, veh.brake(0.0) > 0.0, 1.0)
+    state = State(wheels_held=veh.brake(0.0) > 0.0)
     t = 0.0
     rows, events = [], []
     nfev = segments = 0
@@ -494,21 +619,21 @@ def simulate(params: dict, scenario: dict, method: str = "LSODA", rtol: float = 
 
     def record(mode, tt, xx):
         uu, ud, _ = mode.kinematics(tt, np.ascontiguousarray(xx))
-        rows.append((tt, uu[V], ud[V], uu[WP], uu[WT], uu[WO], uu[WF], uu[WR], mode.gear + 1,
-                     {OPEN: 0, ENGAGING: 1, LOCKED: 2}[mode.lockup]))
+        rows.append((tt, uu[V], ud[V], uu[WP], uu[WT], uu[WO], uu[WF], uu[WR], mode.st.gear + 1,
+                     {OPEN: 0, ENGAGING: 1, LOCKED: 2}[mode.st.lockup]))
 
     while True:
-        mode = Mode(veh, *state)
+        mode = Mode(veh, state)
         x = mode.state_of(u)
-        atol = mode.atol(atol_scale)
-        evs = mode.events()
-        while True:  # one mode, split at the input breakpoints
+        kind = mode.due(t, x)  # a switch already due fires before any integration
+        t_root, x_root = t, x
+        while kind is None:  # one mode, split at the input breakpoints
             t_stop = next(b for b in breaks if b > t)
             j = bisect.bisect_right(times, t_stop, lo=i_out)
             # the samples of the span, and its end (for the state there) unless it is a sample
             t_eval = times[i_out:j] if j > i_out and times[j - 1] == t_stop else np.append(times[i_out:j], t_stop)
-            sol = solve_ivp(mode.rhs, (t, t_stop), x, method=method, rtol=rtol, atol=atol, events=evs,
-                            t_eval=t_eval, first_step=min(1e-5, t_stop - t))
+            sol = solve_ivp(mode.rhs, (t, t_stop), x, method=method, rtol=rtol, atol=mode.atol(atol_scale),
+                            events=mode.events(), t_eval=t_eval, first_step=min(1e-5, t_stop - t))
             segments += 1
             nfev += sol.nfev
             if sol.status < 0:
@@ -528,12 +653,12 @@ def simulate(params: dict, scenario: dict, method: str = "LSODA", rtol: float = 
             if t >= end:
                 return _result(rows, events, nfev, segments)
         u_root = mode.full(x_root)
-        if kind == "stop-speed":
-            events.append((t_root, kind, mode.gear + 1))
+        if kind == "stop":
+            events.append((t_root, EVENT_NAME[kind], mode.st.gear + 1))
             record(mode, t_root, x_root)
             return _result(rows, events, nfev, segments)
-        state = mode.switch(kind, u_root, t_root)
-        events.append((t_root, kind, state[0] + 1))
+        state, name = mode.switch(kind, u_root, t_root)
+        events.append((t_root, name, state.gear + 1))
         if len(events) > MAX_EVENTS:
             raise RuntimeError(f"more than {MAX_EVENTS} events: events chatter")
         t, u = t_root, u_root
@@ -553,15 +678,16 @@ def _result(rows, events, nfev, segments) -> dict:
 def main():
     import time
 
-    params, sc = sedan_params(), flip_flop(1.0, 30.0, 100.0 / 3.6)
-    for method in ("LSODA", "Radau"):
-        t0 = time.perf_counter()
-        r = simulate(params, sc, method=method)
-        dt = time.perf_counter() - t0
-        print(f"{method}: {dt * 1e3:.0f} ms, {r['nfev']} RHS calls, {r['segments']} segments, "
-              f"{len(r['time_s'])} samples, final speed {r['vehicle_speed_m_s'][-1]:.6f} m/s")
-        for e in r["events"]:
-            print(f"  {e[0]:10.6f} s  {e[1]:<16} gear {e[2]}")
+    params = sedan_params()
+    for label, sc in (("flip-flop to 100 km/h", flip_flop(1.0, 30.0, 100.0 / 3.6)), ("coast and brake", coast_and_brake())):
+        for method in ("LSODA", "Radau"):
+            t0 = time.perf_counter()
+            r = simulate(params, sc, method=method)
+            dt = time.perf_counter() - t0
+            print(f"{label}, {method}: {dt * 1e3:.0f} ms, {r['nfev']} RHS calls, {r['segments']} segments, "
+                  f"{len(r['time_s'])} samples, final speed {r['vehicle_speed_m_s'][-1]:.6g} m/s")
+            for e in r["events"]:
+                print(f"  {e[0]:10.6f} s  {e[1]:<16} gear {e[2]}")
 
 
 if __name__ == "__main__":

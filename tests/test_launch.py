@@ -548,3 +548,22 @@ def test_part_pedal_launch_is_gentler(flip_flop_runs):
     assert part.vehicle_speed_m_s[part.time_s < 5.0].abs().max() == 0.0
     window = lambda f: f[(f.time_s > 5.0) & (f.time_s <= 6.0)].vehicle_accel_m_s2.mean()
     assert 0.0 < window(part) < window(full)
+
+
+@needs_core
+def test_logged_engine_torque_is_replayed(tmp_path, cli, flip_flop_runs):
+    """Thesis §3.5.2.2: the engine model replaced by a logged engine torque. Replaying the engine
+    torque of the table model's own run reproduces its launch."""
+    f = flip_flop_runs["table"]
+    sc = L.flip_flop()
+    path = tmp_path / "logged.csv"
+    pedal, brake = sc.pedals_at(f.time_s)
+    pd.DataFrame({"time_s": f.time_s, "accelerator_pedal": pedal, "brake_pedal": brake,
+                  "engine_torque_nm": f.engine_torque_nm}).to_csv(path, index=False)
+    out = tmp_path / "out"
+    r = cli("launch", "--out", out, "--scenario", path, "--model", "table")
+    assert r.code == 0, r.stderr
+    g = pd.read_csv(out / "table.csv")
+    assert g.engine_torque_nm.to_numpy() == pytest.approx(np.interp(g.time_s, f.time_s, f.engine_torque_nm), abs=1e-9)
+    v = np.interp(f.time_s, g.time_s, g.vehicle_speed_m_s)
+    assert np.max(np.abs(v - f.vehicle_speed_m_s)) < 0.05

@@ -115,6 +115,9 @@ class Scenario:
     stop_speed_m_s: float | None = None
     brake_release_time_s: float = 0.0
     source: str = ""
+    #: A logged engine (crank) torque replayed instead of the engine model (thesis §3.5.2.2), N·m,
+    #: one value per time stamp; the pedal then drives only the shift and lock-up schedules.
+    engine_torque_nm: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         src = self.source or f"scenario {self.name}"
@@ -156,6 +159,14 @@ class Scenario:
         object.__setattr__(self, "brake_release_time_s", float(self.brake_release_time_s))
         if self.stop_speed_m_s is not None:
             object.__setattr__(self, "stop_speed_m_s", float(self.stop_speed_m_s))
+        if self.engine_torque_nm is not None:
+            e = np.array(self.engine_torque_nm, dtype=float, ndmin=1)
+            if e.shape != t.shape:
+                raise InputError(src, "engine_torque_nm", f"{e.size} values", f"one per time_s ({len(t)})")
+            bad = np.flatnonzero(~np.isfinite(e) | (np.abs(e) > 20_000))
+            if bad.size:
+                raise InputError(src, f"engine_torque_nm[{bad[0]}]", float(e[bad[0]]), "a finite crank torque in N·m")
+            object.__setattr__(self, "engine_torque_nm", e)
 
     def pedals_at(self, time_s) -> tuple[np.ndarray, np.ndarray]:
         """Accelerator and brake pedal at ``time_s`` (linear interpolation, end values held)."""
@@ -164,9 +175,12 @@ class Scenario:
 
     def core_spec(self) -> dict[str, Any]:
         """The dict the core takes."""
-        return {"time_s": self.time_s.tolist(), "accelerator_pedal": self.accelerator_pedal.tolist(),
+        spec = {"time_s": self.time_s.tolist(), "accelerator_pedal": self.accelerator_pedal.tolist(),
                 "brake_pedal": self.brake_pedal.tolist(), "end_time_s": self.end_time_s,
                 "stop_speed_m_s": self.stop_speed_m_s}
+        if self.engine_torque_nm is not None:
+            spec["engine_torque_nm"] = self.engine_torque_nm.tolist()
+        return spec
 
     def frame(self) -> pd.DataFrame:
         return pd.DataFrame({"time_s": self.time_s, "accelerator_pedal": self.accelerator_pedal,
@@ -260,13 +274,16 @@ class _ScenarioPicker:
         self._one("time_s", _TIME_COLUMNS, names)
         for pedal in _PEDALS:
             self._one(pedal, _pedal_columns(pedal), names)
+        if "engine_torque_nm" in names:  # optional: a logged engine torque to replay
+            self.picks["engine_torque_nm"] = ("engine_torque_nm", 1.0)
         return list(dict.fromkeys(c for c, _ in self.picks.values()))
 
 
 def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float | None = None) -> Scenario:
     """A user scenario from a CSV, Parquet, ``.mat`` or MDF4 file (the formats of
     :func:`tcsim.measurement.read_measurement`): ``time_s`` (or ``time_ms``), ``accelerator_pedal``
-    and ``brake_pedal`` from 0 to 1 (or ``*_percent`` from 0 to 100; MDF4 ``%`` units are read).
+    and ``brake_pedal`` from 0 to 1 (or ``*_percent`` from 0 to 100; MDF4 ``%`` units are read),
+    and optionally ``engine_torque_nm``, a logged crank torque replayed instead of the engine model.
 
     Time strictly increasing, no NaN, pedals within range; each problem an InputError naming the
     file, the column, the row and the value. Runs to ``end_time_s`` (default the last time stamp)
@@ -289,7 +306,7 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
         raise InputError(str(path), time_column, f"{n} rows", "at least 2 data rows")
     out: dict[str, np.ndarray] = {}
     time_s = None
-    for canonical in ("time_s", *_PEDALS):
+    for canonical in ("time_s", *_PEDALS, *(["engine_torque_nm"] if "engine_torque_nm" in picker.picks else [])):
         column, factor = picker.picks[canonical]
         values = np.asarray(raw[column])
         if len(values) != n:
@@ -300,6 +317,9 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
             meas._increasing(path, column, values)
         unit_factor = _unit_scale(path, column, units.get(column, ""), canonical == "time_s")
         scale = unit_factor if unit_factor is not None else factor
+        if canonical == "engine_torque_nm":
+            out[canonical] = values
+            continue
         if canonical != "time_s":
             limit = 1.0 / scale
             bad = np.flatnonzero((values < 0) | (values > limit * (1 + 1e-12)))
@@ -315,7 +335,7 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
     end = float(t[-1]) if end_time_s is None else end_time_s
     release = brake_release_time(t, out["brake_pedal"])
     return Scenario(path.stem, t, out["accelerator_pedal"], out["brake_pedal"], end, stop_speed_m_s,
-                    min(release, end), str(path))
+                    min(release, end), str(path), out.get("engine_torque_nm"))
 
 
 def scenario_from_option(value: str) -> Scenario:

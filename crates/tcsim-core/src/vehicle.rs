@@ -337,6 +337,28 @@ pub struct Scenario {
     pub brake_pedal: Signal,
     pub end_time_s: f64,
     pub stop_speed_m_s: Option<f64>,
+    /// A logged engine (crank) torque replayed instead of the engine model, as the thesis did in
+    /// its complete-vehicle simulation (§3.5.2.2). The pedal then only drives the shift and lock-up
+    /// schedules.
+    pub engine_torque_nm: Option<Signal>,
+}
+
+impl Scenario {
+    /// Net crank torque, the engine's (indicated) power and its drag loss at `u`, `t`.
+    fn engine(&self, e: &Engine, u: &[f64; N], t: f64) -> (f64, f64, f64) {
+        let w = u[PUMP];
+        match &self.engine_torque_nm {
+            Some(log) => {
+                let torque = log.value(t);
+                (torque, torque * w, 0.0)
+            }
+            None => {
+                let drag = e.drag(w);
+                let indicated = u[TORQUE_FAST] + u[TORQUE_BOOST];
+                (indicated - drag, indicated * w, drag * w)
+            }
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -346,8 +368,8 @@ pub struct Scenario {
 pub enum LockupState {
     Open,
     /// Capacity ramping in since `since_s` (full once `ramped`), slipping. An `armed` clutch locks
-    /// when the slip falls below the sync threshold; one that broke away from locked is armed once
-    /// its slip has grown past twice that.
+    /// when the slip falls below the sync threshold; one that broke away from locked is armed after
+    /// slipping for `REARM_DELAY_S`.
     Engaging { since_s: f64, ramped: bool, armed: bool },
     Locked,
 }
@@ -407,7 +429,9 @@ const CLUTCH_SLIP_RAD_S: f64 = 0.2;
 /// carrying 96 % of its capacity slips by 2·CLUTCH_SLIP_RAD_S, so a smaller slip means it holds.
 const SYNC_SLIP_RAD_S: f64 = 0.5;
 /// Scale of the regularised brake and drag signs, rad/s and m/s.
-const BRAKE_SPEED_RAD_S: f64 = 0.01;
+const BRAKE_SPEED_RAD_S: f64 = 0.002;
+/// After a breakaway the lock-up clutch slips at least this long before it may lock again, s.
+const REARM_DELAY_S: f64 = 0.1;
 /// The lock-up clutch opens below this fraction of its engage speed (hysteresis), and on a
 /// downshift.
 const LOCKUP_RELEASE_FRACTION: f64 = 0.7;
@@ -593,10 +617,9 @@ impl<'a> Plant<'a> {
         // engine
         let wp = u[PUMP];
         let p = self.sc.accelerator_pedal.value(t);
-        let drag = v.engine.drag(wp);
-        let indicated = u[TORQUE_FAST] + u[TORQUE_BOOST];
-        f[PUMP] += indicated - drag;
-        loss += drag * wp;
+        let (net, engine_power, drag_loss) = self.sc.engine(&v.engine, u, t);
+        f[PUMP] += net;
+        loss += drag_loss;
         let (fast, boost) = v.engine.targets(p, wp);
         f[TORQUE_FAST] = (fast - u[TORQUE_FAST]) / v.engine.fast_time_constant_s;
         f[TORQUE_BOOST] = (boost - u[TORQUE_BOOST]) / v.engine.boost_time_constant_s;
@@ -611,7 +634,7 @@ impl<'a> Plant<'a> {
         match self.mode.shift {
             None => {
                 let k = self.mode.gear;
-                let input = if self.mode.lockup == LockupState::Locked { indicated - drag } else { fc[TURBINE] + t_lu };
+                let input = if self.mode.lockup == LockupState::Locked { net } else { fc[TURBINE] + t_lu };
                 let t_loss = (1.0 - gb.efficiencies[k]) * input.max(0.0) * (u[TURBINE] / 1.0).tanh();
                 f[TURBINE] -= t_loss;
                 loss += t_loss * u[TURBINE];
@@ -662,7 +685,7 @@ impl<'a> Plant<'a> {
         let climb = v.body.mass_kg * G * sin_g;
         f[SPEED] -= aero + roll + climb;
         loss += (aero + roll + climb) * vs;
-        (f, Powers { engine_w: indicated * wp, loss_w: loss })
+        (f, Powers { engine_w: engine_power, loss_w: loss })
     }
 
     fn reduced_rhs(&self, f: &[f64; N]) -> Vec<f64> {
@@ -817,7 +840,10 @@ impl SmoothSegment for Plant<'_> {
                     LockupState::Engaging { since_s, .. } => since_s + self.v.lockup.engage_time_s - t,
                     _ => 1.0,
                 },
-                Root::LockupArm => 2.0 * SYNC_SLIP_RAD_S - self.sync_sign * (u[PUMP] - u[TURBINE]),
+                Root::LockupArm => match self.mode.lockup {
+                    LockupState::Engaging { since_s, .. } => since_s + self.v.lockup.engage_time_s + REARM_DELAY_S - t,
+                    _ => 1.0,
+                },
                 Root::LockupLock => self.sync_sign * (u[PUMP] - u[TURBINE]) - SYNC_SLIP_RAD_S,
                 Root::LockupSlip => {
                     // torque through the locked clutch: the engine side's constraint torque
@@ -870,7 +896,7 @@ impl SmoothSegment for Plant<'_> {
             u_dot: ud,
             mode: self.mode,
             converter,
-            engine_torque_nm: u[TORQUE_FAST] + u[TORQUE_BOOST] - self.v.engine.drag(u[PUMP]),
+            engine_torque_nm: self.sc.engine(&self.v.engine, &u, t).0,
             engine_power_w: powers.engine_w,
             loss_power_w: powers.loss_w,
             stored_energy_j: kinetic + spring,
@@ -903,12 +929,22 @@ pub fn initial_state(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario) 
     let p = sc.accelerator_pedal.value(0.0);
     let pump_at = |w: f64| -> CoreResult<f64> { Ok(model.steady_point(w, 0.0)?.pump_torque_nm) };
     let balance = |w: f64| -> CoreResult<f64> {
-        let (fast, boost) = v.engine.targets(p, w);
-        Ok(fast + boost - v.engine.drag(w) - pump_at(w)?)
+        let crank = match &sc.engine_torque_nm {
+            Some(log) => log.value(0.0),
+            None => {
+                let (fast, boost) = v.engine.targets(p, w);
+                fast + boost - v.engine.drag(w)
+            }
+        };
+        Ok(crank - pump_at(w)?)
     };
     let (mut lo, mut hi) = (1.0_f64, v.engine.full_load.x.last().copied().unwrap_or(700.0));
     if balance(lo)? <= 0.0 || balance(hi)? >= 0.0 {
-        return Err(CoreError::new("engine.idle_speed_rad_s", v.engine.idle_speed_rad_s, "an idle governor and full-load curve that can hold the stalled converter (no engine speed balances them)").into());
+        return Err(match &sc.engine_torque_nm {
+            Some(log) => CoreError::new("engine_torque_nm[0]", log.value(0.0), "a positive logged engine torque at the start that the stalled converter can absorb"),
+            None => CoreError::new("engine.idle_speed_rad_s", v.engine.idle_speed_rad_s, "an idle governor and full-load curve that can hold the stalled converter (no engine speed balances them)"),
+        }
+        .into());
     }
     for _ in 0..200 {
         let mid = 0.5 * (lo + hi);
@@ -1011,15 +1047,21 @@ fn switch(plant: &Plant, root: Root, u: &mut [f64; N], t: f64) -> (VehicleMode, 
                 sync = slip.signum();
             }
         }
-        Root::LockupArm => m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: true },
+        Root::LockupArm => {
+            let slip = u[PUMP] - u[TURBINE];
+            if slip.abs() <= SYNC_SLIP_RAD_S {
+                m.lockup = LockupState::Locked;
+            } else {
+                m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: true };
+                sync = slip.signum();
+            }
+        }
         Root::LockupLock => m.lockup = LockupState::Locked,
         Root::LockupRelease => m.lockup = LockupState::Open,
         Root::LockupSlip => {
             // the slip develops in the direction of the torque the clutch could not hold
-            let (_, ud, f, _) = plant.kinematics(&plant.state_of(u), t);
-            let through = -plant.reactions(&ud, &f)[PUMP];
+            // it slips for REARM_DELAY_S at full capacity before it may lock again
             m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: false };
-            sync = if through >= 0.0 { 1.0 } else { -1.0 };
         }
         Root::Stop => {}
     }
@@ -1129,7 +1171,7 @@ pub fn simulate_launch(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario
                 energy_before = Some(kinetic_energy(&plant, &next));
                 let kind = match root {
                     Root::ShiftHandover if new_mode.shift.is_none() => "shift-end",
-                    Root::LockupRamped if new_mode.lockup == LockupState::Locked => "lockup-lock",
+                    Root::LockupRamped | Root::LockupArm if new_mode.lockup == LockupState::Locked => "lockup-lock",
                     _ => event_name(root),
                 };
                 traj.events.push(VehicleEvent { time_s: t_root, kind, gear: new_mode.gear + 1 });

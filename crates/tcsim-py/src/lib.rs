@@ -493,6 +493,10 @@ fn scenario_from(d: &Bound<'_, PyDict>) -> PyResult<Scenario> {
         brake_pedal: signal("brake_pedal")?,
         end_time_s: item(d, "end_time_s")?,
         stop_speed_m_s: opt_item(d, "stop_speed_m_s")?,
+        engine_torque_nm: match opt_item::<Vec<f64>>(d, "engine_torque_nm")? {
+            Some(v) => Some(Signal::new("engine_torque_nm", t.clone(), v, 0.0).map_err(input_error)?),
+            None => None,
+        },
     })
 }
 
