@@ -223,7 +223,10 @@ class Vehicle:
         return self.T0 * math.tanh(w / 1.0) + self.c_drag * w
 
     def targets(self, p, w):
-        full = max(_lerp_held(self.fl_x, self.fl_y, w), 0.0)
+        # rev limiter: full load falls linearly to zero over the 5 % of speed above the curve's end
+        top = self.fl_x[-1]
+        fuel_cut = min(max((1.05 * top - w) / (0.05 * top), 0.0), 1.0)
+        full = max(_lerp_held(self.fl_x, self.fl_y, w), 0.0) * fuel_cut
         governor = self.K_gov * max(self.idle - w, 0.0)
         boost = self.b_frac * p * full
         return min(p * full + governor, full) - boost, boost

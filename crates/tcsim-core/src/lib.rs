@@ -22,6 +22,7 @@ pub mod outputs;
 pub mod scalar;
 pub mod segment;
 pub mod signal;
+pub mod stepper;
 pub mod table;
 pub mod transient;
 pub mod vehicle;

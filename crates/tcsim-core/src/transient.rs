@@ -150,7 +150,7 @@ pub struct InitialState {
 }
 
 /// Discrete state of the piecewise-smooth system.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Mode {
     pub stator_locked: bool,
     /// Sign of Q in the losses: +1, −1, or 0 while the flow is held at zero.
@@ -223,6 +223,9 @@ pub struct Trajectory {
     pub samples: Vec<Sample>,
     pub events: Vec<Event>,
     pub steps: usize,
+    /// State and mode at the end time, after any event there (to continue the run).
+    pub end_state: Vec4,
+    pub end_mode: Mode,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -476,7 +479,7 @@ fn invert(n: usize, a: &Mat4) -> Option<Mat4> {
 
 /// The mode a state starts in: the stator locked if it stands and the clutch would hold; the flow
 /// sign from Q, or from the held-flow balance when Q = 0.
-fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64) -> Mode {
+pub fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64) -> Mode {
     let mut mode = Mode { stator_locked: false, flow_sign: if u[FLOW] > 0.0 { 1.0 } else if u[FLOW] < 0.0 { -1.0 } else { 0.0 } };
     if model.has_flow_sign() && u[FLOW] == 0.0 {
         mode.flow_sign = flow_sign_at_zero(model, drive, u, t, mode.stator_locked || u[STATOR] <= 0.0);
@@ -625,8 +628,16 @@ pub fn simulate_from(model: &dyn ConverterDynamics, drive: &Drive, times_s: &[f6
     let (mut t, mut u, mut mode) = (times_s[0], u0, mode0);
     loop {
         let seg = Segment::new(model, drive, mode);
+        let integrated = t < t_end;
         match run_segment(&seg, &u, t, t_end, times_s, options, &mut traj)? {
-            None => return Ok(traj),
+            None => {
+                traj.end_state = match traj.samples.last() {
+                    Some(s) if integrated => s.u,
+                    _ => u,
+                };
+                traj.end_mode = mode;
+                return Ok(traj);
+            }
             Some((t_root, root, x_root)) => {
                 let mut next = seg.full(&x_root, t_root);
                 let (kind, new_mode) = switch(&seg, root, &mut next, t_root);

@@ -125,13 +125,19 @@ impl Engine {
         non_negative("engine.idle_governor_gain_nm_s_per_rad", self.idle_governor_gain_nm_s_per_rad)?;
         Ok(())
     }
+    /// Rev limiter: the full-load torque falls linearly to zero over the 5 % of speed above the
+    /// full-load curve's last point.
+    pub fn fuel_cut(&self, w: f64) -> f64 {
+        let top = self.full_load.x.last().copied().unwrap_or(f64::INFINITY);
+        ((1.05 * top - w) / (0.05 * top)).clamp(0.0, 1.0)
+    }
     /// Friction and pumping drag, opposing rotation.
     pub fn drag(&self, w: f64) -> f64 {
         self.drag_torque_nm * (w / 1.0).tanh() + self.drag_nm_s_per_rad * w
     }
     /// Targets of the aspirated and boost torque parts for pedal `p` at speed `w`.
     pub fn targets(&self, p: f64, w: f64) -> (f64, f64) {
-        let full = self.full_load.at(w).max(0.0);
+        let full = self.full_load.at(w).max(0.0) * self.fuel_cut(w);
         let governor = self.idle_governor_gain_nm_s_per_rad * (self.idle_speed_rad_s - w).max(0.0);
         let boost = self.boost_fraction * p * full;
         ((p * full + governor).min(full) - boost, boost)

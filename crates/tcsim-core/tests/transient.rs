@@ -262,3 +262,36 @@ fn bad_runs_are_input_errors() {
     assert!(simulate(&ht(SHAPE), &drive, &t, &init, &SolverOptions::default()).is_err());
     assert!(simulate(&ht(SHAPE), &drive, &[0.0, 0.0], &InitialState::default(), &SolverOptions::default()).is_err());
 }
+
+#[test]
+fn a_run_stepped_interval_by_interval_follows_the_single_run() {
+    // the co-simulation engine: inputs piecewise linear on the communication grid
+    use tcsim_core::stepper::{Causality, Stepper};
+    let tp = |t: f64| if t < 0.1 { 40.0 } else if t < 0.3 { 40.0 + (t - 0.1) / 0.2 * 210.0 } else { 250.0 };
+    let wt = |t: f64| 32.0 * t; // passes the coupling point
+    let t_end = 10.0;
+    let drive = Drive::PumpTorqueTurbineSpeed {
+        pump_torque_nm: signal("pump_torque_nm", &[(0.0, 40.0), (0.1, 40.0), (0.3, 250.0), (t_end, 250.0)]),
+        turbine_speed_rad_s: signal("turbine_speed_rad_s", &[(0.0, 0.0), (t_end, wt(t_end))]),
+    };
+    let model = ht(SHAPE);
+    for h in [0.01, 0.1] {
+        let n = (t_end / h).round() as usize;
+        let grid: Vec<f64> = (0..=n).map(|i| i as f64 * h).collect();
+        let (single, cols) = run(&model, &drive, &grid, InitialState::default());
+        let mut stepper = Stepper::new(ht(SHAPE), Causality::PumpTorqueTurbineSpeed, SolverOptions::default());
+        let first = stepper.initialize(0.0, [tp(0.0), wt(0.0)], &InitialState::default()).unwrap();
+        assert!((first.u[0] - col(&cols, "pump_speed_rad_s")[0]).abs() < 1e-12);
+        let mut worst = 0.0f64;
+        for (i, &t) in grid.iter().enumerate().skip(1) {
+            let s = stepper.do_step(h, [tp(t), wt(t)]).unwrap();
+            assert!((s.time_s - t).abs() < 1e-9);
+            worst = worst.max((s.u[0] - col(&cols, "pump_speed_rad_s")[i]).abs() / col(&cols, "pump_speed_rad_s")[i]);
+            worst = worst.max((-s.torque[1] - col(&cols, "turbine_torque_nm")[i]).abs() / 250.0);
+        }
+        println!("h = {h}: largest difference from the single run {worst:.2e}; single-run events {:?}", single.events.iter().map(|e| e.kind).collect::<Vec<_>>());
+        assert!(worst < 1e-4, "h = {h}: {worst}");
+        // both released the stator at the coupling point
+        assert!(!stepper.sample().unwrap().mode.stator_locked && !single.samples.last().unwrap().mode.stator_locked);
+    }
+}
