@@ -12,7 +12,7 @@ use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
 use tcsim_core::batch::{ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs, TransientJob};
-use tcsim_core::dynamics::{ConverterDynamics, HtDynamics, Inertias, QuasiDynamics, TableDynamics};
+use tcsim_core::dynamics::ConverterDynamics;
 use tcsim_core::signal::Signal;
 use tcsim_core::transient::{Drive, EventKind, InitialState, SolverOptions, TransientError, TurbineLoad};
 use tcsim_core::vehicle::{launch_column_names, simulate_launch, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres, Vehicle};
@@ -237,37 +237,21 @@ fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -
     }
 }
 
+/// A Python dict as a core model specification.
+struct DictSpec<'a, 'py>(&'a Bound<'py, PyDict>);
+
+impl tcsim_core::dynamics::ModelSpec for DictSpec<'_, '_> {
+    fn kind(&self) -> tcsim_core::CoreResult<String> {
+        item::<String>(self.0, "kind").map_err(|e| CoreError::new("kind", e, "a model kind"))
+    }
+    fn numbers(&self, key: &str) -> Option<Vec<f64>> {
+        let v = self.0.get_item(key).ok()??;
+        v.extract::<f64>().map(|x| vec![x]).or_else(|_| v.extract::<Vec<f64>>()).ok()
+    }
+}
+
 fn model_from(d: &Bound<'_, PyDict>) -> PyResult<Box<dyn ConverterDynamics + Send>> {
-    let kind: String = item(d, "kind")?;
-    let inertia: [f64; 3] = item(d, "inertia_kg_m2")?;
-    let inertia = Inertias::new(inertia[0], inertia[1], inertia[2]).map_err(input_error)?;
-    let table = || -> PyResult<Characteristic> {
-        Characteristic::new(item(d, "speed_ratio")?, item(d, "torque_ratio")?, item(d, "capacity_factor_nm_s2")?).map_err(input_error)
-    };
-    Ok(match kind.as_str() {
-        "table" => Box::new(TableDynamics { characteristic: table()?, inertia }),
-        "quasi-dynamic" => {
-            let shape: [f64; 2] = item(d, "shape_effect_m2")?;
-            let m = QuasiDynamics {
-                characteristic: table()?,
-                inertia,
-                fluid_density_kg_m3: item(d, "fluid_density_kg_m3")?,
-                pump_radius_m: item(d, "pump_exit_radius_m")?,
-                pump_shape_effect_m2: shape[0],
-                turbine_shape_effect_m2: shape[1],
-                flow_time_constant_s: item(d, "flow_time_constant_s")?,
-            };
-            m.validate().map_err(input_error)?;
-            Box::new(m)
-        }
-        "hrovat-tobler" => {
-            let g: Vec<f64> = item(d, "geometry")?;
-            let g: [f64; N_PARAMS] = g.try_into().map_err(|_| PyValueError::new_err(format!("geometry must have {N_PARAMS} values")))?;
-            let geometry = HtGeometry::new(g).map_err(input_error)?;
-            Box::new(HtDynamics::new(geometry, inertia, item(d, "fluid_length_m")?, item(d, "shape_effect_m2")?).map_err(input_error)?)
-        }
-        other => return Err(PyValueError::new_err(format!("unknown model kind {other:?}"))),
-    })
+    tcsim_core::dynamics::build_model(&DictSpec(d)).map_err(input_error)
 }
 
 fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal> {
