@@ -61,11 +61,14 @@ impl<M: ConverterDynamics> Stepper<M> {
         Ok(self.last.expect("a run samples its start"))
     }
 
-    /// Advance by `h` to `time + h`, the inputs moving linearly to `inputs_end`. Returns the sample
-    /// at the end of the interval.
-    pub fn do_step(&mut self, h: f64, inputs_end: [f64; 2]) -> TransientResult<Sample> {
+    /// Advance by `h` to `time + h`, the inputs moving linearly from `inputs_start` to `inputs_end`
+    /// (pass the previous end values for continuous inputs). Returns the sample at the end.
+    pub fn do_step(&mut self, h: f64, inputs_start: [f64; 2], inputs_end: [f64; 2]) -> TransientResult<Sample> {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(crate::CoreError::new("communication step size", h, "a finite, positive step").into());
+        }
         let (t0, t1) = (self.time_s, self.time_s + h);
-        let drive = self.drive([t0, t1], self.inputs, inputs_end)?;
+        let drive = self.drive([t0, t1], inputs_start, inputs_end)?;
         let traj = simulate_from(&self.model, &drive, &[t0, t1], self.u, self.mode, &self.options)?;
         let end = *traj.samples.last().expect("a run samples its end");
         self.time_s = t1;
@@ -78,6 +81,11 @@ impl<M: ConverterDynamics> Stepper<M> {
 
     pub fn time_s(&self) -> f64 {
         self.time_s
+    }
+
+    /// The inputs at the current time (the end values of the last interval).
+    pub fn inputs(&self) -> [f64; 2] {
+        self.inputs
     }
 
     /// The latest sample (outputs of the current state).

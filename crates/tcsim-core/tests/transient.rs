@@ -284,7 +284,7 @@ fn a_run_stepped_interval_by_interval_follows_the_single_run() {
         assert!((first.u[0] - col(&cols, "pump_speed_rad_s")[0]).abs() < 1e-12);
         let mut worst = 0.0f64;
         for (i, &t) in grid.iter().enumerate().skip(1) {
-            let s = stepper.do_step(h, [tp(t), wt(t)]).unwrap();
+            let s = stepper.do_step(h, stepper.inputs(), [tp(t), wt(t)]).unwrap();
             assert!((s.time_s - t).abs() < 1e-9);
             worst = worst.max((s.u[0] - col(&cols, "pump_speed_rad_s")[i]).abs() / col(&cols, "pump_speed_rad_s")[i]);
             worst = worst.max((-s.torque[1] - col(&cols, "turbine_torque_nm")[i]).abs() / 250.0);

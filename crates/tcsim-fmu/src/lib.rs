@@ -1,0 +1,354 @@
+//! The FMI 2.0 C API of the tcsim converter models: Co-Simulation, with diffsol's BDF inside
+//! `fmi2DoStep` (through `tcsim_core::stepper`). No Python at run time.
+//!
+//! The model and its parameters come from `resources/model.json`, written by `tcsim export-fmu`
+//! (`python/tcsim/fmu.py`). Every entry point catches panics: none crosses the C boundary; a
+//! failure returns `fmi2Error` with its message through the logger callback.
+//!
+//! Model Exchange is not provided yet: `fmi2Instantiate` refuses `fmi2ModelExchange`.
+
+#![allow(clippy::missing_safety_doc)]
+
+mod instance;
+
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
+use std::panic::{catch_unwind, AssertUnwindSafe};
+
+pub use instance::{Configuration, Instance, FIRST_PARAMETER, SIGNALS};
+
+type Status = c_int;
+const OK: Status = 0;
+const ERROR: Status = 3;
+const FATAL: Status = 4;
+const CO_SIMULATION: c_int = 1;
+
+type Logger = unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char, ...);
+
+/// `fmi2CallbackFunctions`.
+#[repr(C)]
+#[derive(Clone, Copy)]
+pub struct Callbacks {
+    logger: Option<Logger>,
+    allocate_memory: Option<unsafe extern "C" fn(usize, usize) -> *mut c_void>,
+    free_memory: Option<unsafe extern "C" fn(*mut c_void)>,
+    step_finished: Option<unsafe extern "C" fn(*mut c_void, Status)>,
+    environment: *mut c_void,
+}
+
+/// What an `fmi2Component` points to.
+pub struct Component {
+    name: CString,
+    callbacks: Option<Callbacks>,
+    instance: Instance,
+}
+
+impl Component {
+    fn log(&self, status: Status, message: &str) {
+        let Some(cb) = self.callbacks else { return };
+        let Some(logger) = cb.logger else { return };
+        let msg = CString::new(message.replace('\0', " ")).unwrap_or_default();
+        let category = if status >= ERROR { c"logStatusError" } else { c"logAll" };
+        // the message is passed as an argument of "%s", so a '%' in it is not a format
+        unsafe { logger(cb.environment, self.name.as_ptr(), status, category.as_ptr(), c"%s".as_ptr(), msg.as_ptr()) };
+    }
+}
+
+fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
+    payload.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| payload.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into())
+}
+
+/// Run `f` on the component; an error or a panic is logged and becomes `fmi2Error`.
+unsafe fn with(c: *mut c_void, f: impl FnOnce(&mut Component) -> Result<(), String>) -> Status {
+    if c.is_null() {
+        return ERROR;
+    }
+    let comp = unsafe { &mut *(c as *mut Component) };
+    match catch_unwind(AssertUnwindSafe(|| f(comp))) {
+        Ok(Ok(())) => OK,
+        Ok(Err(msg)) => {
+            comp.log(ERROR, &msg);
+            ERROR
+        }
+        Err(payload) => {
+            let msg = format!("internal error: {}", panic_message(payload));
+            comp.log(FATAL, &msg);
+            ERROR
+        }
+    }
+}
+
+unsafe fn slice<'a, T>(p: *const T, n: usize) -> Result<&'a [T], String> {
+    if n == 0 {
+        return Ok(&[]);
+    }
+    if p.is_null() {
+        return Err("null array".into());
+    }
+    Ok(unsafe { std::slice::from_raw_parts(p, n) })
+}
+
+unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], String> {
+    if n == 0 {
+        return Ok(&mut []);
+    }
+    if p.is_null() {
+        return Err("null array".into());
+    }
+    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
+}
+
+fn resources_path(location: &str) -> String {
+    let path = location.strip_prefix("file://").unwrap_or(location);
+    // file:///C:/... on Windows; percent-encoded spaces
+    let path = if path.len() > 2 && path.as_bytes()[0] == b'/' && path.as_bytes()[2] == b':' { &path[1..] } else { path };
+    path.replace("%20", " ").trim_end_matches('/').to_string()
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetTypesPlatform() -> *const c_char {
+    c"default".as_ptr()
+}
+
+#[no_mangle]
+pub extern "C" fn fmi2GetVersion() -> *const c_char {
+    c"2.0".as_ptr()
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetDebugLogging(c: *mut c_void, _on: c_int, _n: usize, _categories: *const *const c_char) -> Status {
+    unsafe { with(c, |_| Ok(())) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Instantiate(
+    name: *const c_char,
+    kind: c_int,
+    _guid: *const c_char,
+    resources: *const c_char,
+    callbacks: *const Callbacks,
+    _visible: c_int,
+    _logging_on: c_int,
+) -> *mut c_void {
+    let result = catch_unwind(AssertUnwindSafe(|| {
+        let name = if name.is_null() { CString::default() } else { unsafe { CStr::from_ptr(name) }.to_owned() };
+        let callbacks = if callbacks.is_null() { None } else { Some(unsafe { *callbacks }) };
+        let fail = |msg: String| {
+            let comp = Component { name: name.clone(), callbacks, instance: Instance::new(Configuration { causality: tcsim_core::stepper::Causality::Speeds, model: Default::default(), parameters: vec![] }) };
+            comp.log(ERROR, &msg);
+            std::ptr::null_mut()
+        };
+        if kind != CO_SIMULATION {
+            return fail("this FMU supports Co-Simulation only (Model Exchange is not provided yet)".into());
+        }
+        if resources.is_null() {
+            return fail("no fmuResourceLocation".into());
+        }
+        let dir = resources_path(&unsafe { CStr::from_ptr(resources) }.to_string_lossy());
+        let text = match std::fs::read_to_string(format!("{dir}/model.json")) {
+            Ok(t) => t,
+            Err(e) => return fail(format!("{dir}/model.json: {e}")),
+        };
+        match Configuration::parse(&text) {
+            Ok(config) => Box::into_raw(Box::new(Component { name, callbacks, instance: Instance::new(config) })) as *mut c_void,
+            Err(msg) => fail(msg),
+        }
+    }));
+    result.unwrap_or(std::ptr::null_mut())
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2FreeInstance(c: *mut c_void) {
+    if !c.is_null() {
+        let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(c as *mut Component) })));
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetupExperiment(c: *mut c_void, tolerance_defined: c_int, tolerance: f64, start: f64, _stop_defined: c_int, _stop: f64) -> Status {
+    unsafe {
+        with(c, |comp| {
+            if tolerance_defined != 0 && tolerance.is_finite() && tolerance > 0.0 {
+                comp.instance.options.rtol = tolerance.min(1e-4);
+            }
+            comp.instance.start_time = start;
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Status {
+    unsafe { with(c, |_| Ok(())) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Status {
+    unsafe { with(c, |comp| comp.instance.initialize()) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> Status {
+    unsafe { with(c, |_| Ok(())) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> Status {
+    unsafe {
+        with(c, |comp| {
+            comp.instance.reset();
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, n: usize, values: *mut f64) -> Status {
+    unsafe {
+        with(c, |comp| {
+            let (vr, values) = (slice(vr, n)?, slice_mut(values, n)?);
+            for (r, v) in vr.iter().zip(values.iter_mut()) {
+                *v = comp.instance.get(*r).ok_or(format!("no variable with value reference {r}"))?;
+            }
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetReal(c: *mut c_void, vr: *const u32, n: usize, values: *const f64) -> Status {
+    unsafe {
+        with(c, |comp| {
+            for (r, v) in slice(vr, n)?.iter().zip(slice(values, n)?) {
+                comp.instance.set(*r, *v)?;
+            }
+            Ok(())
+        })
+    }
+}
+
+/// Integer, Boolean and String variables: the FMU has none.
+unsafe fn none_of_type(c: *mut c_void, n: usize) -> Status {
+    unsafe { with(c, |_| if n == 0 { Ok(()) } else { Err("this FMU has only Real variables".into()) }) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetInteger(c: *mut c_void, _vr: *const u32, n: usize, _v: *mut c_int) -> Status {
+    unsafe { none_of_type(c, n) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetInteger(c: *mut c_void, _vr: *const u32, n: usize, _v: *const c_int) -> Status {
+    unsafe { none_of_type(c, n) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetBoolean(c: *mut c_void, _vr: *const u32, n: usize, _v: *mut c_int) -> Status {
+    unsafe { none_of_type(c, n) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetBoolean(c: *mut c_void, _vr: *const u32, n: usize, _v: *const c_int) -> Status {
+    unsafe { none_of_type(c, n) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetString(c: *mut c_void, _vr: *const u32, n: usize, _v: *mut *const c_char) -> Status {
+    unsafe { none_of_type(c, n) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetString(c: *mut c_void, _vr: *const u32, n: usize, _v: *const *const c_char) -> Status {
+    unsafe { none_of_type(c, n) }
+}
+
+/// Capabilities the FMU declares it does not have.
+unsafe fn unsupported(c: *mut c_void, what: &str) -> Status {
+    unsafe { with(c, |_| Err(format!("{what} is not supported by this FMU"))) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, _s: *mut *mut c_void) -> Status {
+    unsafe { unsupported(c, "fmi2GetFMUstate") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, _s: *mut c_void) -> Status {
+    unsafe { unsupported(c, "fmi2SetFMUstate") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, _s: *mut *mut c_void) -> Status {
+    unsafe { unsupported(c, "fmi2FreeFMUstate") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: *mut c_void, _s: *mut c_void, _n: *mut usize) -> Status {
+    unsafe { unsupported(c, "fmi2SerializedFMUstateSize") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(c: *mut c_void, _s: *mut c_void, _b: *mut c_char, _n: usize) -> Status {
+    unsafe { unsupported(c, "fmi2SerializeFMUstate") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c: *mut c_void, _b: *const c_char, _n: usize, _s: *mut *mut c_void) -> Status {
+    unsafe { unsupported(c, "fmi2DeSerializeFMUstate") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetDirectionalDerivative(c: *mut c_void, _u: *const u32, _nu: usize, _z: *const u32, _nz: usize, _dv: *const f64, _dz: *mut f64) -> Status {
+    unsafe { unsupported(c, "fmi2GetDirectionalDerivative") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(c: *mut c_void, vr: *const u32, n: usize, order: *const c_int, values: *const f64) -> Status {
+    unsafe {
+        with(c, |comp| {
+            for ((r, o), v) in slice(vr, n)?.iter().zip(slice(order, n)?).zip(slice(values, n)?) {
+                comp.instance.set_rate(*r, *o, *v)?;
+            }
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(c: *mut c_void, _vr: *const u32, _n: usize, _o: *const c_int, _v: *mut f64) -> Status {
+    unsafe { unsupported(c, "fmi2GetRealOutputDerivatives") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2DoStep(c: *mut c_void, t: f64, h: f64, _no_prior_state: c_int) -> Status {
+    unsafe { with(c, |comp| comp.instance.do_step(t, h)) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2CancelStep(c: *mut c_void) -> Status {
+    unsafe { unsupported(c, "fmi2CancelStep (steps are synchronous)") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetStatus(c: *mut c_void, _kind: c_int, _value: *mut Status) -> Status {
+    unsafe { unsupported(c, "fmi2GetStatus (steps are synchronous)") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetRealStatus(c: *mut c_void, _kind: c_int, _value: *mut f64) -> Status {
+    unsafe { unsupported(c, "fmi2GetRealStatus") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetIntegerStatus(c: *mut c_void, _kind: c_int, _value: *mut c_int) -> Status {
+    unsafe { unsupported(c, "fmi2GetIntegerStatus") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetBooleanStatus(c: *mut c_void, _kind: c_int, _value: *mut c_int) -> Status {
+    unsafe { unsupported(c, "fmi2GetBooleanStatus") }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetStringStatus(c: *mut c_void, _kind: c_int, _value: *mut *const c_char) -> Status {
+    unsafe { unsupported(c, "fmi2GetStringStatus") }
+}
