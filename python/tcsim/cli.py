@@ -145,6 +145,19 @@ def launch(
     stdout.print(launch_command(vehicle, out, scenario, model or [], sweep_shape_effects))
 
 
+@app.command("export-fmu")
+def export_fmu(
+    converter: Annotated[str, typer.Argument(help="bundled name or converter .toml")],
+    model: Annotated[str, typer.Option("--model", "-m", help="table | hrovat-tobler | quasi-dynamic")],
+    out: Annotated[Path, typer.Option("--out", "-o", help="the FMU file to write (*.fmu)")],
+    causality: Annotated[str, typer.Option("--causality", help="pump-torque (pump torque and turbine speed in) | speeds (both speeds in)")] = "pump-torque",
+) -> None:
+    """Export one model as an FMI 2.0 Co-Simulation FMU (linux64 binary, sources to rebuild elsewhere; no Python inside)."""
+    from .fmu import export_fmu_command
+
+    stdout.print(export_fmu_command(converter, model, out, causality), highlight=False, soft_wrap=True)
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     if issubclass(category, TcsimWarning):
         console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True)

@@ -47,8 +47,10 @@ impl<M: ConverterDynamics> Stepper<M> {
 
     /// Start at `t0` with `inputs` (pump torque or speed, turbine speed): the steady state
     /// consistent with them unless `init` gives values.
-    pub fn initialize(&mut self, t0: f64, inputs: [f64; 2], init: &InitialState) -> TransientResult<Sample> {
-        let drive = self.drive([t0, t0 + 1.0], inputs, inputs)?;
+    /// `rates` are the inputs' rates at `t0` (zero if unknown): they enter the outputs at the start
+    /// (the inertia and shape-effect terms), not the steady state.
+    pub fn initialize(&mut self, t0: f64, inputs: [f64; 2], rates: [f64; 2], init: &InitialState) -> TransientResult<Sample> {
+        let drive = self.drive([t0, t0 + 1.0], inputs, [inputs[0] + rates[0], inputs[1] + rates[1]])?;
         let u = initial_state(&self.model, &drive, t0, init)?;
         let mode = initial_mode(&self.model, &drive, &u, t0);
         self.time_s = t0;

@@ -280,7 +280,7 @@ fn a_run_stepped_interval_by_interval_follows_the_single_run() {
         let grid: Vec<f64> = (0..=n).map(|i| i as f64 * h).collect();
         let (single, cols) = run(&model, &drive, &grid, InitialState::default());
         let mut stepper = Stepper::new(ht(SHAPE), Causality::PumpTorqueTurbineSpeed, SolverOptions::default());
-        let first = stepper.initialize(0.0, [tp(0.0), wt(0.0)], &InitialState::default()).unwrap();
+        let first = stepper.initialize(0.0, [tp(0.0), wt(0.0)], [0.0, 0.0], &InitialState::default()).unwrap();
         assert!((first.u[0] - col(&cols, "pump_speed_rad_s")[0]).abs() < 1e-12);
         let mut worst = 0.0f64;
         for (i, &t) in grid.iter().enumerate().skip(1) {

@@ -178,12 +178,22 @@ pub unsafe extern "C" fn fmi2SetupExperiment(c: *mut c_void, tolerance_defined: 
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Status {
-    unsafe { with(c, |_| Ok(())) }
+    unsafe {
+        with(c, |comp| {
+            comp.instance.initializing = true;
+            Ok(())
+        })
+    }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Status {
-    unsafe { with(c, |comp| comp.instance.initialize()) }
+    unsafe {
+        with(c, |comp| {
+            comp.instance.initializing = false;
+            comp.instance.initialize()
+        })
+    }
 }
 
 #[no_mangle]
