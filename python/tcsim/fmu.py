@@ -75,6 +75,19 @@ CAUSALITIES: dict[str, tuple[str, str]] = {
 }
 #: Start values of the inputs (a part-load stall: 50 N·m at the pump, or the pump at 150 rad/s).
 INPUT_START: dict[str, float] = {"pump_torque_nm": 50.0, "pump_speed_rad_s": 150.0, "turbine_speed_rad_s": 0.0}
+#: Rates of the speed inputs (value references 12, 13), for Model Exchange: optional inputs, zero
+#: when not connected. Co-Simulation takes the rates from fmi2SetRealInputDerivatives or from the
+#: last communication interval instead.
+RATE_INPUTS: dict[str, tuple[int, str, str]] = {
+    "pump_speed_rad_s": (12, "pump_accel_rad_s2", "Rate of the pump speed input (Model Exchange; 0 if not connected)"),
+    "turbine_speed_rad_s": (13, "turbine_accel_rad_s2", "Rate of the turbine speed input (Model Exchange; 0 if not connected)"),
+}
+#: Value reference of the derivative of state coordinate c (0 pump speed, 2 stator speed, 3 flow).
+FIRST_DERIVATIVE = 20
+#: The models' continuous states in Model Exchange: signal name and coordinate.
+_STATES = (("pump_speed_rad_s", 0), ("stator_speed_rad_s", 2), ("flow_m3_s", 3))
+#: Event indicators in Model Exchange: the stator clutch and the flow direction (Hrovat & Tobler).
+EVENT_INDICATORS = {"hrovat-tobler": 3}
 
 
 class FmuLibraryError(RuntimeError):
@@ -97,6 +110,8 @@ UNITS: tuple[Unit, ...] = (
     Unit("N.m", {"kg": 1, "m": 2, "s": -2}),
     Unit("rad/s", {"s": -1, "rad": 1}, (("rpm", 30.0 / math.pi),)),
     Unit("m3/s", {"m": 3, "s": -1}),
+    Unit("rad/s2", {"s": -2, "rad": 1}),
+    Unit("m3/s2", {"m": 3, "s": -2}),
     Unit("kg.m2", {"kg": 1, "m": 2}),
     Unit("N.m.s2/rad2", {"kg": 1, "m": 2, "rad": -2}),
     Unit("m", {"m": 1}),
@@ -282,7 +297,8 @@ def _check_causality(causality: str) -> tuple[str, str]:
 
 def model_description_xml(model: DynamicModel, causality: str = "pump-torque", model_name: str | None = None,
                           guid: str | None = None, generation_time: datetime | None = None) -> str:
-    """The ``modelDescription.xml`` (FMI 2.0, Co-Simulation) of a model under a causality."""
+    """The ``modelDescription.xml`` (FMI 2.0, Co-Simulation and Model Exchange) of a model under a
+    causality."""
     inputs = _check_causality(causality)
     signals = model_signals(model.name)
     params = fmu_parameters(model)
@@ -300,7 +316,9 @@ def model_description_xml(model: DynamicModel, causality: str = "pump-torque", m
              f'<fmiModelDescription fmiVersion="2.0" modelName={a(model_name)} guid={a(guid)}',
              f'  description={a(description)}',
              f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
-             '  variableNamingConvention="flat" numberOfEventIndicators="0">',
+             f'  variableNamingConvention="flat" numberOfEventIndicators="{EVENT_INDICATORS.get(model.name, 0)}">',
+             f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
+             ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
              f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
              ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="false"'
              ' canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
@@ -332,6 +350,18 @@ def model_description_xml(model: DynamicModel, causality: str = "pump-torque", m
         else:
             variable(s.name, s.vr, s.description, 'causality="output" variability="continuous" initial="calculated"',
                      f'unit="{s.unit}"')
+    for name in inputs:
+        if name in RATE_INPUTS:
+            vr, rate, text = RATE_INPUTS[name]
+            variable(rate, vr, text, 'causality="input" variability="continuous"', 'unit="rad/s2" start="0"')
+    states = [(name, c) for name, c in _STATES if name in index and name not in inputs]
+    derivatives = []
+    for name, c in states:
+        der = f"der({name})"
+        unit = "m3/s2" if c == 3 else "rad/s2"
+        variable(der, FIRST_DERIVATIVE + c, f"Time derivative of {name}", 'causality="local" variability="continuous" initial="calculated"',
+                 f'unit="{unit}" derivative="{index[name]}"')
+        derivatives.append(der)
     for p in params:
         display = ' displayUnit="deg"' if p.unit == "rad" else ""
         variable(p.name, p.vr, p.description, 'causality="parameter" variability="tunable"',
@@ -343,9 +373,14 @@ def model_description_xml(model: DynamicModel, causality: str = "pump-torque", m
     for s in outputs:
         # a state (pump speed, flow, stator speed) does not depend directly on the inputs
         lines.append(f'      <Unknown index="{index[s.name]}" dependencies="{"" if s.state else both}"/>')
-    lines += ['    </Outputs>', '    <InitialUnknowns>']
-    for s in outputs:
-        lines.append(f'      <Unknown index="{index[s.name]}" dependencies="{both}"/>')
+    lines.append('    </Outputs>')
+    if derivatives:
+        lines.append('    <Derivatives>')
+        lines += [f'      <Unknown index="{index[der]}"/>' for der in derivatives]
+        lines.append('    </Derivatives>')
+    lines.append('    <InitialUnknowns>')
+    for name in sorted([s.name for s in outputs] + derivatives, key=index.get):
+        lines.append(f'      <Unknown index="{index[name]}"/>')
     lines += ['    </InitialUnknowns>', '  </ModelStructure>', '</fmiModelDescription>', '']
     return "\n".join(lines)
 

@@ -5,11 +5,14 @@ use serde_json::{Map, Value};
 use tcsim_core::dynamics::{build_model, ConverterDynamics, ModelSpec};
 use tcsim_core::outputs::{row, COLUMNS};
 use tcsim_core::stepper::{Causality, Stepper};
-use tcsim_core::transient::{InitialState, Sample, SolverOptions};
+use tcsim_core::dynamics::FLOW;
+use tcsim_core::signal::Signal;
+use tcsim_core::transient::{initial_mode, initial_state, Drive, InitialState, Mode, ModeView, Sample, SolverOptions, EVENT_INDICATORS};
 use tcsim_core::CoreResult;
 
-/// Value references of the signals, fixed whatever the causality.
-pub const SIGNALS: [&str; 12] = [
+/// Value references of the signals, fixed whatever the causality; 12 and 13 are the rates of the
+/// speed inputs (Model Exchange), 20 + c the derivative of state coordinate c.
+pub const SIGNALS: [&str; 14] = [
     "pump_torque_nm",
     "pump_speed_rad_s",
     "turbine_speed_rad_s",
@@ -22,7 +25,11 @@ pub const SIGNALS: [&str; 12] = [
     "effective_pump_torque_nm",
     "effective_turbine_torque_nm",
     "effective_torque_ratio",
+    "pump_accel_rad_s2",
+    "turbine_accel_rad_s2",
 ];
+/// Value reference of the derivative of coordinate 0 (pump speed); + 2 stator speed, + 3 flow.
+pub const FIRST_DERIVATIVE: u32 = 20;
 /// Value reference of the first parameter.
 pub const FIRST_PARAMETER: u32 = 100;
 
@@ -103,24 +110,42 @@ pub struct Instance {
     pub options: SolverOptions,
     pub start_time: f64,
     /// Signal values by value reference (inputs as set, outputs as computed).
-    pub signals: [f64; 12],
+    pub signals: [f64; 14],
     /// Input rates given with `fmi2SetRealInputDerivatives` for the coming step.
-    rates: [Option<f64>; 12],
+    rates: [Option<f64>; 14],
+    /// Model Exchange: the model, all coordinates, the mode and the time.
+    me: Option<ModelExchange>,
     /// Inputs at the previous communication point, for the rate estimate.
     previous: Option<(f64, [f64; 2])>,
     stepper: Option<Stepper<Box<dyn ConverterDynamics + Send>>>,
     rebuild: bool,
+    /// Instantiated for Model Exchange (else Co-Simulation).
+    pub model_exchange: bool,
     /// Between fmi2EnterInitializationMode and fmi2ExitInitializationMode.
     pub initializing: bool,
 }
 
 impl Instance {
     pub fn new(config: Configuration) -> Self {
-        let mut signals = [f64::NAN; 12];
+        let mut signals = [f64::NAN; 14];
         signals[0] = 50.0;
         signals[1] = 150.0;
         signals[2] = 0.0;
-        Self { config, options: SolverOptions::default(), start_time: 0.0, signals, rates: [None; 12], previous: None, stepper: None, rebuild: false, initializing: false }
+        signals[12] = 0.0;
+        signals[13] = 0.0;
+        Self {
+            config,
+            options: SolverOptions::default(),
+            start_time: 0.0,
+            signals,
+            rates: [None; 14],
+            me: None,
+            previous: None,
+            stepper: None,
+            rebuild: false,
+            model_exchange: false,
+            initializing: false,
+        }
     }
 
     /// The value references of the two inputs.
@@ -129,6 +154,11 @@ impl Instance {
             Causality::PumpTorqueTurbineSpeed => [0, 2],
             Causality::Speeds => [1, 2],
         }
+    }
+
+    /// Value references that may be set: the two inputs, and for Model Exchange their rates.
+    fn settable(&self, vr: usize) -> bool {
+        self.input_refs().contains(&vr) || vr == 13 || (vr == 12 && self.config.causality == Causality::Speeds)
     }
 
     fn inputs(&self) -> [f64; 2] {
@@ -141,11 +171,16 @@ impl Instance {
     }
 
     pub fn get(&mut self, vr: u32) -> Option<f64> {
+        let derivative = (FIRST_DERIVATIVE..FIRST_DERIVATIVE + 4).contains(&vr);
+        let output = derivative || ((vr as usize) < SIGNALS.len() && !self.settable(vr as usize));
+        if self.initializing && output {
+            // in initialisation mode the outputs are the steady state for the inputs set so far
+            let _ = self.initialize();
+        }
+        if self.me.is_some() {
+            return self.me_get(vr);
+        }
         if (vr as usize) < SIGNALS.len() {
-            if self.initializing && !self.input_refs().contains(&(vr as usize)) {
-                // in initialisation mode the outputs are the steady state for the inputs set so far
-                let _ = self.initialize();
-            }
             return Some(self.signals[vr as usize]);
         }
         let i = vr.checked_sub(FIRST_PARAMETER)? as usize;
@@ -156,7 +191,7 @@ impl Instance {
     /// not settable.
     pub fn set(&mut self, vr: u32, value: f64) -> Result<(), String> {
         if (vr as usize) < SIGNALS.len() {
-            if !self.input_refs().contains(&(vr as usize)) {
+            if !self.settable(vr as usize) {
                 return Err(format!("{} is an output and cannot be set", SIGNALS[vr as usize]));
             }
             if !value.is_finite() {
@@ -171,6 +206,9 @@ impl Instance {
             // tunable: check the new parameters now, apply them at the next step
             self.model().map_err(|e| e.to_string())?;
             self.rebuild = true;
+        }
+        if let Some(me) = self.me.as_mut() {
+            me.model = build_model(&Spec { model: &self.config.model, parameters: &self.config.parameters }).map_err(|e| e.to_string())?;
         }
         Ok(())
     }
@@ -198,6 +236,9 @@ impl Instance {
 
     /// `fmi2ExitInitializationMode`: the steady state consistent with the inputs.
     pub fn initialize(&mut self) -> Result<(), String> {
+        if self.model_exchange {
+            return self.me_initialize();
+        }
         let model = self.model().map_err(|e| e.to_string())?;
         let mut stepper = Stepper::new(model, self.config.causality, self.options);
         let refs = self.input_refs();
@@ -232,7 +273,7 @@ impl Instance {
         }
         let sample = stepper.do_step(h, start, end).map_err(|e| e.to_string())?;
         self.previous = Some((t, start));
-        self.rates = [None; 12];
+        self.rates = [None; 14];
         self.publish(&sample);
         Ok(())
     }
@@ -287,5 +328,187 @@ mod tests {
         let mut inst = Instance::new(Configuration::parse(CONFIG).unwrap());
         inst.set(100, -1.0).unwrap();
         assert!(inst.initialize().unwrap_err().contains("inertia.pump_kg_m2"));
+    }
+}
+
+/// The Model Exchange side of an instance.
+pub struct ModelExchange {
+    model: Box<dyn ConverterDynamics + Send>,
+    /// All four coordinates; the state coordinates are set by the host.
+    u: [f64; 4],
+    mode: Mode,
+    time_s: f64,
+    coordinates: Vec<usize>,
+}
+
+impl Instance {
+    /// The drive of the current inputs and their rates (linear about the current time).
+    fn me_drive(&self, t: f64) -> Result<Drive, String> {
+        let line = |name: &str, value: f64, rate: f64| Signal::new(name, vec![t, t + 1.0], vec![value, value + rate], 0.0).map_err(|e| e.to_string());
+        let s = &self.signals;
+        Ok(match self.config.causality {
+            Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed { pump_torque_nm: Signal::constant(s[0]), turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])? },
+            Causality::Speeds => Drive::Speeds { pump_speed_rad_s: line("pump_speed_rad_s", s[1], s[12])?, turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])? },
+        })
+    }
+
+    fn me_initialize(&mut self) -> Result<(), String> {
+        let model = self.model().map_err(|e| e.to_string())?;
+        let t = self.start_time;
+        let drive = self.me_drive(t)?;
+        let u = initial_state(&model, &drive, t, &InitialState::default()).map_err(|e| e.to_string())?;
+        let mode = initial_mode(&model, &drive, &u, t);
+        let coordinates = ModeView::state_coordinates(&model, &drive);
+        self.me = Some(ModelExchange { model, u, mode, time_s: t, coordinates });
+        Ok(())
+    }
+
+    /// The number of continuous states and of event indicators.
+    pub fn me_sizes(&self) -> (usize, usize) {
+        match &self.me {
+            Some(me) => (me.coordinates.len(), if me.model.has_stator_clutch() { EVENT_INDICATORS } else { 0 }),
+            None => (0, 0),
+        }
+    }
+
+    fn me_state(&self) -> Result<&ModelExchange, String> {
+        self.me.as_ref().ok_or_else(|| "Model Exchange call before initialisation".to_string())
+    }
+
+    pub fn me_set_time(&mut self, t: f64) -> Result<(), String> {
+        self.me.as_mut().ok_or("fmi2SetTime before initialisation")?.time_s = t;
+        Ok(())
+    }
+
+    pub fn me_set_states(&mut self, x: &[f64]) -> Result<(), String> {
+        let me = self.me.as_mut().ok_or("fmi2SetContinuousStates before initialisation")?;
+        if x.len() != me.coordinates.len() {
+            return Err(format!("{} continuous states given, expected {}", x.len(), me.coordinates.len()));
+        }
+        for (&c, &v) in me.coordinates.iter().zip(x) {
+            me.u[c] = v;
+        }
+        Ok(())
+    }
+
+    pub fn me_get_states(&self, x: &mut [f64]) -> Result<(), String> {
+        let me = self.me_state()?;
+        for (&c, v) in me.coordinates.iter().zip(x.iter_mut()) {
+            *v = me.u[c];
+        }
+        Ok(())
+    }
+
+    pub fn me_nominals(&self, x: &mut [f64]) -> Result<(), String> {
+        let me = self.me_state()?;
+        for (&c, v) in me.coordinates.iter().zip(x.iter_mut()) {
+            *v = if c == FLOW { 0.05 } else { 100.0 };
+        }
+        Ok(())
+    }
+
+    pub fn me_derivatives(&self, dx: &mut [f64]) -> Result<(), String> {
+        let me = self.me_state()?;
+        let drive = self.me_drive(me.time_s)?;
+        let rates = ModeView::new(&me.model, &drive, me.mode).rates(&me.u, me.time_s);
+        for (&c, v) in me.coordinates.iter().zip(dx.iter_mut()) {
+            *v = rates[c];
+        }
+        Ok(())
+    }
+
+    pub fn me_indicators(&self, g: &mut [f64]) -> Result<(), String> {
+        let me = self.me_state()?;
+        let drive = self.me_drive(me.time_s)?;
+        let values = ModeView::new(&me.model, &drive, me.mode).indicators(&me.u, me.time_s, &self.options.hysteresis);
+        for (v, x) in g.iter_mut().zip(values) {
+            *v = x;
+        }
+        Ok(())
+    }
+
+    /// `fmi2NewDiscreteStates`: apply every due switch; whether the states changed.
+    pub fn me_new_discrete_states(&mut self) -> Result<bool, String> {
+        let h = self.options.hysteresis;
+        let me = self.me.as_ref().ok_or("fmi2NewDiscreteStates before initialisation")?;
+        let drive = self.me_drive(me.time_s)?;
+        let (mut u, mut mode, t) = (me.u, me.mode, me.time_s);
+        let mut changed = false;
+        for _ in 0..8 {
+            match ModeView::new(&me.model, &drive, mode).event(&mut u, t, &h) {
+                Some((_, next)) => {
+                    mode = next;
+                    changed = true;
+                }
+                None => break,
+            }
+        }
+        let me = self.me.as_mut().ok_or("no Model Exchange state")?;
+        // keep the host's given coordinates out of the state: only free ones change
+        me.u = u;
+        me.mode = mode;
+        Ok(changed)
+    }
+
+    fn me_get(&mut self, vr: u32) -> Option<f64> {
+        let me = self.me.as_ref()?;
+        if (FIRST_DERIVATIVE..FIRST_DERIVATIVE + 4).contains(&vr) {
+            let drive = self.me_drive(me.time_s).ok()?;
+            return Some(ModeView::new(&me.model, &drive, me.mode).rates(&me.u, me.time_s)[(vr - FIRST_DERIVATIVE) as usize]);
+        }
+        if (vr as usize) < SIGNALS.len() {
+            if self.settable(vr as usize) {
+                return Some(self.signals[vr as usize]);
+            }
+            let drive = self.me_drive(me.time_s).ok()?;
+            let sample = ModeView::new(&me.model, &drive, me.mode).sample(&me.u, me.time_s);
+            let r = row(&me.model, &sample);
+            return COLUMNS.iter().position(|c| *c == SIGNALS[vr as usize]).map(|c| r[c]);
+        }
+        let i = vr.checked_sub(FIRST_PARAMETER)? as usize;
+        self.config.parameters.get(i).map(|p| p.value)
+    }
+}
+
+#[cfg(test)]
+mod me_tests {
+    use super::*;
+
+    #[test]
+    fn model_exchange_states_derivatives_and_events() {
+        let config = Configuration::parse(&format!(
+            r#"{{"model": {{"kind": "hrovat-tobler", "inertia_kg_m2": [0.109, 0.056, 0.01], "fluid_length_m": 0.2914,
+                "shape_effect_m2": [-0.00569, 0.00134, 0.0009], "geometry": {:?}}}, "parameters": []}}"#,
+            tcsim_core::hrovat_tobler::HtGeometry::appendix_d().values
+        ))
+        .unwrap();
+        let mut inst = Instance::new(config);
+        inst.model_exchange = true;
+        inst.set(0, 150.0).unwrap();
+        inst.set(2, 0.0).unwrap();
+        inst.initialize().unwrap();
+        assert_eq!(inst.me_sizes(), (3, 3));
+        // at the steady state the derivatives vanish and no event is due
+        let mut dx = [1.0; 3];
+        inst.me_derivatives(&mut dx).unwrap();
+        assert!(dx.iter().all(|d| d.abs() < 1e-6), "{dx:?}");
+        let mut g = [0.0; 3];
+        inst.me_indicators(&mut g).unwrap();
+        assert!(g.iter().all(|v| *v > 0.0));
+        assert!(!inst.me_new_discrete_states().unwrap());
+        // at the locked steady state past the coupling point the holding torque is negative:
+        // the stator releases
+        let mut x = [0.0; 3];
+        inst.me_get_states(&mut x).unwrap();
+        let g_ht = tcsim_core::hrovat_tobler::HtGeometry::appendix_d();
+        let locked = tcsim_core::hrovat_tobler::locked_steady_state(&g_ht, x[0], 0.97 * x[0]).unwrap();
+        inst.set(2, 0.97 * x[0]).unwrap();
+        inst.me_set_states(&[x[0], 0.0, locked.flow_m3_s]).unwrap();
+        inst.me_indicators(&mut g).unwrap();
+        assert!(g[0] < 0.0, "{g:?}");
+        assert!(inst.me_new_discrete_states().unwrap());
+        inst.me_indicators(&mut g).unwrap();
+        assert!(g[0] > 0.0);
+        assert_eq!(inst.get(3).map(|v| v.is_finite()), Some(true));
     }
 }

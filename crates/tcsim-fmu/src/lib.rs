@@ -1,11 +1,12 @@
 //! The FMI 2.0 C API of the tcsim converter models: Co-Simulation, with diffsol's BDF inside
-//! `fmi2DoStep` (through `tcsim_core::stepper`). No Python at run time.
+//! `fmi2DoStep` (through `tcsim_core::stepper`), and Model Exchange, with the continuous states,
+//! their derivatives, the event indicators of the stator clutch and of flow reversal, and the mode
+//! switches in `fmi2NewDiscreteStates` (through `tcsim_core::transient::ModeView`). No Python at
+//! run time.
 //!
 //! The model and its parameters come from `resources/model.json`, written by `tcsim export-fmu`
 //! (`python/tcsim/fmu.py`). Every entry point catches panics: none crosses the C boundary; a
 //! failure returns `fmi2Error` with its message through the logger callback.
-//!
-//! Model Exchange is not provided yet: `fmi2Instantiate` refuses `fmi2ModelExchange`.
 
 #![allow(clippy::missing_safety_doc)]
 
@@ -20,6 +21,7 @@ type Status = c_int;
 const OK: Status = 0;
 const ERROR: Status = 3;
 const FATAL: Status = 4;
+const MODEL_EXCHANGE: c_int = 0;
 const CO_SIMULATION: c_int = 1;
 
 type Logger = unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char, ...);
@@ -137,8 +139,8 @@ pub unsafe extern "C" fn fmi2Instantiate(
             comp.log(ERROR, &msg);
             std::ptr::null_mut()
         };
-        if kind != CO_SIMULATION {
-            return fail("this FMU supports Co-Simulation only (Model Exchange is not provided yet)".into());
+        if kind != CO_SIMULATION && kind != MODEL_EXCHANGE {
+            return fail(format!("fmuType {kind}: expected Model Exchange (0) or Co-Simulation (1)"));
         }
         if resources.is_null() {
             return fail("no fmuResourceLocation".into());
@@ -149,7 +151,11 @@ pub unsafe extern "C" fn fmi2Instantiate(
             Err(e) => return fail(format!("{dir}/model.json: {e}")),
         };
         match Configuration::parse(&text) {
-            Ok(config) => Box::into_raw(Box::new(Component { name, callbacks, instance: Instance::new(config) })) as *mut c_void,
+            Ok(config) => {
+                let mut instance = Instance::new(config);
+                instance.model_exchange = kind == MODEL_EXCHANGE;
+                Box::into_raw(Box::new(Component { name, callbacks, instance })) as *mut c_void
+            }
             Err(msg) => fail(msg),
         }
     }));
@@ -361,4 +367,122 @@ pub unsafe extern "C" fn fmi2GetBooleanStatus(c: *mut c_void, _kind: c_int, _val
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetStringStatus(c: *mut c_void, _kind: c_int, _value: *mut *const c_char) -> Status {
     unsafe { unsupported(c, "fmi2GetStringStatus") }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Model Exchange
+
+/// `fmi2EventInfo`.
+#[repr(C)]
+pub struct EventInfo {
+    new_discrete_states_needed: c_int,
+    terminate_simulation: c_int,
+    nominals_of_continuous_states_changed: c_int,
+    values_of_continuous_states_changed: c_int,
+    next_event_time_defined: c_int,
+    next_event_time: f64,
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2EnterEventMode(c: *mut c_void) -> Status {
+    unsafe { with(c, |_| Ok(())) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2NewDiscreteStates(c: *mut c_void, info: *mut EventInfo) -> Status {
+    unsafe {
+        with(c, |comp| {
+            let changed = comp.instance.me_new_discrete_states()?;
+            if info.is_null() {
+                return Err("null fmi2EventInfo".into());
+            }
+            let info = &mut *info;
+            info.new_discrete_states_needed = 0;
+            info.terminate_simulation = 0;
+            info.nominals_of_continuous_states_changed = 0;
+            info.values_of_continuous_states_changed = c_int::from(changed);
+            info.next_event_time_defined = 0;
+            info.next_event_time = 0.0;
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: *mut c_void) -> Status {
+    unsafe { with(c, |_| Ok(())) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2CompletedIntegratorStep(c: *mut c_void, _no_prior: c_int, enter_event_mode: *mut c_int, terminate: *mut c_int) -> Status {
+    unsafe {
+        with(c, |_| {
+            if !enter_event_mode.is_null() {
+                *enter_event_mode = 0;
+            }
+            if !terminate.is_null() {
+                *terminate = 0;
+            }
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetTime(c: *mut c_void, t: f64) -> Status {
+    unsafe { with(c, |comp| comp.instance.me_set_time(t)) }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SetContinuousStates(c: *mut c_void, x: *const f64, n: usize) -> Status {
+    unsafe { with(c, |comp| comp.instance.me_set_states(slice(x, n)?)) }
+}
+
+/// Check the host's array size against the model's.
+fn sized(n: usize, expected: usize, what: &str) -> Result<(), String> {
+    if n == expected {
+        Ok(())
+    } else {
+        Err(format!("{n} {what} asked for, the model has {expected}"))
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
+    unsafe {
+        with(c, |comp| {
+            sized(n, comp.instance.me_sizes().0, "continuous states")?;
+            comp.instance.me_get_states(slice_mut(x, n)?)
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
+    unsafe {
+        with(c, |comp| {
+            sized(n, comp.instance.me_sizes().0, "continuous states")?;
+            comp.instance.me_nominals(slice_mut(x, n)?)
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetDerivatives(c: *mut c_void, dx: *mut f64, n: usize) -> Status {
+    unsafe {
+        with(c, |comp| {
+            sized(n, comp.instance.me_sizes().0, "derivatives")?;
+            comp.instance.me_derivatives(slice_mut(dx, n)?)
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2GetEventIndicators(c: *mut c_void, g: *mut f64, n: usize) -> Status {
+    unsafe {
+        with(c, |comp| {
+            sized(n, comp.instance.me_sizes().1, "event indicators")?;
+            comp.instance.me_indicators(slice_mut(g, n)?)
+        })
+    }
 }
