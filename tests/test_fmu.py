@@ -158,7 +158,8 @@ def test_fmu_contents(fmus, model):
     # Model Exchange: the rate of the turbine speed input, and a derivative per continuous state
     # (pump speed 20, stator speed 22, flow 23)
     states = {"table": {20}, "quasi-dynamic": {20, 23}, "hrovat-tobler": {20, 22, 23}}[model]
-    assert {vr for vr in by_vr if 12 <= vr < 100} == {13} | states
+    starts = {"table": {30, 31}, "quasi-dynamic": {30, 31, 33}, "hrovat-tobler": {30, 31, 32, 33}}[model]
+    assert {vr for vr in by_vr if 12 <= vr < 100} == {13} | states | starts
     assert root.get("numberOfEventIndicators") == ("3" if model == "hrovat-tobler" else "0")
     for i, p in enumerate(config["parameters"]):
         v = by_vr[100 + i]
@@ -479,3 +480,18 @@ def test_model_exchange_with_cvode_matches_the_engine(fmus, model):
         stator = fmpy.simulate_fmu(path, fmi_type="ModelExchange", input=inp, output_interval=0.01, stop_time=10.0,
                                    output=["stator_speed_rad_s"])["stator_speed_rad_s"]
         assert stator[0] == 0.0 and stator[-1] > 0.0  # locked at stall, released past the coupling point
+
+
+def test_start_values_override_the_steady_state(fmus):
+    """Initialisation matches tcsim replay (the steady state consistent with the inputs) unless the
+    start values are set: start_from_steady_state = 0 and initial_*."""
+    path = str(fmus[("hrovat-tobler", "pump-torque")])
+    inp = np.array([(0.0, 100.0, 0.0), (0.1, 100.0, 0.0)], dtype=[("time", float), ("pump_torque_nm", float), ("turbine_speed_rad_s", float)])
+    steady = fmpy.simulate_fmu(path, fmi_type="CoSimulation", input=inp, output_interval=0.01, stop_time=0.1)
+    replay = simulate(CONVERTER, PumpTorqueTurbineSpeed([0.0, 0.1], [100.0, 100.0], [0.0, 0.0]), model="hrovat-tobler")
+    assert steady["pump_speed_rad_s"][0] == pytest.approx(replay["pump_speed_rad_s"][0], rel=1e-9)
+    for fmi_type in ("CoSimulation", "ModelExchange"):
+        given = fmpy.simulate_fmu(path, fmi_type=fmi_type, input=inp, output_interval=0.01, stop_time=0.1,
+                                  start_values={"start_from_steady_state": 0.0, "initial_pump_speed_rad_s": 200.0,
+                                                "initial_flow_m3_s": 0.02})
+        assert given["pump_speed_rad_s"][0] == pytest.approx(200.0) and given["flow_m3_s"][0] == pytest.approx(0.02)

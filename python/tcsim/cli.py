@@ -152,7 +152,7 @@ def export_fmu(
     out: Annotated[Path, typer.Option("--out", "-o", help="the FMU file to write (*.fmu)")],
     causality: Annotated[str, typer.Option("--causality", help="pump-torque (pump torque and turbine speed in) | speeds (both speeds in)")] = "pump-torque",
 ) -> None:
-    """Export one model as an FMI 2.0 Co-Simulation FMU (linux64 binary, sources to rebuild elsewhere; no Python inside)."""
+    """Export one model as an FMI 2.0 FMU, Model Exchange and Co-Simulation (linux64 binary, sources to rebuild elsewhere; no Python inside)."""
     from .fmu import export_fmu_command
 
     stdout.print(export_fmu_command(converter, model, out, causality), highlight=False, soft_wrap=True)

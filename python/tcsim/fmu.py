@@ -1,4 +1,5 @@
-"""``tcsim export-fmu``: a converter model as an FMI 2.0 Co-Simulation FMU, with no Python inside.
+"""``tcsim export-fmu``: a converter model as an FMI 2.0 FMU (Model Exchange and Co-Simulation), with
+no Python inside.
 
 ::
 
@@ -354,6 +355,14 @@ def model_description_xml(model: DynamicModel, causality: str = "pump-torque", m
         if name in RATE_INPUTS:
             vr, rate, text = RATE_INPUTS[name]
             variable(rate, vr, text, 'causality="input" variability="continuous"', 'unit="rad/s2" start="0"')
+    variable("start_from_steady_state", 30,
+             "1: start at the steady state consistent with the inputs (as tcsim replay); 0: at the initial_* values",
+             'causality="parameter" variability="fixed" initial="exact"', 'unit="1" start="1"')
+    for name, vr, unit, start in (("pump_speed_rad_s", 31, "rad/s", 150.0), ("stator_speed_rad_s", 32, "rad/s", 0.0),
+                                  ("flow_m3_s", 33, "m3/s", 0.05)):
+        if name in index and name not in inputs:
+            variable(f"initial_{name}", vr, f"Initial {name.replace('_', ' ').rsplit(' ', 2)[0]} when start_from_steady_state = 0",
+                     'causality="parameter" variability="fixed" initial="exact"', f'unit="{unit}" start="{_fmt(start)}"')
     states = [(name, c) for name, c in _STATES if name in index and name not in inputs]
     derivatives = []
     for name, c in states:
@@ -564,7 +573,7 @@ Do not add `<SourceFiles>`: the sources are Rust, not the C an importing tool wo
 * `Cargo.toml`, `Cargo.lock`: the workspace (members `tcsim-core` and `tcsim-fmu` only) and the
   exact dependency versions tcsim was built with;
 * `crates/tcsim-core/`: the converter models and the transient engine (pure Rust);
-* `crates/tcsim-fmu/`: the FMI 2.0 C API (Co-Simulation).
+* `crates/tcsim-fmu/`: the FMI 2.0 C API (Model Exchange and Co-Simulation).
 {missing}
 License: MIT (`LICENSE`).
 """
@@ -690,7 +699,7 @@ def export_fmu_command(converter: str, model: str, out: Path, causality: str) ->
         params = json.loads(zf.read("resources/model.json"))["parameters"]
         platforms = sorted({n.split("/")[1] for n in zf.namelist() if n.startswith("binaries/")})
     inputs = CAUSALITIES[causality]
-    return (f"{model} model of {converter} written to {path} (FMI 2.0 Co-Simulation, {', '.join(platforms)}; "
+    return (f"{model} model of {converter} written to {path} (FMI 2.0 Model Exchange and Co-Simulation, {', '.join(platforms)}; "
             f"inputs {' and '.join(inputs)}; {len(params)} tunable parameters)")
 
 

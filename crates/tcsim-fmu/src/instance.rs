@@ -32,6 +32,10 @@ pub const SIGNALS: [&str; 14] = [
 pub const FIRST_DERIVATIVE: u32 = 20;
 /// Value reference of the first parameter.
 pub const FIRST_PARAMETER: u32 = 100;
+/// Start-value parameters: 30 `start_from_steady_state` (1: the steady state consistent with the
+/// inputs, as `tcsim replay`; 0: the values below), 31 `initial_pump_speed_rad_s`,
+/// 32 `initial_stator_speed_rad_s`, 33 `initial_flow_m3_s`.
+pub const START_PARAMETERS: std::ops::Range<u32> = 30..34;
 
 /// A parameter: the spec entry `model[key]` (scalar) or `model[key][index]`.
 #[derive(Debug, Clone)]
@@ -115,6 +119,8 @@ pub struct Instance {
     rates: [Option<f64>; 14],
     /// Model Exchange: the model, all coordinates, the mode and the time.
     me: Option<ModelExchange>,
+    /// Values of the start-value parameters (value references 30–33).
+    start: [f64; 4],
     /// Inputs at the previous communication point, for the rate estimate.
     previous: Option<(f64, [f64; 2])>,
     stepper: Option<Stepper<Box<dyn ConverterDynamics + Send>>>,
@@ -140,6 +146,7 @@ impl Instance {
             signals,
             rates: [None; 14],
             me: None,
+            start: [1.0, 150.0, 0.0, 0.05],
             previous: None,
             stepper: None,
             rebuild: false,
@@ -171,6 +178,9 @@ impl Instance {
     }
 
     pub fn get(&mut self, vr: u32) -> Option<f64> {
+        if START_PARAMETERS.contains(&vr) {
+            return Some(self.start[(vr - START_PARAMETERS.start) as usize]);
+        }
         let derivative = (FIRST_DERIVATIVE..FIRST_DERIVATIVE + 4).contains(&vr);
         let output = derivative || ((vr as usize) < SIGNALS.len() && !self.settable(vr as usize));
         if self.initializing && output {
@@ -190,6 +200,16 @@ impl Instance {
     /// Set a value; inputs any time, parameters before or between steps (tunable). Outputs are
     /// not settable.
     pub fn set(&mut self, vr: u32, value: f64) -> Result<(), String> {
+        if START_PARAMETERS.contains(&vr) {
+            if self.stepper.is_some() || (self.me.is_some() && !self.initializing) {
+                return Err("the start-value parameters are fixed after initialisation".into());
+            }
+            if !value.is_finite() {
+                return Err(format!("start-value parameter {vr} = {value}: expected a finite value"));
+            }
+            self.start[(vr - START_PARAMETERS.start) as usize] = value;
+            return Ok(());
+        }
         if (vr as usize) < SIGNALS.len() {
             if !self.settable(vr as usize) {
                 return Err(format!("{} is an output and cannot be set", SIGNALS[vr as usize]));
@@ -243,7 +263,7 @@ impl Instance {
         let mut stepper = Stepper::new(model, self.config.causality, self.options);
         let refs = self.input_refs();
         let rates = [self.rates[refs[0]].unwrap_or(0.0), self.rates[refs[1]].unwrap_or(0.0)];
-        let sample = stepper.initialize(self.start_time, self.inputs(), rates, &InitialState::default()).map_err(|e| e.to_string())?;
+        let sample = stepper.initialize(self.start_time, self.inputs(), rates, &self.initial()).map_err(|e| e.to_string())?;
         self.stepper = Some(stepper);
         self.previous = Some((self.start_time, self.inputs()));
         self.publish(&sample);
@@ -316,9 +336,21 @@ mod tests {
         inst.do_step(0.01, 0.01).unwrap();
         assert!((inst.get(3).unwrap() / 100.0 - 2.3).abs() < 1e-3);
         assert!(inst.set(3, 1.0).is_err());
+        assert!(inst.set(30, 0.0).is_err()); // fixed after initialisation
         assert!(inst.do_step(5.0, 0.01).is_err());
         inst.reset();
         assert_eq!(inst.get(101), Some(2.1));
+    }
+
+    #[test]
+    fn start_values_override_the_steady_state() {
+        let mut inst = Instance::new(Configuration::parse(CONFIG).unwrap());
+        inst.set(0, 100.0).unwrap();
+        inst.set(30, 0.0).unwrap();
+        inst.set(31, 123.0).unwrap();
+        inst.initialize().unwrap();
+        assert_eq!(inst.get(1), Some(123.0));
+        assert_eq!(inst.get(31), Some(123.0));
     }
 
     #[test]
@@ -342,6 +374,15 @@ pub struct ModelExchange {
 }
 
 impl Instance {
+    /// The initial state the start-value parameters ask for (none: the steady state).
+    fn initial(&self) -> InitialState {
+        if self.start[0] != 0.0 {
+            return InitialState::default();
+        }
+        let pump = if self.config.causality == Causality::PumpTorqueTurbineSpeed { Some(self.start[1]) } else { None };
+        InitialState { pump_speed_rad_s: pump, turbine_speed_rad_s: None, stator_speed_rad_s: Some(self.start[2]), flow_m3_s: Some(self.start[3]) }
+    }
+
     /// The drive of the current inputs and their rates (linear about the current time).
     fn me_drive(&self, t: f64) -> Result<Drive, String> {
         let line = |name: &str, value: f64, rate: f64| Signal::new(name, vec![t, t + 1.0], vec![value, value + rate], 0.0).map_err(|e| e.to_string());
@@ -356,7 +397,7 @@ impl Instance {
         let model = self.model().map_err(|e| e.to_string())?;
         let t = self.start_time;
         let drive = self.me_drive(t)?;
-        let u = initial_state(&model, &drive, t, &InitialState::default()).map_err(|e| e.to_string())?;
+        let u = initial_state(&model, &drive, t, &self.initial()).map_err(|e| e.to_string())?;
         let mode = initial_mode(&model, &drive, &u, t);
         let coordinates = ModeView::state_coordinates(&model, &drive);
         self.me = Some(ModelExchange { model, u, mode, time_s: t, coordinates });
