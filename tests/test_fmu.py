@@ -495,3 +495,25 @@ def test_start_values_override_the_steady_state(fmus):
                                   start_values={"start_from_steady_state": 0.0, "initial_pump_speed_rad_s": 200.0,
                                                 "initial_flow_m3_s": 0.02})
         assert given["pump_speed_rad_s"][0] == pytest.approx(200.0) and given["flow_m3_s"][0] == pytest.approx(0.02)
+
+
+@pytest.mark.parametrize("fmi_type", ["ModelExchange", "CoSimulation"])
+def test_tip_out_flow_events_in_both_interfaces(fmus, fmi_type):
+    """A tip-out (pump torque 250 → −30 N·m at 5 s) with the turbine still driven: the stator
+    releases, the flow stops and is held at zero, then starts again (the engine's events); both
+    interfaces follow the engine run within the 0.5 % tube."""
+    path = str(fmus[("hrovat-tobler", "pump-torque")])
+    knots, torque = [0.0, 0.1, 0.3, 5.0, 5.1, 8.0], [40.0, 40.0, 250.0, 250.0, -30.0, -30.0]
+    t = np.round(np.arange(0.0, 8.0 + 1e-9, 1e-3), 6)
+    inp = np.array(list(zip(t, np.interp(t, knots, torque), 32.0 * t, np.full_like(t, 32.0))),
+                   dtype=[("time", float), ("pump_torque_nm", float), ("turbine_speed_rad_s", float), ("turbine_accel_rad_s2", float)])
+    res = fmpy.simulate_fmu(path, fmi_type=fmi_type, input=inp, output_interval=1e-3, stop_time=8.0,
+                            output=["pump_speed_rad_s", "turbine_torque_nm", "flow_m3_s"])
+    ref = simulate(CONVERTER, PumpTorqueTurbineSpeed(knots, torque, [32.0 * k for k in knots], derivative_window_s=0.0),
+                   model="hrovat-tobler", times_s=t)
+    assert [e.kind for e in ref.events] == ["stator-release", "flow-zero", "flow-start"]
+    held = (res["time"] > 5.3) & (res["time"] < 6.4)
+    assert np.abs(res["flow_m3_s"][held]).max() < 1e-6  # held at zero between the events
+    for col in ("pump_speed_rad_s", "turbine_torque_nm"):
+        excess = _tube_excess(res["time"], res[col], ref["time_s"], ref[col], 1e-3)
+        assert excess.max() == 0.0, (col, excess.max())
