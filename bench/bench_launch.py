@@ -30,14 +30,13 @@ Target (issue 4): the three-model comparison under 50 ms of compute.
 from __future__ import annotations
 
 import os
-import statistics
 import sys
-import time
 
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
 import scipy_vehicle as ref  # noqa: E402
+from timing import median_and_fastest  # noqa: E402
 
 import tcsim._core as core  # noqa: E402
 from tcsim.transient import dynamic_model  # noqa: E402
@@ -53,14 +52,8 @@ SPEED_TOL_M_S = 1e-2
 
 def median_time(fn, repeats: int) -> float:
     """Median wall time of ``repeats`` calls after a warm-up; the fastest is kept in ``FASTEST``."""
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    FASTEST[fn] = min(times)
-    return statistics.median(times)
+    median, FASTEST[fn] = median_and_fastest(fn, repeats)
+    return median
 
 
 FASTEST: dict = {}

@@ -21,7 +21,6 @@ runs in under 10 s on 2 cores.
 from __future__ import annotations
 
 import os
-import statistics
 import sys
 import time
 
@@ -29,6 +28,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
 import scipy_reference as ref  # noqa: E402
+from timing import median_and_fastest  # noqa: E402
 
 from tcsim.transient import dynamic_model, isolated_takeoff, simulate, simulate_batch  # noqa: E402
 
@@ -42,13 +42,7 @@ BATCH_TIMES = np.linspace(0.0, 10.0, 101)
 
 
 def median_time(fn, repeats: int) -> float:
-    fn()  # warm-up
-    times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return statistics.median(times)
+    return median_and_fastest(fn, repeats)[0]
 
 
 def check_agreement(ours, theirs, label: str) -> None:

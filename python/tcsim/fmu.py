@@ -49,9 +49,9 @@ from typing import Any, Sequence, Union
 from xml.sax.saxutils import quoteattr
 
 from . import _core
-from .converter import MODELS, Converter, load_converter
+from .converter import MODELS, Converter
 from .errors import InputError, TcsimWarning
-from .transient import DynamicModel, PumpTorqueTurbineSpeed, SolverError, Speeds, dynamic_model, simulate
+from .transient import DynamicModel, PumpTorqueTurbineSpeed, SolverError, Speeds, resolve_model, simulate
 
 #: ``modelIdentifier`` of the FMU: the binary is ``binaries/<platform>/tcsim_converter.<ext>``.
 MODEL_IDENTIFIER = "tcsim_converter"
@@ -645,15 +645,7 @@ def export_fmu(converter: Union[Converter, str, Path, DynamicModel, None], model
     atomically. Returns the path."""
     _check_causality(causality)
     out = _output_path(out_path)
-    if isinstance(model, DynamicModel):
-        dyn = model
-    elif isinstance(converter, DynamicModel):
-        dyn = converter
-    else:
-        if model not in MODELS:
-            raise InputError("command line", "--model", model, f"one of {', '.join(MODELS)}")
-        conv = converter if isinstance(converter, Converter) else load_converter(str(converter))
-        dyn = dynamic_model(conv, model)
+    dyn = resolve_model(converter if isinstance(converter, (Converter, DynamicModel)) else str(converter), model)
     _check_model(dyn, causality)
     xml = model_description_xml(dyn, causality)
     config = model_json(dyn, causality)

@@ -37,7 +37,7 @@ from .converter import Converter, load_converter
 from .effective import measured_effective_torques, smoothed_rate  # noqa: F401 (re-exported)
 from .errors import InputError
 from .measurement import Measurement, parse_channel_map, read_measurement
-from .transient import (DERIVATIVE_WINDOW_S, DynamicModel, PumpTorqueTurbineSpeed, SolverError, Speeds,
+from .transient import (DERIVATIVE_WINDOW_S, DynamicModel, resolve_model, PumpTorqueTurbineSpeed, SolverError, Speeds,
                         TransientResult, dynamic_model, simulate_batch)
 
 MODELS = ("quasi-dynamic", "hrovat-tobler")
@@ -130,18 +130,7 @@ def _inadmissible_note(bound: MassMatrixBound, pump_m2: float, turbine_m2: float
 
 def _model(converter: Union[Converter, str, DynamicModel], model: Union[str, DynamicModel]) -> DynamicModel:
     """The dynamic model to fit or sweep; only the two models with shape effects."""
-    if isinstance(model, DynamicModel):
-        m = model
-    elif isinstance(converter, DynamicModel):
-        m = converter
-    else:
-        if model not in MODELS:
-            raise InputError("command line", "--model", model,
-                             f"one of {', '.join(MODELS)} (the table model has no shape effects)")
-        m = dynamic_model(converter, model)
-    if m.name not in MODELS:
-        raise InputError("command line", "--model", m.name, f"one of {', '.join(MODELS)} (the table model has no shape effects)")
-    return m
+    return resolve_model(converter, model, MODELS, " (the table model has no shape effects)")
 
 
 def _runs(models: Sequence[DynamicModel], drive, times_s, rtol: float | None) -> list[TransientResult | str]:

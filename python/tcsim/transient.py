@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from . import _core
-from .converter import Converter, load_converter
+from .converter import MODELS, Converter, load_converter
 from .errors import InputError, core_value
 
 #: Default width of the smoothing window of measured-speed derivatives, s (see docs/transient.md).
@@ -140,6 +140,25 @@ def dynamic_model(converter: Union[Converter, str], model: str = "hrovat-tobler"
         tau = qd.flow_time_constant_s
         spec["flow_time_constant_s"] = tau if tau is not None else default_flow_time_constant_s(conv)
     return DynamicModel(model, spec, conv.path)
+
+
+def resolve_model(converter: Union[Converter, str, "DynamicModel", None], model: Union[str, "DynamicModel"],
+                  allowed: Sequence[str] = MODELS, why: str = "") -> DynamicModel:
+    """A :class:`DynamicModel` given directly (as ``model``, or as ``converter``), or the model named
+    ``model`` of ``converter`` (a :class:`Converter`, bundled name or file). A model outside
+    ``allowed`` is an InputError on ``--model`` (``why`` explains the restriction)."""
+    expected = f"one of {', '.join(allowed)}{why}"
+    if isinstance(model, DynamicModel):
+        m = model
+    elif isinstance(converter, DynamicModel):
+        m = converter
+    else:
+        if model not in allowed:
+            raise InputError("command line", "--model", model, expected)
+        m = dynamic_model(converter, model)
+    if m.name not in allowed:
+        raise InputError("command line", "--model", m.name, expected)
+    return m
 
 
 # ---------------------------------------------------------------------------------------------

@@ -1044,16 +1044,8 @@ fn switch(plant: &Plant, root: Root, u: &mut [f64; N], t: f64) -> (VehicleMode, 
             m.shift = None;
         }
         Root::LockupEngage => m.lockup = LockupState::Engaging { since_s: t, ramped: false, armed: false },
-        Root::LockupRamped => {
-            let slip = u[PUMP] - u[TURBINE];
-            if slip.abs() <= SYNC_SLIP_RAD_S {
-                m.lockup = LockupState::Locked;
-            } else {
-                m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: true };
-                sync = slip.signum();
-            }
-        }
-        Root::LockupArm => {
+        // the ramp is over, or a clutch that broke away has slipped long enough: lock now or arm
+        Root::LockupRamped | Root::LockupArm => {
             let slip = u[PUMP] - u[TURBINE];
             if slip.abs() <= SYNC_SLIP_RAD_S {
                 m.lockup = LockupState::Locked;
