@@ -1,0 +1,95 @@
+"""The runs behind the golden results: each takes a fresh output folder and the golden data
+folder, runs one command of the public command line in-process, and returns its result files as
+frames (decimated where a file is long), keyed by their path under the run's golden folder."""
+
+from __future__ import annotations
+
+import tomllib
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from tcsim.cli import main
+
+Frames = dict[str, pd.DataFrame]
+
+# Li & Sundén (2016) Table C.1, CF in N·m/(rad/s)²
+C1 = pd.DataFrame(
+    {
+        "speed_ratio": [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
+        "torque_ratio": [2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
+        "capacity_factor_nm_s2": [3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3,
+                                  2.713e-3, 2.481e-3, 2.370e-3, 1.842e-3, 1.237e-3, 0.187e-3],
+    }
+)
+
+
+def make_measurement(path: Path) -> None:
+    """A synthetic take-off: Hrovat & Tobler under the isolated take-off drive, 0–3 s at 1 kHz."""
+    from tcsim import transient
+
+    t = np.round(np.arange(3001) * 1e-3, 12)
+    run = transient.simulate("li-sunden-2016", transient.isolated_takeoff(), "hrovat-tobler", times_s=t)
+    f = run.frame()[["time_s", "pump_torque_nm", "turbine_speed_rad_s", "pump_speed_rad_s", "turbine_torque_nm"]]
+    f.to_csv(path, index=False, float_format="%.17g")
+
+
+def _run(*args: str) -> None:
+    code = main([str(a) for a in args])
+    if code != 0:
+        raise RuntimeError(f"tcsim {' '.join(args)} exited {code}")
+
+
+def _every(frame: pd.DataFrame, n: int) -> pd.DataFrame:
+    return frame.iloc[::n].reset_index(drop=True)
+
+
+def launch(out: Path, data: Path) -> Frames:
+    _run("launch", "--out", out)
+    frames = {"summary.csv": pd.read_csv(out / "summary.csv")}
+    for model in ("table", "hrovat-tobler", "quasi-dynamic"):
+        frames[f"{model}.csv"] = _every(pd.read_csv(out / f"{model}.csv"), 50)
+    return frames
+
+
+def replay(out: Path, data: Path) -> Frames:
+    _run("replay", "li-sunden-2016", data / "takeoff_measurement.csv", "--out", out)
+    frames = {"metrics.csv": pd.read_csv(out / "metrics.csv")}
+    for model in ("table", "hrovat-tobler", "quasi-dynamic"):
+        frames[f"{model}.csv"] = _every(pd.read_csv(out / f"{model}.csv"), 25)
+    return frames
+
+
+def characterise(out: Path, data: Path) -> Frames:
+    frames = {}
+    for model in ("hrovat-tobler", "table"):
+        _run("characterise", "li-sunden-2016", "--model", model, "--out", out / model)
+        frames[f"{model}.csv"] = pd.read_csv(out / model / "characteristic.csv")
+    return frames
+
+
+def study(out: Path, data: Path) -> Frames:
+    _run("study", "li-sunden-2016", "--out", out)
+    return {"study.csv": pd.read_csv(out / "study.csv")}
+
+
+def fit(out: Path, data: Path) -> Frames:
+    target = out.parent / "c1.csv"
+    C1.to_csv(target, index=False)
+    _run("fit", "li-sunden-2016", "--target", target, "--out", out)
+    fitted = tomllib.loads((out / "fitted.toml").read_text())
+    rows = [(f"{section}.{key}", float(value)) for section, table in sorted(fitted.items())
+            if isinstance(table, dict) for key, value in sorted(table.items())
+            if isinstance(value, (int, float)) and not isinstance(value, bool)]
+    return {"fitted.csv": pd.DataFrame(rows, columns=["parameter", "value"])}
+
+
+RUNS: dict[str, Callable[[Path, Path], Frames]] = {
+    "launch": launch,
+    "replay": replay,
+    "characterise": characterise,
+    "study": study,
+    "fit": fit,
+}
