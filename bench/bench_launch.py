@@ -36,10 +36,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
 import scipy_vehicle as ref  # noqa: E402
-from timing import median_and_fastest  # noqa: E402
-
 import tcsim._core as core  # noqa: E402
 from tcsim.transient import dynamic_model  # noqa: E402
+from timing import median_and_fastest  # noqa: E402
 
 CONVERTER = "li-sunden-2016-fitted"
 MODELS = ("table", "quasi-dynamic", "hrovat-tobler")
@@ -94,28 +93,47 @@ def agreement(ours: tuple, theirs: dict, label: str, stops: bool) -> dict:
     dwp = np.abs(np.asarray(cols["pump_speed_rad_s"])[:n] - theirs["pump_speed_rad_s"][:n])
     dwt = np.abs(np.asarray(cols["turbine_speed_rad_s"])[:n] - theirs["turbine_speed_rad_s"][:n])
     da = np.abs(np.asarray(cols["vehicle_accel_m_s2"])[:n] - theirs["vehicle_accel_m_s2"][:n])
-    mode_diff = int(np.sum((np.asarray(cols["gear"])[:n] != theirs["gear"][:n])
-                           | (np.asarray(cols["lockup_state"])[:n] != theirs["lockup_state"][:n])))
+    mode_diff = int(
+        np.sum(
+            (np.asarray(cols["gear"])[:n] != theirs["gear"][:n])
+            | (np.asarray(cols["lockup_state"])[:n] != theirs["lockup_state"][:n])
+        )
+    )
     if dv.max() > SPEED_TOL_M_S:
         raise SystemExit(f"{label}: speed traces differ by {dv.max():.3e} m/s at {t_a[int(dv.argmax())]:.2f} s")
-    return {"events": len(ev_ours), "dt_events": dt_events, "stop_ours": stop_ours, "stop_theirs": stop_theirs,
-            "dv": dv.max(), "dv_at": t_a[int(dv.argmax())], "dwp": dwp.max(), "dwt": dwt.max(), "da": da.max(),
-            "mode_diff": mode_diff, "samples": n, "kinds": sorted(set(kinds_ours)),
-            "v_end": (cols["vehicle_speed_m_s"][-1], theirs["vehicle_speed_m_s"][-1])}
+    return {
+        "events": len(ev_ours),
+        "dt_events": dt_events,
+        "stop_ours": stop_ours,
+        "stop_theirs": stop_theirs,
+        "dv": dv.max(),
+        "dv_at": t_a[int(dv.argmax())],
+        "dwp": dwp.max(),
+        "dwt": dwt.max(),
+        "da": da.max(),
+        "mode_diff": mode_diff,
+        "samples": n,
+        "kinds": sorted(set(kinds_ours)),
+        "v_end": (cols["vehicle_speed_m_s"][-1], theirs["vehicle_speed_m_s"][-1]),
+    }
 
 
 def print_agreement(agree: dict) -> None:
     for m, a in agree.items():
         line = f"  {m:<6} {a['events']} events, same kinds, order and gears; max event-time difference {a['dt_events']:.2e} s"
         if a["stop_ours"] is not None:
-            line += (f"; 100 km/h at {a['stop_ours']:.5f} s (tcsim) vs {a['stop_theirs']:.5f} s (SciPy), "
-                     f"difference {abs(a['stop_ours'] - a['stop_theirs']):.2e} s")
+            line += (
+                f"; 100 km/h at {a['stop_ours']:.5f} s (tcsim) vs {a['stop_theirs']:.5f} s (SciPy), "
+                f"difference {abs(a['stop_ours'] - a['stop_theirs']):.2e} s"
+            )
         else:
             line += f"; final speed {a['v_end'][0]:.3g} m/s (tcsim) vs {a['v_end'][1]:.3g} m/s (SciPy)"
         print(line)
-        print(f"         over {a['samples']} common samples: max |Δv| {a['dv']:.2e} m/s (at {a['dv_at']:.2f} s), "
-              f"|Δω_p| {a['dwp']:.2e} rad/s, |Δω_t| {a['dwt']:.2e} rad/s, |Δa| {a['da']:.2e} m/s², "
-              f"{a['mode_diff']} samples with another gear or lock-up state")
+        print(
+            f"         over {a['samples']} common samples: max |Δv| {a['dv']:.2e} m/s (at {a['dv_at']:.2f} s), "
+            f"|Δω_p| {a['dwp']:.2e} rad/s, |Δω_t| {a['dwt']:.2e} rad/s, |Δa| {a['da']:.2e} m/s², "
+            f"{a['mode_diff']} samples with another gear or lock-up state"
+        )
 
 
 def bundled_timing():
@@ -146,8 +164,9 @@ def main() -> None:
     agree = {m: agreement(table, sp[m], f"flip-flop: tcsim table vs SciPy {m}", True) for m in sp}
     coast_runs = tcsim_runs(specs, vehicle, coast)
     sp_coast = {m: ref.simulate(params, coast, method=m) for m in ("LSODA", "Radau")}
-    agree_coast = {m: agreement(coast_runs[0], sp_coast[m], f"coast and brake: tcsim table vs SciPy {m}", False)
-                   for m in sp_coast}
+    agree_coast = {
+        m: agreement(coast_runs[0], sp_coast[m], f"coast and brake: tcsim table vs SciPy {m}", False) for m in sp_coast
+    }
 
     def timed(fn, repeats):
         med = median_time(fn, repeats)
@@ -167,8 +186,10 @@ def main() -> None:
     print("tcsim events per model (time to 100 km/h from t = 0 / from the brake release):")
     for name, r in zip(MODELS, runs):
         stop, rel = r[2][-1][0], r[2][0][0]
-        print(f"  {name:<14} {len(r[2])} events, 100 km/h at {stop:.4f} s / {stop - rel:.4f} s, "
-              f"{len(r[1]['time_s'])} samples")
+        print(
+            f"  {name:<14} {len(r[2])} events, 100 km/h at {stop:.4f} s / {stop - rel:.4f} s, "
+            f"{len(r[1]['time_s'])} samples"
+        )
     print("\nAgreement, tcsim table model vs SciPy (same vehicle, scenario and table), flip-flop to 100 km/h:")
     print_agreement(agree)
     print(f"  (brake release at {release:.5f} s)")
@@ -178,20 +199,28 @@ def main() -> None:
     print("  tcsim events per model: " + ", ".join(f"{name} {len(r[2])}" for name, r in zip(MODELS, coast_runs)))
     print(f"\nTimings, median (fastest) of {REPEATS} after a warm-up; SciPy of {SCIPY_REPEATS}:")
     print("  flip-flop to 100 km/h")
-    print(f"  tcsim, three models, one launch_runs call, {os.cpu_count()} workers: {t3 * 1e3:8.2f} ms ({f3 * 1e3:.2f})  "
-          f"target < {TARGET_MS:.0f} ms: {'met' if t3 * 1e3 < TARGET_MS else 'NOT met'}")
-    print(f"  tcsim, three models, one worker:                 {t3_1 * 1e3:8.2f} ms ({f3_1 * 1e3:.2f})  "
-          f"target: {'met' if t3_1 * 1e3 < TARGET_MS else 'NOT met'}")
+    print(
+        f"  tcsim, three models, one launch_runs call, {os.cpu_count()} workers: {t3 * 1e3:8.2f} ms ({f3 * 1e3:.2f})  "
+        f"target < {TARGET_MS:.0f} ms: {'met' if t3 * 1e3 < TARGET_MS else 'NOT met'}"
+    )
+    print(
+        f"  tcsim, three models, one worker:                 {t3_1 * 1e3:8.2f} ms ({f3_1 * 1e3:.2f})  "
+        f"target: {'met' if t3_1 * 1e3 < TARGET_MS else 'NOT met'}"
+    )
     print(f"  tcsim, table model alone:                        {t1 * 1e3:8.2f} ms ({f1 * 1e3:.2f})")
     for m, (t, f) in scipy.items():
-        print(f"  SciPy solve_ivp {m:<5}, table model alone:       {t * 1e3:8.2f} ms ({f * 1e3:.2f})  "
-              f"ratio to tcsim table {t / t1:5.1f}×, to tcsim's three models {t / t3:5.1f}×")
+        print(
+            f"  SciPy solve_ivp {m:<5}, table model alone:       {t * 1e3:8.2f} ms ({f * 1e3:.2f})  "
+            f"ratio to tcsim table {t / t1:5.1f}×, to tcsim's three models {t / t3:5.1f}×"
+        )
     print("  coast and brake, 40 s")
     print(f"  tcsim, three models, one launch_runs call, {os.cpu_count()} workers: {c3 * 1e3:8.2f} ms ({g3 * 1e3:.2f})")
     print(f"  tcsim, table model alone:                        {c1 * 1e3:8.2f} ms ({g1 * 1e3:.2f})")
     for m, (t, f) in scipy_coast.items():
-        print(f"  SciPy solve_ivp {m:<5}, table model alone:       {t * 1e3:8.2f} ms ({f * 1e3:.2f})  "
-              f"ratio to tcsim table {t / c1:5.1f}×, to tcsim's three models {t / c3:5.1f}×")
+        print(
+            f"  SciPy solve_ivp {m:<5}, table model alone:       {t * 1e3:8.2f} ms ({f * 1e3:.2f})  "
+            f"ratio to tcsim table {t / c1:5.1f}×, to tcsim's three models {t / c3:5.1f}×"
+        )
     if bundled is not None:
         name, conv, tb = bundled
         print(f"  tcsim, three models, bundled vehicle {name} ({conv}), flip-flop: {tb * 1e3:.2f} ms")

@@ -35,14 +35,25 @@ def reference_locked(g: dict, wp: float, wt: float) -> tuple[float, float, float
     """
     rho, A = g["fluid_density_kg_m3"], g["flow_area_m2"]
     rp, rt, rs = g["pump_exit_radius_m"], g["turbine_exit_radius_m"], g["stator_exit_radius_m"]
-    tp, tt, ts = (math.tan(math.radians(g[k])) for k in ("pump_exit_angle_deg", "turbine_exit_angle_deg", "stator_exit_angle_deg"))
-    tpp, ttt, tss = (math.tan(math.radians(g[k])) for k in ("pump_inlet_angle_deg", "turbine_inlet_angle_deg", "stator_inlet_angle_deg"))
+    tp, tt, ts = (
+        math.tan(math.radians(g[k])) for k in ("pump_exit_angle_deg", "turbine_exit_angle_deg", "stator_exit_angle_deg")
+    )
+    tpp, ttt, tss = (
+        math.tan(math.radians(g[k]))
+        for k in ("pump_inlet_angle_deg", "turbine_inlet_angle_deg", "stator_inlet_angle_deg")
+    )
     cp, ct, cs, f = g["pump_shock_loss"], g["turbine_shock_loss"], g["stator_shock_loss"], g["friction_loss"]
 
     def rhs(Q):
         q = Q / A
-        head = rho * (rp**2 * wp**2 + rt**2 * wt**2 - rp**2 * wt * wp) + rho * q * (wp * (rp * tp - rs * ts) + wt * (rt * tt - rp * tp))
-        shock = cp * (-rs * wp + q * (ts - tpp)) ** 2 + ct * (rp * (wp - wt) + q * (tp - ttt)) ** 2 + cs * (rt * wt + q * (tt - tss)) ** 2
+        head = rho * (rp**2 * wp**2 + rt**2 * wt**2 - rp**2 * wt * wp) + rho * q * (
+            wp * (rp * tp - rs * ts) + wt * (rt * tt - rp * tp)
+        )
+        shock = (
+            cp * (-rs * wp + q * (ts - tpp)) ** 2
+            + ct * (rp * (wp - wt) + q * (tp - ttt)) ** 2
+            + cs * (rt * wt + q * (tt - tss)) ** 2
+        )
         friction = f * q * q * (3 + tp**2 + tt**2 + ts**2)
         return head - rho / 2 * (shock + friction)
 
@@ -82,8 +93,10 @@ def main() -> None:
     # relative differences; the stator holding torque passes through zero at the coupling point,
     # so its difference is taken relative to the pump torque
     scale = {"stator_torque_nm": np.abs(out["pump_torque_nm"][idx])}
-    diffs = {c: float(np.max(np.abs(ref[:, k] - out[c][idx]) / scale.get(c, np.abs(out[c][idx]))))
-             for k, c in enumerate(("flow_m3_s", "pump_torque_nm", "turbine_torque_nm", "stator_torque_nm"))}
+    diffs = {
+        c: float(np.max(np.abs(ref[:, k] - out[c][idx]) / scale.get(c, np.abs(out[c][idx]))))
+        for k, c in enumerate(("flow_m3_s", "pump_torque_nm", "turbine_torque_nm", "stator_torque_nm"))
+    }
     err = max(diffs.values())
     assert err < 1e-8, f"reference and tcsim disagree: {diffs}"
 
@@ -91,8 +104,10 @@ def main() -> None:
     print(f"{'implementation':<34}{'points/s':>14}{'µs/point':>12}")
     print(f"{'tcsim (batched closed form, core)':<34}{rate:>14.3e}{1e6 * t_tcsim:>12.4f}")
     print(f"{'SciPy brentq per point (locked)':<34}{1 / t_ref:>14.3e}{1e6 * t_ref:>12.4f}")
-    print(f"speed-up tcsim / SciPy: {t_ref / t_tcsim:,.0f}x  ({N:,} tcsim points, median of {REPEATS}; "
-          f"SciPy on {len(idx)} locked points, extrapolated per point)")
+    print(
+        f"speed-up tcsim / SciPy: {t_ref / t_tcsim:,.0f}x  ({N:,} tcsim points, median of {REPEATS}; "
+        f"SciPy on {len(idx)} locked points, extrapolated per point)"
+    )
     print("agreement (max relative difference): " + ", ".join(f"{c} {d:.1e}" for c, d in diffs.items()))
     print(f"requirement >= 1e6 points/s: {'met' if rate >= 1e6 else 'NOT met'}")
 

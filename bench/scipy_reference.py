@@ -48,13 +48,27 @@ def load_parameters(path=DEFAULT) -> dict:
     i, g = d["inertia"], d["geometry"]
     tan = lambda key: math.tan(math.radians(g[key]))  # noqa: E731
     return dict(
-        Ip=i["pump_kg_m2"], It=i["turbine_kg_m2"], Is=i["stator_kg_m2"],
-        rho=g["fluid_density_kg_m3"], A=g["flow_area_m2"],
-        Rp=g["pump_exit_radius_m"], Rt=g["turbine_exit_radius_m"], Rs=g["stator_exit_radius_m"],
-        tp=tan("pump_exit_angle_deg"), tt=tan("turbine_exit_angle_deg"), ts=tan("stator_exit_angle_deg"),
-        tpp=tan("pump_inlet_angle_deg"), ttt=tan("turbine_inlet_angle_deg"), tss=tan("stator_inlet_angle_deg"),
-        Cp=g["pump_shock_loss"], Ct=g["turbine_shock_loss"], Cs=g["stator_shock_loss"], f=g["friction_loss"],
-        Lf=g["fluid_length_m"], Sp=g["pump_shape_effect_m2"], St=g["turbine_shape_effect_m2"],
+        Ip=i["pump_kg_m2"],
+        It=i["turbine_kg_m2"],
+        Is=i["stator_kg_m2"],
+        rho=g["fluid_density_kg_m3"],
+        A=g["flow_area_m2"],
+        Rp=g["pump_exit_radius_m"],
+        Rt=g["turbine_exit_radius_m"],
+        Rs=g["stator_exit_radius_m"],
+        tp=tan("pump_exit_angle_deg"),
+        tt=tan("turbine_exit_angle_deg"),
+        ts=tan("stator_exit_angle_deg"),
+        tpp=tan("pump_inlet_angle_deg"),
+        ttt=tan("turbine_inlet_angle_deg"),
+        tss=tan("stator_inlet_angle_deg"),
+        Cp=g["pump_shock_loss"],
+        Ct=g["turbine_shock_loss"],
+        Cs=g["stator_shock_loss"],
+        f=g["friction_loss"],
+        Lf=g["fluid_length_m"],
+        Sp=g["pump_shape_effect_m2"],
+        St=g["turbine_shape_effect_m2"],
         Ss=g["stator_shape_effect_m2"],
     )
 
@@ -69,9 +83,15 @@ def takeoff_scenario(tip_out: bool = False) -> dict:
     times, torques = [0.0, 0.1, 0.3, 10.0], [40.0, 40.0, 250.0, 250.0]
     if tip_out:
         times, torques = [0.0, 0.1, 0.3, 5.0, 5.1, 10.0], [40.0, 40.0, 250.0, 250.0, -30.0, -30.0]
-    return dict(t_span=(0.0, 10.0), pump_torque_times_s=times, pump_torque_nm=torques,
-                load_inertia_kg_m2=1.2, load_torque_nm=10.0, load_drag_nm_s2=0.002,
-                turbine_speed0_rad_s=0.0)
+    return dict(
+        t_span=(0.0, 10.0),
+        pump_torque_times_s=times,
+        pump_torque_nm=torques,
+        load_inertia_kg_m2=1.2,
+        load_torque_nm=10.0,
+        load_drag_nm_s2=0.002,
+        turbine_speed0_rad_s=0.0,
+    )
 
 
 class Model:
@@ -85,9 +105,15 @@ class Model:
         self.IL, self.T0, self.cd = sc["load_inertia_kg_m2"], sc["load_torque_nm"], sc["load_drag_nm_s2"]
         self.tq_t, self.tq_v = np.asarray(sc["pump_torque_times_s"]), np.asarray(sc["pump_torque_nm"])
         # mass matrix (left-hand sides of eqs 2.12–2.15), load inertia added to the turbine
-        self.M = np.array([[self.Ip, 0, 0, rho * self.Sp], [0, self.It + self.IL, 0, rho * self.St],
-                           [0, 0, self.Is, rho * self.Ss],
-                           [rho * self.Sp, rho * self.St, rho * self.Ss, rho * self.Lf / A]], float)
+        self.M = np.array(
+            [
+                [self.Ip, 0, 0, rho * self.Sp],
+                [0, self.It + self.IL, 0, rho * self.St],
+                [0, 0, self.Is, rho * self.Ss],
+                [rho * self.Sp, rho * self.St, rho * self.Ss, rho * self.Lf / A],
+            ],
+            float,
+        )
         np.linalg.cholesky(self.M)  # raises unless M is positive definite (physics notes §4)
         # Euler-head coefficients of eq 2.15 and the friction constant of eqs 2.19, 2.23–2.25
         self.a = self.Rp * self.tp - self.Rs * self.ts
@@ -95,9 +121,13 @@ class Model:
         self.c = self.Rs * self.ts - self.Rt * self.tt
         self.kf = 0.5 * rho * self.f * (3 + self.tp**2 + self.tt**2 + self.ts**2)
         # shock velocities (eqs 2.20–2.22) are linear in u: V = dV @ u
-        self.dV = np.array([[-self.Rs, 0, self.Rs, (self.ts - self.tpp) / A],
-                            [self.Rp, -self.Rp, 0, (self.tp - self.ttt) / A],
-                            [0, self.Rt, -self.Rt, (self.tt - self.tss) / A]])
+        self.dV = np.array(
+            [
+                [-self.Rs, 0, self.Rs, (self.ts - self.tpp) / A],
+                [self.Rp, -self.Rp, 0, (self.tp - self.ttt) / A],
+                [0, self.Rt, -self.Rt, (self.tt - self.tss) / A],
+            ]
+        )
         self.C = np.array([self.Cp, self.Ct, self.Cs])
         self._modes = {}
 
@@ -108,8 +138,15 @@ class Model:
         """Eq 2.15 right-hand side without P_loss (Euler heads). u: (4,) or (4, n)."""
         wp, wt, ws, Q = u
         Rp2, Rt2, Rs2 = self.Rp**2, self.Rt**2, self.Rs**2
-        return self.rho * (Rp2 * wp * wp + Rt2 * wt * wt + Rs2 * ws * ws - Rs2 * wp * ws - Rp2 * wt * wp
-                           - Rt2 * ws * wt + Q / self.A * (wp * self.a + wt * self.b + ws * self.c))
+        return self.rho * (
+            Rp2 * wp * wp
+            + Rt2 * wt * wt
+            + Rs2 * ws * ws
+            - Rs2 * wp * ws
+            - Rp2 * wt * wp
+            - Rt2 * ws * wt
+            + Q / self.A * (wp * self.a + wt * self.b + ws * self.c)
+        )
 
     def shock(self, u):
         """(ρ/2) Σ C_sh,x V_sh,x², eqs 2.19–2.22 (P0 of the stuck test when Q = 0)."""
@@ -138,16 +175,21 @@ class Model:
         V = self.dV @ u
         dP = sigma * rho * (self.C * V) @ self.dV
         dP[3] += sigma * 2 * self.kf * q / A
-        return np.array([
-            [-rq * Rp2, 0.0, rq * Rs2, -rho * (hp - hs) - rq * self.a / A],
-            [rq * Rp2, -rq * Rt2, 0.0, -rho * (ht - hp) - rq * self.b / A],
-            [0.0, rq * Rt2, -rq * Rs2, -rho * (hs - ht) - rq * self.c / A],
-            [rho * (2 * Rp2 * wp - Rs2 * ws - Rp2 * wt + q * self.a) - dP[0],
-             rho * (2 * Rt2 * wt - Rp2 * wp - Rt2 * ws + q * self.b) - dP[1],
-             rho * (2 * Rs2 * ws - Rs2 * wp - Rt2 * wt + q * self.c) - dP[2],
-             rho * (wp * self.a + wt * self.b + ws * self.c) / A - dP[3]]])
+        return np.array(
+            [
+                [-rq * Rp2, 0.0, rq * Rs2, -rho * (hp - hs) - rq * self.a / A],
+                [rq * Rp2, -rq * Rt2, 0.0, -rho * (ht - hp) - rq * self.b / A],
+                [0.0, rq * Rt2, -rq * Rs2, -rho * (hs - ht) - rq * self.c / A],
+                [
+                    rho * (2 * Rp2 * wp - Rs2 * ws - Rp2 * wt + q * self.a) - dP[0],
+                    rho * (2 * Rt2 * wt - Rp2 * wp - Rt2 * ws + q * self.b) - dP[1],
+                    rho * (2 * Rs2 * ws - Rs2 * wp - Rt2 * wt + q * self.c) - dP[2],
+                    rho * (wp * self.a + wt * self.b + ws * self.c) / A - dP[3],
+                ],
+            ]
+        )
 
-    def mode(self, stator, sigma) -> "Mode":
+    def mode(self, stator, sigma) -> Mode:
         key = (stator, sigma)
         if key not in self._modes:
             self._modes[key] = Mode(self, stator, sigma)
@@ -207,9 +249,11 @@ class Mode:
 
     def events(self):
         """Terminal event functions of this mode, each with a `kind`."""
+
         def ev(fun, direction, kind):
             fun.terminal, fun.direction, fun.kind = True, direction, kind
             return fun
+
         full, out = self.full, []
         if self.stator == LOCKED and self.sigma:  # with Q ≡ 0 the holding torque is identically 0
             out.append(ev(lambda t, x: self.holding_torque(t, full(x)), -1, "stator_release"))
@@ -263,8 +307,17 @@ def simulate(params, scenario, method="LSODA", rtol=1e-6, atol=None, t_eval=None
     while t < t1:
         mode = m.mode(stator, sigma)
         evs = mode.events()
-        sol = solve_ivp(mode.rhs, (t, next(b for b in stops if b > t)), u[mode.free], method=method,
-                        jac=mode.jac, events=evs, dense_output=True, rtol=rtol, atol=atol[mode.free])
+        sol = solve_ivp(
+            mode.rhs,
+            (t, next(b for b in stops if b > t)),
+            u[mode.free],
+            method=method,
+            jac=mode.jac,
+            events=evs,
+            dense_output=True,
+            rtol=rtol,
+            atol=atol[mode.free],
+        )
         if sol.status < 0:
             raise RuntimeError(f"{method} failed at t = {t}: {sol.message}")
         nfev, njev = nfev + sol.nfev, njev + sol.njev
@@ -283,8 +336,12 @@ def simulate(params, scenario, method="LSODA", rtol=1e-6, atol=None, t_eval=None
             else:
                 sigma = 1 if kind == "flow_start+" else -1
             events.append((t, kind))
-            if (kind != "stator_release" and stator == LOCKED and sigma
-                    and m.mode(LOCKED, sigma).holding_torque(t, u) < 0):
+            if (
+                kind != "stator_release"
+                and stator == LOCKED
+                and sigma
+                and m.mode(LOCKED, sigma).holding_torque(t, u) < 0
+            ):
                 stator = FREE  # flow restarted against the clutch: it cannot hold a negative torque
                 events.append((t, "stator_release"))
             if len(events) > MAX_EVENTS:
@@ -305,10 +362,22 @@ def simulate(params, scenario, method="LSODA", rtol=1e-6, atol=None, t_eval=None
             ts[sel] = m.rho * m.Ss * ud[3] - F[2]
         loss[sel] = us[3] * ploss if mode.sigma else 0.0
         smode[sel], fsign[sel] = mode.stator, mode.sigma
-    return dict(time_s=t_eval, pump_speed_rad_s=U[0], turbine_speed_rad_s=U[1], stator_speed_rad_s=U[2],
-                flow_m3_s=U[3], pump_torque_nm=m.pump_torque(t_eval), turbine_torque_nm=tt,
-                stator_torque_nm=ts, stator_mode=smode.astype(int), flow_sign=fsign.astype(int),
-                loss_power_w=loss, events=events, nfev=nfev, njev=njev)
+    return dict(
+        time_s=t_eval,
+        pump_speed_rad_s=U[0],
+        turbine_speed_rad_s=U[1],
+        stator_speed_rad_s=U[2],
+        flow_m3_s=U[3],
+        pump_torque_nm=m.pump_torque(t_eval),
+        turbine_torque_nm=tt,
+        stator_torque_nm=ts,
+        stator_mode=smode.astype(int),
+        flow_sign=fsign.astype(int),
+        loss_power_w=loss,
+        events=events,
+        nfev=nfev,
+        njev=njev,
+    )
 
 
 def energy_residual(params, scenario, r) -> float:
@@ -333,10 +402,14 @@ def _self_check(p, sc):
         u = np.array([150.0, 90.0, 20.0, 0.03 * sigma]) * (1 + 0.1 * rng.standard_normal(4))
         F, ploss = m.forces(u, sigma)
         err_f = rel(_fd(lambda v: m.forces(v, sigma)[0], u, h), m.jacobian(u, sigma))
-        err_mode = max(rel(_fd(lambda x: md.rhs(0.5, x), u[md.free], h[md.free]), md.jac(0.5, u[md.free]))
-                       for md in (m.mode(st, sg) for st in (LOCKED, FREE) for sg in (sigma, 0)))
-        print(f"  sigma={sigma:+d}: dF/du vs FD {err_f:.1e}, mode Jacobians vs FD {err_mode:.1e}, power identity "
-              f"u·F + Q·Ploss = {u @ F + u[3] * ploss:.1e} (of Q·Ploss {u[3] * ploss:.3e})")
+        err_mode = max(
+            rel(_fd(lambda x: md.rhs(0.5, x), u[md.free], h[md.free]), md.jac(0.5, u[md.free]))
+            for md in (m.mode(st, sg) for st in (LOCKED, FREE) for sg in (sigma, 0))
+        )
+        print(
+            f"  sigma={sigma:+d}: dF/du vs FD {err_f:.1e}, mode Jacobians vs FD {err_mode:.1e}, power identity "
+            f"u·F + Q·Ploss = {u @ F + u[3] * ploss:.1e} (of Q·Ploss {u[3] * ploss:.3e})"
+        )
 
 
 def main():
@@ -356,22 +429,35 @@ def main():
                 r = simulate(p, sc, method=method)
                 times.append(time.perf_counter() - start)
             fine = simulate(p, sc, method=method, rtol=1e-8, atol=1e-8 * REF, t_eval=fine_t)
-            print(f"{method}: rtol 1e-6, median wall {1e3 * statistics.median(times):.1f} ms (of 5), "
-                  f"nfev {r['nfev']}, njev {r['njev']}")
+            print(
+                f"{method}: rtol 1e-6, median wall {1e3 * statistics.median(times):.1f} ms (of 5), "
+                f"nfev {r['nfev']}, njev {r['njev']}"
+            )
             for te, kind in r["events"]:
                 k = np.searchsorted(fine_t, te)
                 sr = fine["turbine_speed_rad_s"][k] / fine["pump_speed_rad_s"][k]
                 print(f"  event t = {te:.6f} s  {kind}  (SR ~ {sr:.4f})")
-            print("  final (rtol 1e-6): wp %.6f wt %.6f ws %.6f rad/s, Q %.8f m3/s" % tuple(r[k][-1] for k in STATE))
-            print("  final (rtol 1e-8): wp %.6f wt %.6f ws %.6f rad/s, Q %.8f m3/s; Tt %.4f Ts %.4f N m"
-                  % (*(fine[k][-1] for k in STATE), fine["turbine_torque_nm"][-1], fine["stator_torque_nm"][-1]))
+            print(
+                "  final (rtol 1e-6): wp {:.6f} wt {:.6f} ws {:.6f} rad/s, Q {:.8f} m3/s".format(
+                    *tuple(r[k][-1] for k in STATE)
+                )
+            )
+            print(
+                "  final (rtol 1e-8): wp {:.6f} wt {:.6f} ws {:.6f} rad/s, Q {:.8f} m3/s; Tt {:.4f} Ts {:.4f} N m".format(
+                    *(fine[k][-1] for k in STATE), fine["turbine_torque_nm"][-1], fine["stator_torque_nm"][-1]
+                )
+            )
             coarse = simulate(p, sc, method=method, t_eval=fine_t)
-            print(f"  energy residual / int|Tp wp|dt: rtol 1e-6 {energy_residual(p, sc, coarse):.2e}, "
-                  f"rtol 1e-8 {energy_residual(p, sc, fine):.2e}")
+            print(
+                f"  energy residual / int|Tp wp|dt: rtol 1e-6 {energy_residual(p, sc, coarse):.2e}, "
+                f"rtol 1e-8 {energy_residual(p, sc, fine):.2e}"
+            )
             kinds = [k for _, k in fine["events"]]
-            print(f"  stator released: {'stator_release' in kinds}, relocked: {'stator_lock' in kinds}, "
-                  f"Q reversed: {any(k in ('flow_zero->-1', 'flow_start-') for k in kinds)} "
-                  f"({len(kinds)} events at rtol 1e-8)")
+            print(
+                f"  stator released: {'stator_release' in kinds}, relocked: {'stator_lock' in kinds}, "
+                f"Q reversed: {any(k in ('flow_zero->-1', 'flow_start-') for k in kinds)} "
+                f"({len(kinds)} events at rtol 1e-8)"
+            )
 
 
 if __name__ == "__main__":

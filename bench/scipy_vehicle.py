@@ -119,8 +119,19 @@ SEDAN = {
         "front_axle_inertia_kg_m2": 2.2,
         "rear_axle_inertia_kg_m2": 2.2,
     },
-    "tyres": {"rolling_radius_m": 0.345, "friction_coefficient": 1.0, "slip_stiffness": 15.0, "front_load_fraction": 0.57},
-    "body": {"mass_kg": 2050.0, "drag_area_m2": 0.70, "rolling_resistance": 0.010, "air_density_kg_m3": 1.2, "grade_percent": 0.0},
+    "tyres": {
+        "rolling_radius_m": 0.345,
+        "friction_coefficient": 1.0,
+        "slip_stiffness": 15.0,
+        "front_load_fraction": 0.57,
+    },
+    "body": {
+        "mass_kg": 2050.0,
+        "drag_area_m2": 0.70,
+        "rolling_resistance": 0.010,
+        "air_density_kg_m3": 1.2,
+        "grade_percent": 0.0,
+    },
     "brake": {"capacity_nm": 6000.0, "front_fraction": 0.6},
 }
 
@@ -130,9 +141,13 @@ def load_table(path=CONVERTER) -> dict:
     with open(path, "rb") as fh:
         d = tomllib.load(fh)
     c, i = d["characteristic"], d["inertia"]
-    return {"speed_ratio": list(c["speed_ratio"]), "torque_ratio": list(c["torque_ratio"]),
-            "capacity_factor_nm_s2": list(c["capacity_factor_nm_s2"]),
-            "pump_kg_m2": i["pump_kg_m2"], "turbine_kg_m2": i["turbine_kg_m2"]}
+    return {
+        "speed_ratio": list(c["speed_ratio"]),
+        "torque_ratio": list(c["torque_ratio"]),
+        "capacity_factor_nm_s2": list(c["capacity_factor_nm_s2"]),
+        "pump_kg_m2": i["pump_kg_m2"],
+        "turbine_kg_m2": i["turbine_kg_m2"],
+    }
 
 
 def sedan_params(converter_path=CONVERTER) -> dict:
@@ -145,8 +160,13 @@ def flip_flop(pedal: float = 1.0, end_time_s: float = 30.0, stop_speed_m_s: floa
     1→0 together over 5.00–5.05 s; to ``stop_speed_m_s`` or ``end_time_s``. Keys as the binding's
     ``scenario_from``."""
     t = [0.0, 5.0, 5.05, end_time_s]
-    return {"time_s": t, "accelerator_pedal": [0.0, 0.0, pedal, pedal], "brake_pedal": [1.0, 1.0, 0.0, 0.0],
-            "end_time_s": end_time_s, "stop_speed_m_s": stop_speed_m_s}
+    return {
+        "time_s": t,
+        "accelerator_pedal": [0.0, 0.0, pedal, pedal],
+        "brake_pedal": [1.0, 1.0, 0.0, 0.0],
+        "end_time_s": end_time_s,
+        "stop_speed_m_s": stop_speed_m_s,
+    }
 
 
 def coast_and_brake(end_time_s: float = 40.0) -> dict:
@@ -154,8 +174,13 @@ def coast_and_brake(end_time_s: float = 40.0) -> dict:
     at idle for 5 s, full pedal from 5.05 s (brake off over 5.00–5.05 s), pedal off over 8.00–8.05 s,
     coasting, then the brake ramped to 0.6 over 20–20.5 s and held; no stop speed."""
     t = [0.0, 5.0, 5.05, 8.0, 8.05, 20.0, 20.5, end_time_s]
-    return {"time_s": t, "accelerator_pedal": [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
-            "brake_pedal": [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.6, 0.6], "end_time_s": end_time_s, "stop_speed_m_s": None}
+    return {
+        "time_s": t,
+        "accelerator_pedal": [0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+        "brake_pedal": [1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.6, 0.6],
+        "end_time_s": end_time_s,
+        "stop_speed_m_s": None,
+    }
 
 
 def _lerp_held(xs, ys, x):
@@ -174,27 +199,51 @@ class Vehicle:
     """Parameters as plain floats and lists, and the mode-independent component laws."""
 
     def __init__(self, p: dict, sc: dict):
-        e, g, lu, d, ty, b, br, c = (p[k] for k in ("engine", "gearbox", "lockup", "driveline", "tyres", "body", "brake", "converter"))
+        e, g, lu, d, ty, b, br, c = (
+            p[k] for k in ("engine", "gearbox", "lockup", "driveline", "tyres", "body", "brake", "converter")
+        )
         self.Ie, self.idle, self.K_gov = e["inertia_kg_m2"], e["idle_speed_rad_s"], e["idle_governor_gain_nm_s_per_rad"]
         self.fl_x, self.fl_y = list(e["full_load_speed_rad_s"]), list(e["full_load_torque_nm"])
         self.T0, self.c_drag = e["drag_torque_nm"], e["drag_nm_s_per_rad"]
         self.tau_f, self.tau_b, self.b_frac = e["fast_time_constant_s"], e["boost_time_constant_s"], e["boost_fraction"]
         self.ratios, self.eff, self.I_in = list(g["ratios"]), list(g["efficiencies"]), list(g["input_inertia_kg_m2"])
-        self.I_out, self.C_shift, self.t_handover = g["output_inertia_kg_m2"], g["shift_clutch_capacity_nm"], g["shift_handover_s"]
+        self.I_out, self.C_shift, self.t_handover = (
+            g["output_inertia_kg_m2"],
+            g["shift_clutch_capacity_nm"],
+            g["shift_handover_s"],
+        )
         self.up0, self.up1 = g["upshift_speed_zero_pedal_m_s"], g["upshift_speed_full_pedal_m_s"]
         self.dn0, self.dn1 = g["downshift_speed_zero_pedal_m_s"], g["downshift_speed_full_pedal_m_s"]
         self.C_lu, self.lu_static, self.t_engage = lu["capacity_nm"], lu["static_to_kinetic"], lu["engage_time_s"]
-        self.lu_min_gear, self.lu_v0, self.lu_v1 = lu["min_gear"], lu["engage_speed_zero_pedal_m_s"], lu["engage_speed_full_pedal_m_s"]
+        self.lu_min_gear, self.lu_v0, self.lu_v1 = (
+            lu["min_gear"],
+            lu["engage_speed_zero_pedal_m_s"],
+            lu["engage_speed_full_pedal_m_s"],
+        )
         self.i_fd = d["final_drive_ratio"]
         self.k = (d["front_shaft_stiffness_nm_per_rad"], d["rear_shaft_stiffness_nm_per_rad"])
         self.c = (d["front_shaft_damping_nm_s_per_rad"], d["rear_shaft_damping_nm_s_per_rad"])
         self.I_axle = (d["front_axle_inertia_kg_m2"], d["rear_axle_inertia_kg_m2"])
-        self.r_w, self.mu, self.C_slip, self.front_load = ty["rolling_radius_m"], ty["friction_coefficient"], ty["slip_stiffness"], ty["front_load_fraction"]
-        self.m, self.CdA, self.Crr, self.rho_air = b["mass_kg"], b["drag_area_m2"], b["rolling_resistance"], b["air_density_kg_m3"]
+        self.r_w, self.mu, self.C_slip, self.front_load = (
+            ty["rolling_radius_m"],
+            ty["friction_coefficient"],
+            ty["slip_stiffness"],
+            ty["front_load_fraction"],
+        )
+        self.m, self.CdA, self.Crr, self.rho_air = (
+            b["mass_kg"],
+            b["drag_area_m2"],
+            b["rolling_resistance"],
+            b["air_density_kg_m3"],
+        )
         a = math.atan(b["grade_percent"] / 100.0)
         self.sin_g, self.cos_g = math.sin(a), math.cos(a)
         self.C_brake, self.brake_front = br["capacity_nm"], br["front_fraction"]
-        self.sr_x, self.tr_y, self.cf_y = list(c["speed_ratio"]), list(c["torque_ratio"]), list(c["capacity_factor_nm_s2"])
+        self.sr_x, self.tr_y, self.cf_y = (
+            list(c["speed_ratio"]),
+            list(c["torque_ratio"]),
+            list(c["capacity_factor_nm_s2"]),
+        )
         self.Ip, self.It = c["pump_kg_m2"], c["turbine_kg_m2"]
         self.sc_t = list(sc["time_s"])
         self.sc_pedal, self.sc_brake = list(sc["accelerator_pedal"]), list(sc["brake_pedal"])
@@ -284,7 +333,9 @@ class Mode:
         # mass matrix (diagonal for the table model); per-gear input inertia, the off-going gear
         # during a shift
         i_gear = veh.I_in[shift[0] if shift else gear]
-        self.mdiag = np.array([veh.Ip + veh.Ie, veh.It + i_gear, veh.I_out, veh.I_axle[0], veh.I_axle[1], veh.m, 1.0, 1.0, 1.0, 1.0])
+        self.mdiag = np.array(
+            [veh.Ip + veh.Ie, veh.It + i_gear, veh.I_out, veh.I_axle[0], veh.I_axle[1], veh.m, 1.0, 1.0, 1.0, 1.0]
+        )
         # generalised coordinates u = P x, in the core's order of columns
         rep = [None] * N
         cols = []
@@ -398,7 +449,10 @@ class Mode:
         weight = veh.m * G * veh.cos_g
         brake = veh.brake_torque(t)
         root = math.sqrt(v * v + SLIP_SPEED_M_S * SLIP_SPEED_M_S)
-        for axle, load, share in ((WF, veh.front_load, veh.brake_front), (WR, 1.0 - veh.front_load, 1.0 - veh.brake_front)):
+        for axle, load, share in (
+            (WF, veh.front_load, veh.brake_front),
+            (WR, 1.0 - veh.front_load, 1.0 - veh.brake_front),
+        ):
             kappa = (veh.r_w * u[axle] - v) / root
             force = veh.mu * load * weight * math.tanh(veh.C_slip * kappa / veh.mu)
             f[axle] -= veh.r_w * force
@@ -482,8 +536,10 @@ class Mode:
     def events(self):
         out = []
         for kind in self.roots:
+
             def ev(t, x, kind=kind):
                 return self.root_value(kind, t, x)
+
             ev.terminal = True
             ev.direction = 0.0
             out.append(ev)
@@ -510,7 +566,9 @@ class Mode:
             return "stop"
         if st.wheels_held and self.brake_margin(ud, f, t) < 0.0:
             return "brake-release"
-        if st.lockup != OPEN and (st.gear + 1 < veh.lu_min_gear or u[V] < LOCKUP_RELEASE_FRACTION * veh.engage_speed(p)):
+        if st.lockup != OPEN and (
+            st.gear + 1 < veh.lu_min_gear or u[V] < LOCKUP_RELEASE_FRACTION * veh.engage_speed(p)
+        ):
             return "lockup-release"
         if st.shift is None and not st.wheels_held:
             if st.gear + 1 < len(veh.ratios) and u[V] > veh.upshift_speed(st.gear, p):
@@ -550,14 +608,16 @@ class Mode:
             slip = u[WP] - u[WT]
             if abs(slip) <= SYNC_SLIP_RAD_S:
                 return replace(st, lockup=LOCKED), "lockup-lock"
-            return replace(st, lockup=ENGAGING, lockup_since=ramped_since, ramped=True, armed=True,
-                           sync=math.copysign(1.0, slip)), name
+            return replace(
+                st, lockup=ENGAGING, lockup_since=ramped_since, ramped=True, armed=True, sync=math.copysign(1.0, slip)
+            ), name
         if kind == "lockup-arm":
             slip = u[WP] - u[WT]
             if abs(slip) <= SYNC_SLIP_RAD_S:
                 return replace(st, lockup=LOCKED), "lockup-lock"
-            return replace(st, lockup=ENGAGING, lockup_since=ramped_since, ramped=True, armed=True,
-                           sync=math.copysign(1.0, slip)), name
+            return replace(
+                st, lockup=ENGAGING, lockup_since=ramped_since, ramped=True, armed=True, sync=math.copysign(1.0, slip)
+            ), name
         if kind == "lockup-lock":
             return replace(st, lockup=LOCKED), name
         if kind == "lockup-release":
@@ -596,8 +656,14 @@ def initial_state(veh: Vehicle) -> np.ndarray:
     return u
 
 
-def simulate(params: dict, scenario: dict, method: str = "LSODA", rtol: float = 1e-6, output_step_s: float = 0.01,
-             atol_scale: float = 1.0) -> dict:
+def simulate(
+    params: dict,
+    scenario: dict,
+    method: str = "LSODA",
+    rtol: float = 1e-6,
+    output_step_s: float = 0.01,
+    atol_scale: float = 1.0,
+) -> dict:
     """Launch from the braked standstill with the table converter model.
 
     ``params``: :data:`SEDAN`-style sections plus ``"converter"`` (:func:`load_table`);
@@ -622,8 +688,20 @@ def simulate(params: dict, scenario: dict, method: str = "LSODA", rtol: float = 
 
     def record(mode, tt, xx):
         uu, ud, _ = mode.kinematics(tt, np.ascontiguousarray(xx))
-        rows.append((tt, uu[V], ud[V], uu[WP], uu[WT], uu[WO], uu[WF], uu[WR], mode.st.gear + 1,
-                     {OPEN: 0, ENGAGING: 1, LOCKED: 2}[mode.st.lockup]))
+        rows.append(
+            (
+                tt,
+                uu[V],
+                ud[V],
+                uu[WP],
+                uu[WT],
+                uu[WO],
+                uu[WF],
+                uu[WR],
+                mode.st.gear + 1,
+                {OPEN: 0, ENGAGING: 1, LOCKED: 2}[mode.st.lockup],
+            )
+        )
 
     while True:
         mode = Mode(veh, state)
@@ -635,8 +713,17 @@ def simulate(params: dict, scenario: dict, method: str = "LSODA", rtol: float = 
             j = bisect.bisect_right(times, t_stop, lo=i_out)
             # the samples of the span, and its end (for the state there) unless it is a sample
             t_eval = times[i_out:j] if j > i_out and times[j - 1] == t_stop else np.append(times[i_out:j], t_stop)
-            sol = solve_ivp(mode.rhs, (t, t_stop), x, method=method, rtol=rtol, atol=mode.atol(atol_scale),
-                            events=mode.events(), t_eval=t_eval, first_step=min(1e-5, t_stop - t))
+            sol = solve_ivp(
+                mode.rhs,
+                (t, t_stop),
+                x,
+                method=method,
+                rtol=rtol,
+                atol=mode.atol(atol_scale),
+                events=mode.events(),
+                t_eval=t_eval,
+                first_step=min(1e-5, t_stop - t),
+            )
             segments += 1
             nfev += sol.nfev
             if sol.status < 0:
@@ -668,8 +755,18 @@ def simulate(params: dict, scenario: dict, method: str = "LSODA", rtol: float = 
 
 
 def _result(rows, events, nfev, segments) -> dict:
-    cols = ("time_s", "vehicle_speed_m_s", "vehicle_accel_m_s2", "pump_speed_rad_s", "turbine_speed_rad_s",
-            "gearbox_output_speed_rad_s", "front_axle_speed_rad_s", "rear_axle_speed_rad_s", "gear", "lockup_state")
+    cols = (
+        "time_s",
+        "vehicle_speed_m_s",
+        "vehicle_accel_m_s2",
+        "pump_speed_rad_s",
+        "turbine_speed_rad_s",
+        "gearbox_output_speed_rad_s",
+        "front_axle_speed_rad_s",
+        "rear_axle_speed_rad_s",
+        "gear",
+        "lockup_state",
+    )
     a = np.array(rows, dtype=float).reshape(-1, len(cols))
     out = {c: a[:, i] for i, c in enumerate(cols)}
     out["events"] = events
@@ -682,13 +779,18 @@ def main():
     import time
 
     params = sedan_params()
-    for label, sc in (("flip-flop to 100 km/h", flip_flop(1.0, 30.0, 100.0 / 3.6)), ("coast and brake", coast_and_brake())):
+    for label, sc in (
+        ("flip-flop to 100 km/h", flip_flop(1.0, 30.0, 100.0 / 3.6)),
+        ("coast and brake", coast_and_brake()),
+    ):
         for method in ("LSODA", "Radau"):
             t0 = time.perf_counter()
             r = simulate(params, sc, method=method)
             dt = time.perf_counter() - t0
-            print(f"{label}, {method}: {dt * 1e3:.0f} ms, {r['nfev']} RHS calls, {r['segments']} segments, "
-                  f"{len(r['time_s'])} samples, final speed {r['vehicle_speed_m_s'][-1]:.6g} m/s")
+            print(
+                f"{label}, {method}: {dt * 1e3:.0f} ms, {r['nfev']} RHS calls, {r['segments']} segments, "
+                f"{len(r['time_s'])} samples, final speed {r['vehicle_speed_m_s'][-1]:.6g} m/s"
+            )
             for e in r["events"]:
                 print(f"  {e[0]:10.6f} s  {e[1]:<16} gear {e[2]}")
 

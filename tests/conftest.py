@@ -16,8 +16,21 @@ SHARED_CONVERTERS = REPO.parent / "shared" / "data" / "converters"
 # Li & Sundén (2016) Table C.1 with CF in N·m/(rad/s)²
 C1_SR = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0]
 C1_TR = [2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00]
-C1_CF = [3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3,
-         1.842e-3, 1.237e-3, 0.187e-3]
+C1_CF = [
+    3.272e-3,
+    3.257e-3,
+    3.228e-3,
+    3.181e-3,
+    3.112e-3,
+    3.017e-3,
+    2.887e-3,
+    2.713e-3,
+    2.481e-3,
+    2.370e-3,
+    1.842e-3,
+    1.237e-3,
+    0.187e-3,
+]
 
 
 @dataclass
@@ -30,8 +43,9 @@ class Run:
 def run_cli(*args: str, cwd: Path | None = None) -> Run:
     """Run ``python -m tcsim`` in a subprocess, as a user would."""
     env = dict(os.environ, COLUMNS="200")
-    p = subprocess.run([sys.executable, "-m", "tcsim", *map(str, args)], capture_output=True, text=True,
-                       cwd=cwd, env=env, timeout=300)
+    p = subprocess.run(
+        [sys.executable, "-m", "tcsim", *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=300
+    )
     return Run(p.returncode, p.stdout, p.stderr)
 
 

@@ -9,11 +9,10 @@ import pandas as pd
 import pytest
 
 import tcsim
+from conftest import C1_CF, C1_SR, C1_TR, SHARED_CONVERTERS
 from tcsim import _core
 from tcsim.converter import load_converter
 from tcsim.steady import characterise, coupling_point
-
-from conftest import C1_CF, C1_SR, C1_TR, SHARED_CONVERTERS
 
 WP = 2000 * math.pi / 30
 
@@ -124,11 +123,15 @@ def test_csv_import_in_every_capacity_convention(tmp_path, convention):
 
 def test_vecto_vtcc_import(tmp_path):
     p = tmp_path / "tc.vtcc"
-    p.write_text("# VECTO torque converter\nSpeed Ratio, Torque Ratio,MP1000\n0.0,1.80,377.80\n0.5,1.33,314.84\n"
-                 "1.0,1.0,0.00\n1.100,0.999,-40.0\n")
+    p.write_text(
+        "# VECTO torque converter\nSpeed Ratio, Torque Ratio,MP1000\n0.0,1.80,377.80\n0.5,1.33,314.84\n"
+        "1.0,1.0,0.00\n1.100,0.999,-40.0\n"
+    )
     conv = load_converter(p)
     w1000 = 1000 * math.pi / 30
-    np.testing.assert_allclose(conv.characteristic.capacity_factor_nm_s2, np.array([377.8, 314.84, 0.0, -40.0]) / w1000**2)
+    np.testing.assert_allclose(
+        conv.characteristic.capacity_factor_nm_s2, np.array([377.8, 314.84, 0.0, -40.0]) / w1000**2
+    )
     df = characterise(conv, "table", pump_speed_rpm=1000, speed_ratio=np.array([0.0, 1.1]))
     np.testing.assert_allclose(df["pump_torque_nm"], [377.8, -40.0], rtol=1e-12)
 
@@ -156,10 +159,19 @@ def test_bundled_fluid_parameters_come_from_the_torus_estimate(ls):
     from tcsim.torus import torus_estimate
 
     g = ls.geometry
-    e = torus_estimate(g.pump_exit_radius_m, g.turbine_exit_radius_m, g.stator_exit_radius_m,
-                       g.pump_inlet_angle_deg, g.pump_exit_angle_deg, g.turbine_inlet_angle_deg,
-                       g.turbine_exit_angle_deg, g.stator_inlet_angle_deg, g.stator_exit_angle_deg,
-                       g.flow_area_m2, g.fluid_density_kg_m3)
+    e = torus_estimate(
+        g.pump_exit_radius_m,
+        g.turbine_exit_radius_m,
+        g.stator_exit_radius_m,
+        g.pump_inlet_angle_deg,
+        g.pump_exit_angle_deg,
+        g.turbine_inlet_angle_deg,
+        g.turbine_exit_angle_deg,
+        g.stator_inlet_angle_deg,
+        g.stator_exit_angle_deg,
+        g.flow_area_m2,
+        g.fluid_density_kg_m3,
+    )
     assert g.fluid_length_m == pytest.approx(e.fluid_length_m, abs=5e-5)
     assert g.pump_shape_effect_m2 == pytest.approx(e.pump_shape_effect_m2, abs=5e-6)
     assert g.turbine_shape_effect_m2 == pytest.approx(e.turbine_shape_effect_m2, abs=5e-6)
@@ -168,8 +180,11 @@ def test_bundled_fluid_parameters_come_from_the_torus_estimate(ls):
     # is positive definite: ρL_f/A > ρ²S_p²/I_p + ρ²S_t²/I_t (+ the stator term)
     rho, A, i = g.fluid_density_kg_m3, g.flow_area_m2, ls.inertia
     lhs = rho * g.fluid_length_m / A
-    rhs = rho**2 * (g.pump_shape_effect_m2**2 / i.pump_kg_m2 + g.turbine_shape_effect_m2**2 / i.turbine_kg_m2
-                    + g.stator_shape_effect_m2**2 / i.stator_kg_m2)
+    rhs = rho**2 * (
+        g.pump_shape_effect_m2**2 / i.pump_kg_m2
+        + g.turbine_shape_effect_m2**2 / i.turbine_kg_m2
+        + g.stator_shape_effect_m2**2 / i.stator_kg_m2
+    )
     assert lhs > rhs
     # and the element inertias are at least the fluid they carry
     assert i.pump_kg_m2 > e.pump_fluid_inertia_kg_m2 and i.turbine_kg_m2 > e.turbine_fluid_inertia_kg_m2
@@ -184,9 +199,14 @@ def test_torus_bound_holds_for_any_angles():
         ang = rng.uniform(-75, 75, 6)
         e = torus_estimate(0.12, 0.065, 0.06, *ang, 0.01, 840.0)
         rho2 = 840.0**2
-        total = sum(rho2 * s_**2 / i for s_, i in ((e.pump_shape_effect_m2, e.pump_fluid_inertia_kg_m2),
-                                                    (e.turbine_shape_effect_m2, e.turbine_fluid_inertia_kg_m2),
-                                                    (e.stator_shape_effect_m2, e.stator_fluid_inertia_kg_m2)))
+        total = sum(
+            rho2 * s_**2 / i
+            for s_, i in (
+                (e.pump_shape_effect_m2, e.pump_fluid_inertia_kg_m2),
+                (e.turbine_shape_effect_m2, e.turbine_fluid_inertia_kg_m2),
+                (e.stator_shape_effect_m2, e.stator_fluid_inertia_kg_m2),
+            )
+        )
         assert total < 840.0 * e.fluid_length_m / 0.01
 
 
@@ -196,9 +216,19 @@ def test_characterise_command_writes_csv_and_plots(cli, tmp_path):
     assert r.code == 0, r.stderr
     assert "coupling point" in r.stdout
     df = pd.read_csv(out / "characteristic.csv")
-    for col in ("speed_ratio", "torque_ratio", "capacity_factor_nm_s2", "k_factor_rpm_per_sqrt_nm", "efficiency",
-                "pump_speed_rad_s", "pump_torque_nm", "turbine_torque_nm", "flow_m3_s", "stator_torque_nm",
-                "stator_speed_rad_s"):
+    for col in (
+        "speed_ratio",
+        "torque_ratio",
+        "capacity_factor_nm_s2",
+        "k_factor_rpm_per_sqrt_nm",
+        "efficiency",
+        "pump_speed_rad_s",
+        "pump_torque_nm",
+        "turbine_torque_nm",
+        "flow_m3_s",
+        "stator_torque_nm",
+        "stator_speed_rad_s",
+    ):
         assert col in df.columns
     for png in ("torque_ratio.png", "capacity_factor.png", "k_factor.png", "efficiency.png"):
         assert (out / png).stat().st_size > 10_000

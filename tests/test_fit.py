@@ -20,7 +20,7 @@ from tcsim import _core
 from tcsim.cli import main
 from tcsim.converter import Characteristic, load_converter
 from tcsim.errors import InputError, TcsimWarning
-from tcsim.fitting import DEFAULT_FREE, LOSSES, RADII, PUMP_SPEED_RAD_S, fit_hrovat_tobler, target_table
+from tcsim.fitting import DEFAULT_FREE, LOSSES, PUMP_SPEED_RAD_S, RADII, fit_hrovat_tobler, target_table
 
 SHARED_TABLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "converters"
 
@@ -48,8 +48,15 @@ def write_csv(table: Characteristic, path: Path) -> Path:
 # (1) recovery of known parameters
 
 #: Appendix D reference with three losses and three angles changed (the "truth").
-TRUTH = dict(pump_shock_loss=0.7, turbine_shock_loss=0.8, stator_shock_loss=1.3, friction_loss=0.3,
-             pump_exit_angle_deg=-25.0, turbine_exit_angle_deg=-45.0, turbine_inlet_angle_deg=50.0)
+TRUTH = dict(
+    pump_shock_loss=0.7,
+    turbine_shock_loss=0.8,
+    stator_shock_loss=1.3,
+    friction_loss=0.3,
+    pump_exit_angle_deg=-25.0,
+    turbine_exit_angle_deg=-45.0,
+    turbine_inlet_angle_deg=50.0,
+)
 GRID = np.round(np.arange(0.0, 0.8501, 0.05), 10)
 
 
@@ -246,6 +253,7 @@ def test_fit_runs_on_every_shared_table(path, bundled):
     assert r.rms_cf < np.sqrt(np.mean((cf0 / r.capacity_factor_table - 1) ** 2))
     if resized:  # the size is the whole difference: radii and area close it (measured 0.03–0.6 %)
         assert r.rms_tr < 0.01 and r.rms_cf < 0.01
-    print(f"\n{path.name}: SR 0–{r.speed_ratio_max:g}, {len(r.free)} free, CF(0) ratio {ratio:.2f}: "
-          f"RMS TR {100 * r.rms_tr:.2f} %, CF {100 * r.rms_cf:.2f} %; max {100 * r.max_tr:.2f} %, {100 * r.max_cf:.2f} %")
-
+    print(
+        f"\n{path.name}: SR 0–{r.speed_ratio_max:g}, {len(r.free)} free, CF(0) ratio {ratio:.2f}: "
+        f"RMS TR {100 * r.rms_tr:.2f} %, CF {100 * r.rms_cf:.2f} %; max {100 * r.max_tr:.2f} %, {100 * r.max_cf:.2f} %"
+    )

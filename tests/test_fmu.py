@@ -58,8 +58,9 @@ def fmu_library() -> Path:
         return Path(env.split(os.pathsep)[0])
     root = tfmu.source_root() or (REPO if (REPO / "crates" / "tcsim-fmu" / "Cargo.toml").is_file() else None)
     if root is not None and shutil.which("cargo"):
-        p = subprocess.run(["cargo", "build", "--release", "-p", "tcsim-fmu"], cwd=root, capture_output=True, text=True,
-                           timeout=1800)
+        p = subprocess.run(
+            ["cargo", "build", "--release", "-p", "tcsim-fmu"], cwd=root, capture_output=True, text=True, timeout=1800
+        )
         assert p.returncode == 0, p.stderr[-3000:]
         return root / "target" / "release" / tfmu.LIBRARY_FILE
     for profile in ("release", "debug"):
@@ -82,8 +83,11 @@ def library_env(fmu_library):
 def fmus(library_env, tmp_path_factory) -> dict[tuple[str, str], Path]:
     """The FMU of each model and causality."""
     out = tmp_path_factory.mktemp("fmus")
-    return {(m, c): tfmu.export_fmu(CONVERTER, m, out / f"{m}-{c}.fmu", causality=c)
-            for m in MODELS for c in tfmu.CAUSALITIES}
+    return {
+        (m, c): tfmu.export_fmu(CONVERTER, m, out / f"{m}-{c}.fmu", causality=c)
+        for m in MODELS
+        for c in tfmu.CAUSALITIES
+    }
 
 
 @pytest.fixture(scope="session")
@@ -95,8 +99,9 @@ def takeoff() -> dict[str, np.ndarray]:
 
 
 def _input(takeoff, names) -> np.ndarray:
-    return np.array(list(zip(takeoff["time"], *(takeoff[n] for n in names))),
-                    dtype=[("time", float)] + [(n, float) for n in names])
+    return np.array(
+        list(zip(takeoff["time"], *(takeoff[n] for n in names))), dtype=[("time", float)] + [(n, float) for n in names]
+    )
 
 
 def _tube_excess(t_fmu, y_fmu, t_ref, y_ref, time_tolerance_s: float) -> np.ndarray:
@@ -136,17 +141,28 @@ def test_fmu_contents(fmus, model):
         names = set(zf.namelist())
         config = json.loads(zf.read("resources/model.json"))
         readme = zf.read("sources/README.md").decode()
-    assert {"modelDescription.xml", "resources/model.json", "binaries/linux64/tcsim_converter.so",
-            "sources/README.md", "sources/Cargo.toml", "sources/Cargo.lock",
-            "sources/crates/tcsim-core/src/lib.rs", "sources/crates/tcsim-fmu/src/lib.rs"} <= names
+    assert {
+        "modelDescription.xml",
+        "resources/model.json",
+        "binaries/linux64/tcsim_converter.so",
+        "sources/README.md",
+        "sources/Cargo.toml",
+        "sources/Cargo.lock",
+        "sources/crates/tcsim-core/src/lib.rs",
+        "sources/crates/tcsim-fmu/src/lib.rs",
+    } <= names
     assert not any(n.endswith(".py") or n.endswith(".pyc") for n in names), "no Python inside"
     assert "win64" in readme and "darwin64" in readme and "cargo build --release -p tcsim-fmu" in readme
 
     # every numeric entry of the spec is a parameter, value reference 100 + i, start = spec value
     spec = dynamic_model(CONVERTER, model).spec
     assert config["causality"] == "pump-torque" and config["model"] == json.loads(json.dumps(spec))
-    expected = [(k, i) for k, v in spec.items() if not isinstance(v, str)
-                for i in (range(len(v)) if isinstance(v, list) else [0])]
+    expected = [
+        (k, i)
+        for k, v in spec.items()
+        if not isinstance(v, str)
+        for i in (range(len(v)) if isinstance(v, list) else [0])
+    ]
     assert [(p["key"], p["index"]) for p in config["parameters"]] == expected
 
     root = _model_description(path)
@@ -202,9 +218,13 @@ def test_cosimulation_matches_replay(fmus, takeoff, model):
     t, tp, wt = takeoff["time"], takeoff["pump_torque_nm"], takeoff["turbine_speed_rad_s"]
     dyn = dynamic_model(CONVERTER, model)
     ref = simulate(dyn, PumpTorqueTurbineSpeed(t, tp, wt))
-    res = fmpy.simulate_fmu(str(fmus[(model, "pump-torque")]), fmi_type="CoSimulation",
-                            input=_input(takeoff, ("pump_torque_nm", "turbine_speed_rad_s")),
-                            output_interval=STEP_S, stop_time=STOP_S)
+    res = fmpy.simulate_fmu(
+        str(fmus[(model, "pump-torque")]),
+        fmi_type="CoSimulation",
+        input=_input(takeoff, ("pump_torque_nm", "turbine_speed_rad_s")),
+        output_interval=STEP_S,
+        stop_time=STOP_S,
+    )
     assert res["time"][-1] == pytest.approx(STOP_S)
     later = res["time"] > 1.5 * STEP_S
     for col in ("pump_speed_rad_s", "turbine_torque_nm", "effective_turbine_torque_nm"):
@@ -224,8 +244,9 @@ def _step_with_rates(path: Path, inputs: tuple[str, str], t, a, b, h: float = ST
     vr = {v.name: v.valueReference for v in md.modelVariables}
     out_names = [v.name for v in md.modelVariables if v.causality == "output"]
     unzip = fmpy.extract(str(path))
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
-                      instanceName="rates")
+    slave = FMU2Slave(
+        guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier, instanceName="rates"
+    )
     ins = [vr[n] for n in inputs]
     outs = [vr[n] for n in out_names]
     try:
@@ -278,14 +299,21 @@ def test_speeds_causality_simulates(fmus, takeoff, model):
     within the 0.5 % tube at every communication point."""
     t, wp, wt = takeoff["time"], takeoff["pump_speed_rad_s"], takeoff["turbine_speed_rad_s"]
     path = fmus[(model, "speeds")]
-    res = fmpy.simulate_fmu(str(path), fmi_type="CoSimulation", input=_input(takeoff, ("pump_speed_rad_s", "turbine_speed_rad_s")),
-                            output_interval=STEP_S, stop_time=STOP_S)
+    res = fmpy.simulate_fmu(
+        str(path),
+        fmi_type="CoSimulation",
+        input=_input(takeoff, ("pump_speed_rad_s", "turbine_speed_rad_s")),
+        output_interval=STEP_S,
+        stop_time=STOP_S,
+    )
     assert res["time"][-1] == pytest.approx(STOP_S)
     for col in ("pump_torque_nm", "turbine_torque_nm", "speed_ratio", "effective_torque_ratio"):
         assert np.all(np.isfinite(res[col])), col
     ref = simulate(CONVERTER, Speeds(t, wp, wt), model=model)
     later = res["time"] > 1.5 * STEP_S
-    excess = _tube_excess(res["time"][later], res["turbine_torque_nm"][later], ref["time_s"], ref["turbine_torque_nm"], STEP_S)
+    excess = _tube_excess(
+        res["time"][later], res["turbine_torque_nm"][later], ref["time_s"], ref["turbine_torque_nm"], STEP_S
+    )
     assert excess.max() == 0.0, excess.max()
 
     ref = simulate(CONVERTER, Speeds(t, wp, wt, derivative_window_s=0.0), model=model)
@@ -341,7 +369,9 @@ def test_repeated_instantiate_reset_free_does_not_leak(fmus, model):
     rss = {}
     try:
         for cycle in range(1, 1001):
-            slave = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="tcsim_converter", instanceName=f"c{cycle}")
+            slave = FMU2Slave(
+                guid=md.guid, unzipDirectory=unzip, modelIdentifier="tcsim_converter", instanceName=f"c{cycle}"
+            )
             slave.instantiate()
             for _ in range(2):  # the second time after fmi2Reset
                 slave.setupExperiment(startTime=0.0)
@@ -374,7 +404,9 @@ def test_export_api_input_errors(library_env, tmp_path):
     with pytest.raises(InputError, match=r"\.fmu"):
         tfmu.export_fmu(CONVERTER, "table", tmp_path / "x.zip")
     with pytest.raises(InputError, match="shape_effect"):  # beyond the mass-matrix bound: refused at export
-        tfmu.export_fmu(dynamic_model(CONVERTER, "hrovat-tobler").with_shape_effects(0.5, 0.5), None, tmp_path / "x.fmu")
+        tfmu.export_fmu(
+            dynamic_model(CONVERTER, "hrovat-tobler").with_shape_effects(0.5, 0.5), None, tmp_path / "x.fmu"
+        )
     assert list(tmp_path.iterdir()) == []
 
 
@@ -407,10 +439,13 @@ def test_cli_export_fmu(cli, library_env, tmp_path):
     assert [p.name for p in out.parent.iterdir()] == ["ht.fmu"], "no temporary file left"
 
 
-@pytest.mark.parametrize("args, field", [
-    (("--model", "nonsense"), "--model"),
-    (("--model", "table", "--causality", "torques"), "--causality"),
-])
+@pytest.mark.parametrize(
+    "args, field",
+    [
+        (("--model", "nonsense"), "--model"),
+        (("--model", "table", "--causality", "torques"), "--causality"),
+    ],
+)
 def test_cli_export_fmu_bad_input_is_exit_2(cli, library_env, tmp_path, args, field):
     out = tmp_path / "x.fmu"
     r = cli("export-fmu", CONVERTER, *args, "-o", out)
@@ -443,8 +478,12 @@ def test_outputs_in_initialisation_mode_are_the_steady_state(fmus):
         slave.exitInitializationMode()
         after = slave.getReal([1, 3])
         assert during == pytest.approx(after, rel=1e-12)
-        steady = simulate(CONVERTER, PumpTorqueTurbineSpeed([0.0, 1.0], [120.0, 120.0], [50.0, 50.0]),
-                          model="hrovat-tobler", times_s=[0.0, 1e-6])
+        steady = simulate(
+            CONVERTER,
+            PumpTorqueTurbineSpeed([0.0, 1.0], [120.0, 120.0], [50.0, 50.0]),
+            model="hrovat-tobler",
+            times_s=[0.0, 1e-6],
+        )
         assert after[0] == pytest.approx(steady["pump_speed_rad_s"][0], rel=1e-9)
         slave.terminate()
     finally:
@@ -466,19 +505,43 @@ def test_model_exchange_with_cvode_matches_the_engine(fmus, model):
     t = np.round(np.arange(0.0, 10.0 + 1e-9, 0.01), 6)
     tp = np.interp(t, [0.0, 0.1, 0.3, 10.0], [40.0, 40.0, 250.0, 250.0])
     wt = 32.0 * t  # passes the coupling point: the stator releases (Hrovat & Tobler)
-    inp = np.array(list(zip(t, tp, wt, np.full_like(t, 32.0))), dtype=[("time", float), ("pump_torque_nm", float),
-                   ("turbine_speed_rad_s", float), ("turbine_accel_rad_s2", float)])
-    res = fmpy.simulate_fmu(path, fmi_type="ModelExchange", input=inp, output_interval=1e-3, stop_time=10.0,
-                            output=["pump_speed_rad_s", "turbine_torque_nm"])
-    ref = simulate(CONVERTER, PumpTorqueTurbineSpeed([0.0, 0.1, 0.3, 10.0], [40.0, 40.0, 250.0, 250.0],
-                                                     [0.0, 3.2, 9.6, 320.0], derivative_window_s=0.0),
-                   model=model, times_s=np.round(np.arange(0.0, 10.0 + 1e-9, 1e-3), 6))
+    inp = np.array(
+        list(zip(t, tp, wt, np.full_like(t, 32.0))),
+        dtype=[
+            ("time", float),
+            ("pump_torque_nm", float),
+            ("turbine_speed_rad_s", float),
+            ("turbine_accel_rad_s2", float),
+        ],
+    )
+    res = fmpy.simulate_fmu(
+        path,
+        fmi_type="ModelExchange",
+        input=inp,
+        output_interval=1e-3,
+        stop_time=10.0,
+        output=["pump_speed_rad_s", "turbine_torque_nm"],
+    )
+    ref = simulate(
+        CONVERTER,
+        PumpTorqueTurbineSpeed(
+            [0.0, 0.1, 0.3, 10.0], [40.0, 40.0, 250.0, 250.0], [0.0, 3.2, 9.6, 320.0], derivative_window_s=0.0
+        ),
+        model=model,
+        times_s=np.round(np.arange(0.0, 10.0 + 1e-9, 1e-3), 6),
+    )
     for col in ("pump_speed_rad_s", "turbine_torque_nm"):
         excess = _tube_excess(res["time"], res[col], ref["time_s"], ref[col], 1e-3)
         assert excess.max() == 0.0, (col, excess.max())
     if model == "hrovat-tobler":
-        stator = fmpy.simulate_fmu(path, fmi_type="ModelExchange", input=inp, output_interval=0.01, stop_time=10.0,
-                                   output=["stator_speed_rad_s"])["stator_speed_rad_s"]
+        stator = fmpy.simulate_fmu(
+            path,
+            fmi_type="ModelExchange",
+            input=inp,
+            output_interval=0.01,
+            stop_time=10.0,
+            output=["stator_speed_rad_s"],
+        )["stator_speed_rad_s"]
         assert stator[0] == 0.0 and stator[-1] > 0.0  # locked at stall, released past the coupling point
 
 
@@ -486,14 +549,22 @@ def test_start_values_override_the_steady_state(fmus):
     """Initialisation matches tcsim replay (the steady state consistent with the inputs) unless the
     start values are set: start_from_steady_state = 0 and initial_*."""
     path = str(fmus[("hrovat-tobler", "pump-torque")])
-    inp = np.array([(0.0, 100.0, 0.0), (0.1, 100.0, 0.0)], dtype=[("time", float), ("pump_torque_nm", float), ("turbine_speed_rad_s", float)])
+    inp = np.array(
+        [(0.0, 100.0, 0.0), (0.1, 100.0, 0.0)],
+        dtype=[("time", float), ("pump_torque_nm", float), ("turbine_speed_rad_s", float)],
+    )
     steady = fmpy.simulate_fmu(path, fmi_type="CoSimulation", input=inp, output_interval=0.01, stop_time=0.1)
     replay = simulate(CONVERTER, PumpTorqueTurbineSpeed([0.0, 0.1], [100.0, 100.0], [0.0, 0.0]), model="hrovat-tobler")
     assert steady["pump_speed_rad_s"][0] == pytest.approx(replay["pump_speed_rad_s"][0], rel=1e-9)
     for fmi_type in ("CoSimulation", "ModelExchange"):
-        given = fmpy.simulate_fmu(path, fmi_type=fmi_type, input=inp, output_interval=0.01, stop_time=0.1,
-                                  start_values={"start_from_steady_state": 0.0, "initial_pump_speed_rad_s": 200.0,
-                                                "initial_flow_m3_s": 0.02})
+        given = fmpy.simulate_fmu(
+            path,
+            fmi_type=fmi_type,
+            input=inp,
+            output_interval=0.01,
+            stop_time=0.1,
+            start_values={"start_from_steady_state": 0.0, "initial_pump_speed_rad_s": 200.0, "initial_flow_m3_s": 0.02},
+        )
         assert given["pump_speed_rad_s"][0] == pytest.approx(200.0) and given["flow_m3_s"][0] == pytest.approx(0.02)
 
 
@@ -505,12 +576,29 @@ def test_tip_out_flow_events_in_both_interfaces(fmus, fmi_type):
     path = str(fmus[("hrovat-tobler", "pump-torque")])
     knots, torque = [0.0, 0.1, 0.3, 5.0, 5.1, 8.0], [40.0, 40.0, 250.0, 250.0, -30.0, -30.0]
     t = np.round(np.arange(0.0, 8.0 + 1e-9, 1e-3), 6)
-    inp = np.array(list(zip(t, np.interp(t, knots, torque), 32.0 * t, np.full_like(t, 32.0))),
-                   dtype=[("time", float), ("pump_torque_nm", float), ("turbine_speed_rad_s", float), ("turbine_accel_rad_s2", float)])
-    res = fmpy.simulate_fmu(path, fmi_type=fmi_type, input=inp, output_interval=1e-3, stop_time=8.0,
-                            output=["pump_speed_rad_s", "turbine_torque_nm", "flow_m3_s"])
-    ref = simulate(CONVERTER, PumpTorqueTurbineSpeed(knots, torque, [32.0 * k for k in knots], derivative_window_s=0.0),
-                   model="hrovat-tobler", times_s=t)
+    inp = np.array(
+        list(zip(t, np.interp(t, knots, torque), 32.0 * t, np.full_like(t, 32.0))),
+        dtype=[
+            ("time", float),
+            ("pump_torque_nm", float),
+            ("turbine_speed_rad_s", float),
+            ("turbine_accel_rad_s2", float),
+        ],
+    )
+    res = fmpy.simulate_fmu(
+        path,
+        fmi_type=fmi_type,
+        input=inp,
+        output_interval=1e-3,
+        stop_time=8.0,
+        output=["pump_speed_rad_s", "turbine_torque_nm", "flow_m3_s"],
+    )
+    ref = simulate(
+        CONVERTER,
+        PumpTorqueTurbineSpeed(knots, torque, [32.0 * k for k in knots], derivative_window_s=0.0),
+        model="hrovat-tobler",
+        times_s=t,
+    )
     assert [e.kind for e in ref.events] == ["stator-release", "flow-zero", "flow-start"]
     held = (res["time"] > 5.3) & (res["time"] < 6.4)
     assert np.abs(res["flow_m3_s"][held]).max() < 1e-6  # held at zero between the events

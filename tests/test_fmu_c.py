@@ -32,8 +32,12 @@ def test_plain_c_program_runs_a_takeoff(tmp_path, library, model):
     spec = transient.dynamic_model("li-sunden-2016", model).spec
     (resources / "model.json").write_text(json.dumps({"causality": "pump-torque", "model": spec, "parameters": []}))
     exe = tmp_path / "takeoff"
-    subprocess.run(["gcc", "-O2", "-Wall", "-Werror", "-o", exe, REPO / "tests" / "c" / "takeoff.c", "-ldl", "-lm"],
-                   check=True, capture_output=True, text=True)
+    subprocess.run(
+        ["gcc", "-O2", "-Wall", "-Werror", "-o", exe, REPO / "tests" / "c" / "takeoff.c", "-ldl", "-lm"],
+        check=True,
+        capture_output=True,
+        text=True,
+    )
     r = subprocess.run([exe, library, resources.as_uri()], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
     rows = [list(map(float, line.split())) for line in r.stdout.splitlines()]
@@ -42,8 +46,12 @@ def test_plain_c_program_runs_a_takeoff(tmp_path, library, model):
     # the inputs between communication points: the turbine speed ramp is linear, the torque ramp
     # has its corners on the 10 ms grid)
     t = [0.0, 0.1, 0.3, 5.0]
-    ref = transient.simulate("li-sunden-2016", transient.PumpTorqueTurbineSpeed(
-        t, [40.0, 40.0, 250.0, 250.0], [40.0 * x for x in t], derivative_window_s=0.0), model=model, times_s=[0.0, 5.0])
+    ref = transient.simulate(
+        "li-sunden-2016",
+        transient.PumpTorqueTurbineSpeed(t, [40.0, 40.0, 250.0, 250.0], [40.0 * x for x in t], derivative_window_s=0.0),
+        model=model,
+        times_s=[0.0, 5.0],
+    )
     assert rows[-1][1] == pytest.approx(ref["pump_speed_rad_s"][-1], rel=1e-3)
     assert rows[-1][2] == pytest.approx(ref["turbine_torque_nm"][-1], rel=1e-3)
 

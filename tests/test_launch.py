@@ -51,33 +51,46 @@ def test_part_pedal():
     assert L.part_pedal().core_spec()["stop_speed_m_s"] == pytest.approx(13.8889, abs=1e-4)
 
 
-@pytest.mark.parametrize("make, field", [
-    (lambda: L.flip_flop(hold_s=5.0, end_time_s=5.0), "end_time_s"),
-    (lambda: L.flip_flop(hold_s=0.0), "hold_s"),
-    (lambda: L.part_pedal(pedal=0.0), "pedal"),
-    (lambda: L.part_pedal(pedal=1.5), "pedal"),
-    (lambda: L.part_pedal(pedal=math.nan), "pedal"),
-])
+@pytest.mark.parametrize(
+    "make, field",
+    [
+        (lambda: L.flip_flop(hold_s=5.0, end_time_s=5.0), "end_time_s"),
+        (lambda: L.flip_flop(hold_s=0.0), "hold_s"),
+        (lambda: L.part_pedal(pedal=0.0), "pedal"),
+        (lambda: L.part_pedal(pedal=1.5), "pedal"),
+        (lambda: L.part_pedal(pedal=math.nan), "pedal"),
+    ],
+)
 def test_bad_builtin_scenarios(make, field):
     with pytest.raises(InputError) as err:
         make()
     assert err.value.field == field
 
 
-@pytest.mark.parametrize("kwargs, field", [
-    (dict(time_s=[0, 1, 1, 2]), "time_s[2]"),
-    (dict(time_s=[0.5, 1, 2, 3]), "time_s[0]"),
-    (dict(accelerator_pedal=[0, 0, 1.2, 1]), "accelerator_pedal[2]"),
-    (dict(brake_pedal=[1, 1, -0.1, 0]), "brake_pedal[2]"),
-    (dict(brake_pedal=[1, math.nan, 0, 0]), "brake_pedal[1]"),
-    (dict(brake_pedal=[1, 0, 0]), "brake_pedal"),
-    (dict(end_time_s=0.0), "end_time_s"),
-    (dict(stop_speed_m_s=-1.0), "stop_speed_m_s"),
-    (dict(brake_release_time_s=99.0), "brake_release_time_s"),
-])
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        (dict(time_s=[0, 1, 1, 2]), "time_s[2]"),
+        (dict(time_s=[0.5, 1, 2, 3]), "time_s[0]"),
+        (dict(accelerator_pedal=[0, 0, 1.2, 1]), "accelerator_pedal[2]"),
+        (dict(brake_pedal=[1, 1, -0.1, 0]), "brake_pedal[2]"),
+        (dict(brake_pedal=[1, math.nan, 0, 0]), "brake_pedal[1]"),
+        (dict(brake_pedal=[1, 0, 0]), "brake_pedal"),
+        (dict(end_time_s=0.0), "end_time_s"),
+        (dict(stop_speed_m_s=-1.0), "stop_speed_m_s"),
+        (dict(brake_release_time_s=99.0), "brake_release_time_s"),
+    ],
+)
 def test_scenario_validation(kwargs, field):
-    args = dict(name="x", time_s=[0, 1, 2, 3], accelerator_pedal=[0, 0, 1, 1], brake_pedal=[1, 1, 0, 0],
-                end_time_s=3.0, stop_speed_m_s=None, brake_release_time_s=1.0)
+    args = dict(
+        name="x",
+        time_s=[0, 1, 2, 3],
+        accelerator_pedal=[0, 0, 1, 1],
+        brake_pedal=[1, 1, 0, 0],
+        end_time_s=3.0,
+        stop_speed_m_s=None,
+        brake_release_time_s=1.0,
+    )
     args.update(kwargs)
     with pytest.raises(InputError) as err:
         L.Scenario(**args)
@@ -123,8 +136,14 @@ def test_read_scenario_csv(tmp_path):
 
 def test_read_scenario_percent_ms_and_parquet(tmp_path):
     df = _scenario_frame()
-    other = pd.DataFrame({"time_ms": df.time_s * 1000, "accelerator_pedal_percent": df.accelerator_pedal * 100,
-                          "brake_pedal_percent": df.brake_pedal * 100, "engine_speed_rpm": 800.0})
+    other = pd.DataFrame(
+        {
+            "time_ms": df.time_s * 1000,
+            "accelerator_pedal_percent": df.accelerator_pedal * 100,
+            "brake_pedal_percent": df.brake_pedal * 100,
+            "engine_speed_rpm": 800.0,
+        }
+    )
     for suffix in (".csv", ".parquet"):
         path = tmp_path / f"scen{suffix}"
         (other.to_csv(path, index=False) if suffix == ".csv" else other.to_parquet(path))
@@ -179,8 +198,9 @@ def test_read_scenario_bad_files(tmp_path, case):
 
 def test_read_scenario_percent_out_of_range_and_bad_paths(tmp_path):
     df = _scenario_frame()
-    pct = pd.DataFrame({"time_s": df.time_s, "accelerator_pedal_percent": df.accelerator_pedal * 100,
-                        "brake_pedal": df.brake_pedal})
+    pct = pd.DataFrame(
+        {"time_s": df.time_s, "accelerator_pedal_percent": df.accelerator_pedal * 100, "brake_pedal": df.brake_pedal}
+    )
     pct.loc[100, "accelerator_pedal_percent"] = 120.0
     path = tmp_path / "pct.csv"
     pct.to_csv(path, index=False)
@@ -240,8 +260,14 @@ def test_launch_summary_columns_and_values():
     for name, a in (("table", 5.0), ("quasi-dynamic", 4.0)):
         accel = np.where(t < 5.0, 0.0, a)
         v = np.maximum(0.0, a * (t - 5.0))
-        frames[name] = pd.DataFrame({"time_s": t, "vehicle_speed_m_s": v, "vehicle_accel_m_s2": accel,
-                                     "effective_torque_ratio": np.where(t < 5.0, 2.14, 2.14 - a / 10)})
+        frames[name] = pd.DataFrame(
+            {
+                "time_s": t,
+                "vehicle_speed_m_s": v,
+                "vehicle_accel_m_s2": accel,
+                "effective_torque_ratio": np.where(t < 5.0, 2.14, 2.14 - a / 10),
+            }
+        )
     s = L.launch_summary(frames, 5.0)
     assert list(s.columns) == list(L.SUMMARY_COLUMNS) and list(s.model) == ["table", "quasi-dynamic"]
     row = s.set_index("model").loc["quasi-dynamic"]
@@ -278,12 +304,22 @@ def fake_launch_runs(models, vehicle, scenario, options, threads):
         stop = scenario["stop_speed_m_s"]
         n = int(np.argmax(v >= stop)) + 1 if stop is not None and (v >= stop).any() else len(t)
         etr = np.where(t < release, 2.14, 2.14 - (0.3 + shape) * np.exp(-(t - release) / 0.3))
-        cols = {"time_s": t, "vehicle_speed_m_s": v, "vehicle_accel_m_s2": a, "pump_speed_rad_s": 80 + 200 * acc_pedal,
-                "turbine_speed_rad_s": v * 50, "speed_ratio": np.clip(v * 50 / (80 + 200 * acc_pedal), 0, 1),
-                "torque_ratio": etr + 0.05, "effective_torque_ratio": etr, "gear": np.where(v < 12.5, 1.0, 2.0),
-                "lockup_state": np.zeros_like(t), "engine_torque_nm": 100 + 300 * acc_pedal,
-                "pump_torque_nm": 90 + 250 * acc_pedal, "turbine_torque_nm": 200 + 300 * acc_pedal,
-                "stator_speed_rad_s": np.full_like(t, np.nan)}
+        cols = {
+            "time_s": t,
+            "vehicle_speed_m_s": v,
+            "vehicle_accel_m_s2": a,
+            "pump_speed_rad_s": 80 + 200 * acc_pedal,
+            "turbine_speed_rad_s": v * 50,
+            "speed_ratio": np.clip(v * 50 / (80 + 200 * acc_pedal), 0, 1),
+            "torque_ratio": etr + 0.05,
+            "effective_torque_ratio": etr,
+            "gear": np.where(v < 12.5, 1.0, 2.0),
+            "lockup_state": np.zeros_like(t),
+            "engine_torque_nm": 100 + 300 * acc_pedal,
+            "pump_torque_nm": 90 + 250 * acc_pedal,
+            "turbine_torque_nm": 200 + 300 * acc_pedal,
+            "stator_speed_rad_s": np.full_like(t, np.nan),
+        }
         cols = {k: np.asarray(c)[:n] for k, c in cols.items()}
         events = [(float(t[np.argmax(v >= 12.5)]), "upshift", 1, 2)] if (v[:n] >= 12.5).any() else []
         out.append(("ok", cols, events))
@@ -371,16 +407,32 @@ def test_launch_writes_files_and_plots(fake_core, vehicle, tmp_path):
         result = L.launch(vehicle, "flip-flop", sweep=True)
     assert list(result.summary.model) == ["table", "hrovat-tobler", "quasi-dynamic"]
     s = result.summary.set_index("model")
-    assert s.time_0_100_km_h_s.notna().all() and (s.loc["table"].mean_accel_first_0_5_s_m_s2
-                                                  > s.loc["quasi-dynamic"].mean_accel_first_0_5_s_m_s2)
+    assert s.time_0_100_km_h_s.notna().all() and (
+        s.loc["table"].mean_accel_first_0_5_s_m_s2 > s.loc["quasi-dynamic"].mean_accel_first_0_5_s_m_s2
+    )
     paths = L.write_launch(result, tmp_path)
     names = {p.name for p in paths}
-    assert {"summary.csv", "table.csv", "hrovat-tobler.csv", "quasi-dynamic.csv", "timeseries.csv", "events.csv",
-            "scenario.csv", "shape_sweep.csv", "shape_sweep_summary.csv", "torque_speed_ratio.png",
-            "effective_torque_ratio.png", "vehicle_accel_release.png", "vehicle_accel.png", "vehicle_speed.png",
-            "speeds.png", "shape_sweep_quasi-dynamic_effective_torque_ratio.png",
-            "shape_sweep_quasi-dynamic_vehicle_accel.png", "shape_sweep_hrovat-tobler_effective_torque_ratio.png",
-            "shape_sweep_hrovat-tobler_vehicle_accel.png"} <= names
+    assert {
+        "summary.csv",
+        "table.csv",
+        "hrovat-tobler.csv",
+        "quasi-dynamic.csv",
+        "timeseries.csv",
+        "events.csv",
+        "scenario.csv",
+        "shape_sweep.csv",
+        "shape_sweep_summary.csv",
+        "torque_speed_ratio.png",
+        "effective_torque_ratio.png",
+        "vehicle_accel_release.png",
+        "vehicle_accel.png",
+        "vehicle_speed.png",
+        "speeds.png",
+        "shape_sweep_quasi-dynamic_effective_torque_ratio.png",
+        "shape_sweep_quasi-dynamic_vehicle_accel.png",
+        "shape_sweep_hrovat-tobler_effective_torque_ratio.png",
+        "shape_sweep_hrovat-tobler_vehicle_accel.png",
+    } <= names
     assert all(p.exists() and p.stat().st_size > 0 for p in paths)
     summary = pd.read_csv(tmp_path / "summary.csv")
     assert list(summary.columns) == list(L.SUMMARY_COLUMNS)
@@ -395,8 +447,12 @@ def test_cli_launch_with_the_stand_in(fake_core, tmp_path, capsys):
     from tcsim import cli
 
     out = tmp_path / "out"
-    assert cli.main(["launch", "--out", str(out), "--scenario", "part-pedal", "--model", "table",
-                     "--model", "quasi-dynamic"]) == 0
+    assert (
+        cli.main(
+            ["launch", "--out", str(out), "--scenario", "part-pedal", "--model", "table", "--model", "quasi-dynamic"]
+        )
+        == 0
+    )
     printed = capsys.readouterr().out
     assert "part-pedal" in printed and "quasi-dynamic" in printed
     s = pd.read_csv(out / "summary.csv")
@@ -404,11 +460,14 @@ def test_cli_launch_with_the_stand_in(fake_core, tmp_path, capsys):
     assert s.time_0_50_km_h_s.notna().all()
 
 
-@pytest.mark.parametrize("args, words", [
-    (["--model", "nonsense"], ["--model", "nonsense"]),
-    (["--scenario", "moon-landing"], ["--scenario", "moon-landing", "flip-flop"]),
-    (["--model", "table", "--sweep-shape-effects"], ["--sweep-shape-effects", "hrovat-tobler"]),
-])
+@pytest.mark.parametrize(
+    "args, words",
+    [
+        (["--model", "nonsense"], ["--model", "nonsense"]),
+        (["--scenario", "moon-landing"], ["--scenario", "moon-landing", "flip-flop"]),
+        (["--model", "table", "--sweep-shape-effects"], ["--sweep-shape-effects", "hrovat-tobler"]),
+    ],
+)
 def test_cli_bad_options_exit_2(fake_core, tmp_path, capsys, args, words):
     from tcsim import cli
 
@@ -433,8 +492,9 @@ def test_cli_bad_scenario_file_exit_2(fake_core, tmp_path, capsys):
 def test_cli_solver_failure_exit_1_nothing_written(monkeypatch, tmp_path, capsys):
     from tcsim import cli
 
-    monkeypatch.setattr(tcsim._core, "launch_runs", lambda *a: [("solver", "step size too small at t = 5.3 s")] * 3,
-                        raising=False)
+    monkeypatch.setattr(
+        tcsim._core, "launch_runs", lambda *a: [("solver", "step size too small at t = 5.3 s")] * 3, raising=False
+    )
     out = tmp_path / "out"
     assert cli.main(["launch", "--out", str(out)]) == 1
     err = capsys.readouterr().err
@@ -463,8 +523,9 @@ def test_vehicle_stands_still_while_braked(flip_flop_runs):
 def test_stall_phase_table_and_quasi_dynamic_agree_then_dynamic_models_start_lower(flip_flop_runs):
     table, qd = flip_flop_runs["table"], flip_flop_runs["quasi-dynamic"]
     t = np.linspace(1.0, 4.9, 40)
-    np.testing.assert_allclose(np.interp(t, qd.time_s, qd.torque_ratio), np.interp(t, table.time_s, table.torque_ratio),
-                               rtol=1e-4)
+    np.testing.assert_allclose(
+        np.interp(t, qd.time_s, qd.torque_ratio), np.interp(t, table.time_s, table.torque_ratio), rtol=1e-4
+    )
     s = L.launch_summary(flip_flop_runs, 5.0).set_index("model")
     for dyn in ("hrovat-tobler", "quasi-dynamic"):
         assert s.loc[dyn].mean_accel_first_0_5_s_m_s2 < s.loc["table"].mean_accel_first_0_5_s_m_s2
@@ -501,8 +562,17 @@ def test_cli_launch_end_to_end(cli, tmp_path):
     assert r.code == 0, (r.stdout, r.stderr)
     assert "Traceback" not in r.stderr and "flip-flop" in r.stdout
     names = {p.name for p in out.iterdir()}
-    assert {"summary.csv", "table.csv", "hrovat-tobler.csv", "quasi-dynamic.csv", "timeseries.csv", "events.csv",
-            "torque_speed_ratio.png", "vehicle_accel_release.png", "vehicle_accel.png"} <= names
+    assert {
+        "summary.csv",
+        "table.csv",
+        "hrovat-tobler.csv",
+        "quasi-dynamic.csv",
+        "timeseries.csv",
+        "events.csv",
+        "torque_speed_ratio.png",
+        "vehicle_accel_release.png",
+        "vehicle_accel.png",
+    } <= names
     s = pd.read_csv(out / "summary.csv")
     assert list(s.model) == ["table", "hrovat-tobler", "quasi-dynamic"]
     assert s.time_0_100_km_h_s.between(3.0, 15.0).all() and (s.time_0_50_km_h_s < s.time_0_100_km_h_s).all()
@@ -514,8 +584,9 @@ def test_cli_launch_end_to_end(cli, tmp_path):
 def test_cli_launch_scenario_file(cli, tmp_path):
     path = tmp_path / "creep.csv"
     t = np.round(np.arange(0, 6.0001, 0.05), 6)
-    pd.DataFrame({"time_s": t, "accelerator_pedal": 0.0,
-                  "brake_pedal": np.interp(t, [0, 1, 1.5, 6], [1, 1, 0, 0])}).to_csv(path, index=False)
+    pd.DataFrame(
+        {"time_s": t, "accelerator_pedal": 0.0, "brake_pedal": np.interp(t, [0, 1, 1.5, 6], [1, 1, 0, 0])}
+    ).to_csv(path, index=False)
     out = tmp_path / "out"
     r = cli("launch", "--out", out, "--scenario", path, "--model", "table")
     assert r.code == 0, (r.stdout, r.stderr)
@@ -546,7 +617,10 @@ def test_part_pedal_launch_is_gentler(flip_flop_runs):
     part = L.run_launch(veh, L.part_pedal(), L.select_models(veh, ["table"]))["table"]
     full = flip_flop_runs["table"]
     assert part.vehicle_speed_m_s[part.time_s < 5.0].abs().max() == 0.0
-    window = lambda f: f[(f.time_s > 5.0) & (f.time_s <= 6.0)].vehicle_accel_m_s2.mean()
+
+    def window(f):
+        return f[(f.time_s > 5.0) & (f.time_s <= 6.0)].vehicle_accel_m_s2.mean()
+
     assert 0.0 < window(part) < window(full)
 
 
@@ -558,8 +632,9 @@ def test_logged_engine_torque_is_replayed(tmp_path, cli, flip_flop_runs):
     sc = L.flip_flop()
     path = tmp_path / "logged.csv"
     pedal, brake = sc.pedals_at(f.time_s)
-    pd.DataFrame({"time_s": f.time_s, "accelerator_pedal": pedal, "brake_pedal": brake,
-                  "engine_torque_nm": f.engine_torque_nm}).to_csv(path, index=False)
+    pd.DataFrame(
+        {"time_s": f.time_s, "accelerator_pedal": pedal, "brake_pedal": brake, "engine_torque_nm": f.engine_torque_nm}
+    ).to_csv(path, index=False)
     out = tmp_path / "out"
     r = cli("launch", "--out", out, "--scenario", path, "--model", "table")
     assert r.code == 0, r.stderr

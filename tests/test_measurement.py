@@ -20,8 +20,13 @@ ORIGINAL = {
     "pump_speed_rad_s": 120.0 + 60.0 * TIME_S,
     "turbine_torque_nm": 300.0 - 50.0 * TIME_S**2,
 }
-UNITS = {"time_s": "s", "pump_torque_nm": "Nm", "turbine_speed_rad_s": "rad/s", "pump_speed_rad_s": "rad/s",
-         "turbine_torque_nm": "N m"}
+UNITS = {
+    "time_s": "s",
+    "pump_torque_nm": "Nm",
+    "turbine_speed_rad_s": "rad/s",
+    "pump_speed_rad_s": "rad/s",
+    "turbine_torque_nm": "N m",
+}
 
 
 def write_csv(path: Path, columns: dict[str, np.ndarray]) -> Path:
@@ -37,8 +42,9 @@ def write_mat_v73(path: Path, columns: dict[str, np.ndarray]) -> Path:
         for k, (name, values) in enumerate(columns.items()):
             shape = (1, len(values)) if k % 2 else (len(values), 1)  # both orientations
             f.create_dataset(name, data=values.reshape(shape)).attrs["MATLAB_class"] = np.bytes_("double")
-        f.create_dataset("label", data=np.frombuffer(b"a\0b\0", np.uint16).reshape(2, 1)).attrs["MATLAB_class"] = \
+        f.create_dataset("label", data=np.frombuffer(b"a\0b\0", np.uint16).reshape(2, 1)).attrs["MATLAB_class"] = (
             np.bytes_("char")
+        )
     with open(path, "r+b") as f:
         text = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Mon Jan  1 00:00:00 2024 HDF5 schema 1.00 ."
         f.write(text.ljust(116) + bytes(8) + b"\x00\x02IM")  # text, subsystem offset, version 0x0200, endian
@@ -105,8 +111,10 @@ def test_round_trip(tmp_path, name):
 
 def test_optional_channels_absent_and_comments(tmp_path):
     path = tmp_path / "m.csv"
-    path.write_text("# logged on the test bench\ntime_s,pump_torque_nm,turbine_speed_rad_s\n"
-                    "0,100,0\n# a comment line\n0.1,101,2\n0.2,102,4\n")
+    path.write_text(
+        "# logged on the test bench\ntime_s,pump_torque_nm,turbine_speed_rad_s\n"
+        "0,100,0\n# a comment line\n0.1,101,2\n0.2,102,4\n"
+    )
     m = read_measurement(path)
     assert set(m.channels) == {"pump_torque_nm", "turbine_speed_rad_s"}
     np.testing.assert_array_equal(m.channels["pump_torque_nm"], [100, 101, 102])
@@ -117,16 +125,21 @@ def test_mdf_channels_resampled_onto_first_required(tmp_path):
 
     path = tmp_path / "m.mf4"
     mdf = MDF(version="4.10")
-    mdf.append([Signal(ORIGINAL["pump_torque_nm"], TIME_S, name="pump_torque_nm", unit="Nm"),
-                Signal(ORIGINAL["turbine_speed_rad_s"], TIME_S, name="turbine_speed_rad_s", unit="rad/s")])
+    mdf.append(
+        [
+            Signal(ORIGINAL["pump_torque_nm"], TIME_S, name="pump_torque_nm", unit="Nm"),
+            Signal(ORIGINAL["turbine_speed_rad_s"], TIME_S, name="turbine_speed_rad_s", unit="rad/s"),
+        ]
+    )
     coarse = TIME_S[::4]
     mdf.append([Signal(120.0 + 60.0 * coarse, coarse, name="pump_speed_rad_s", unit="rad/s")])
     mdf.save(path, overwrite=True)
     mdf.close()
     m = read_measurement(path)
     np.testing.assert_allclose(m.time_s, TIME_S, rtol=1e-12)
-    np.testing.assert_allclose(m.channels["pump_speed_rad_s"][: len(TIME_S) - 3], ORIGINAL["pump_speed_rad_s"][:-3],
-                               rtol=1e-9)
+    np.testing.assert_allclose(
+        m.channels["pump_speed_rad_s"][: len(TIME_S) - 3], ORIGINAL["pump_speed_rad_s"][:-3], rtol=1e-9
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -134,9 +147,15 @@ def test_mdf_channels_resampled_onto_first_required(tmp_path):
 
 
 def test_rpm_and_time_ms_columns_are_converted(tmp_path):
-    path = write_csv(tmp_path / "m.csv", {"time_ms": TIME_S * 1000.0, "pump_torque_knm": ORIGINAL["pump_torque_nm"] / 1e3,
-                                          "turbine_speed_rpm": ORIGINAL["turbine_speed_rad_s"] * 30.0 / math.pi,
-                                          "turbine_torque_lbf_ft": ORIGINAL["turbine_torque_nm"] / 1.3558179483314004})
+    path = write_csv(
+        tmp_path / "m.csv",
+        {
+            "time_ms": TIME_S * 1000.0,
+            "pump_torque_knm": ORIGINAL["pump_torque_nm"] / 1e3,
+            "turbine_speed_rpm": ORIGINAL["turbine_speed_rad_s"] * 30.0 / math.pi,
+            "turbine_torque_lbf_ft": ORIGINAL["turbine_torque_nm"] / 1.3558179483314004,
+        },
+    )
     m = read_measurement(path)
     np.testing.assert_allclose(m.time_s, TIME_S, rtol=1e-12)
     for key in ("pump_torque_nm", "turbine_speed_rad_s", "turbine_torque_nm"):
@@ -144,10 +163,15 @@ def test_rpm_and_time_ms_columns_are_converted(tmp_path):
 
 
 def test_mdf_unit_metadata_decides(tmp_path):
-    path = write_mdf(tmp_path / "m.mf4", {"EngTrq": ORIGINAL["pump_torque_nm"] / 1e3,
-                                          "TurbSpd": ORIGINAL["turbine_speed_rad_s"] * 30.0 / math.pi,
-                                          "EngSpd": ORIGINAL["pump_speed_rad_s"] * 180.0 / math.pi},
-                     {"EngTrq": "kNm", "TurbSpd": "rpm", "EngSpd": "deg/s"})
+    path = write_mdf(
+        tmp_path / "m.mf4",
+        {
+            "EngTrq": ORIGINAL["pump_torque_nm"] / 1e3,
+            "TurbSpd": ORIGINAL["turbine_speed_rad_s"] * 30.0 / math.pi,
+            "EngSpd": ORIGINAL["pump_speed_rad_s"] * 180.0 / math.pi,
+        },
+        {"EngTrq": "kNm", "TurbSpd": "rpm", "EngSpd": "deg/s"},
+    )
     mapping = parse_channel_map(["pump_torque_nm=EngTrq", "turbine_speed_rad_s = TurbSpd", "pump_speed_rad_s=EngSpd"])
     m = read_measurement(path, mapping)
     for key in ("pump_torque_nm", "turbine_speed_rad_s", "pump_speed_rad_s"):
@@ -159,9 +183,15 @@ def test_mdf_unit_metadata_decides(tmp_path):
 
 
 def test_channel_map(tmp_path):
-    path = write_csv(tmp_path / "m.csv", {"t": TIME_S, "EngTrq": ORIGINAL["pump_torque_nm"],
-                                          "TurbSpd_rpm": ORIGINAL["turbine_speed_rad_s"] * 30.0 / math.pi,
-                                          "turbine_torque_nm": ORIGINAL["turbine_torque_nm"]})
+    path = write_csv(
+        tmp_path / "m.csv",
+        {
+            "t": TIME_S,
+            "EngTrq": ORIGINAL["pump_torque_nm"],
+            "TurbSpd_rpm": ORIGINAL["turbine_speed_rad_s"] * 30.0 / math.pi,
+            "turbine_torque_nm": ORIGINAL["turbine_torque_nm"],
+        },
+    )
     mapping = parse_channel_map(["time_s=t", "pump_torque_nm=EngTrq", "turbine_speed_rad_s=TurbSpd_rpm"])
     assert mapping == {"time_s": "t", "pump_torque_nm": "EngTrq", "turbine_speed_rad_s": "TurbSpd_rpm"}
     m = read_measurement(path, mapping)
@@ -209,19 +239,34 @@ def _with(values: np.ndarray, row: int, value) -> np.ndarray:
 
 BAD_CSV = {
     # name: (column changes, field, words in the message)
-    "missing channel": ({"pump_torque_nm": None}, "pump_torque_nm",
-                        ["missing", "pump_torque_knm", "--channel pump_torque_nm=COLUMN", "turbine_speed_rad_s"]),
+    "missing channel": (
+        {"pump_torque_nm": None},
+        "pump_torque_nm",
+        ["missing", "pump_torque_knm", "--channel pump_torque_nm=COLUMN", "turbine_speed_rad_s"],
+    ),
     "missing time": ({"time_s": None}, "time_s", ["missing", "time_ms"]),
     "time not increasing": ({"time_s": _with(TIME_S, 50, TIME_S[48])}, "time_s", ["row 51", "strictly increasing"]),
     "NaN": ({"pump_torque_nm": _with(ORIGINAL["pump_torque_nm"], 9, np.nan)}, "pump_torque_nm", ["NaN at row 10"]),
-    "inf": ({"turbine_speed_rad_s": _with(ORIGINAL["turbine_speed_rad_s"], 0, np.inf)}, "turbine_speed_rad_s",
-            ["inf at row 1"]),
-    "non-numeric": ({"pump_torque_nm": _with(ORIGINAL["pump_torque_nm"], 4, "12,5 Nm")}, "pump_torque_nm",
-                    ["'12,5 Nm' at row 5", "numbers only"]),
-    "rad/s that look like rpm": ({"pump_speed_rad_s": ORIGINAL["pump_speed_rad_s"] * 30.0 / math.pi * 8},
-                                 "pump_speed_rad_s", ["values look like rpm", "*_rpm"]),
-    "torque too large": ({"turbine_torque_nm": ORIGINAL["turbine_torque_nm"] * 1000}, "turbine_torque_nm",
-                         ["N·m", "20 000"]),
+    "inf": (
+        {"turbine_speed_rad_s": _with(ORIGINAL["turbine_speed_rad_s"], 0, np.inf)},
+        "turbine_speed_rad_s",
+        ["inf at row 1"],
+    ),
+    "non-numeric": (
+        {"pump_torque_nm": _with(ORIGINAL["pump_torque_nm"], 4, "12,5 Nm")},
+        "pump_torque_nm",
+        ["'12,5 Nm' at row 5", "numbers only"],
+    ),
+    "rad/s that look like rpm": (
+        {"pump_speed_rad_s": ORIGINAL["pump_speed_rad_s"] * 30.0 / math.pi * 8},
+        "pump_speed_rad_s",
+        ["values look like rpm", "*_rpm"],
+    ),
+    "torque too large": (
+        {"turbine_torque_nm": ORIGINAL["turbine_torque_nm"] * 1000},
+        "turbine_torque_nm",
+        ["N·m", "20 000"],
+    ),
     "time in ms named _s": ({"time_s": TIME_S * 1e6}, "time_s", ["time in seconds"]),
     "one row": ({k: v[:1] for k, v in {"time_s": TIME_S, **ORIGINAL}.items()}, "time_s", ["1 rows", "at least 2"]),
 }
@@ -238,17 +283,22 @@ def test_bad_csv(tmp_path, case):
 
 
 def test_mdf_unconvertible_unit(tmp_path):
-    path = write_mdf(tmp_path / "m.mf4", {"pump_torque_nm": ORIGINAL["pump_torque_nm"],
-                                          "VehSpd": ORIGINAL["turbine_speed_rad_s"]}, {"VehSpd": "km/h"})
+    path = write_mdf(
+        tmp_path / "m.mf4",
+        {"pump_torque_nm": ORIGINAL["pump_torque_nm"], "VehSpd": ORIGINAL["turbine_speed_rad_s"]},
+        {"VehSpd": "km/h"},
+    )
     with pytest.raises(InputError) as excinfo:
         read_measurement(path, {"turbine_speed_rad_s": "VehSpd"})
     assert_error(excinfo, path, "VehSpd", "km/h", "wrong units", "rpm")
 
 
 def test_mdf_torque_in_bar(tmp_path):
-    path = write_mdf(tmp_path / "m.mf4", {"pump_torque_nm": ORIGINAL["pump_torque_nm"],
-                                          "turbine_speed_rad_s": ORIGINAL["turbine_speed_rad_s"]},
-                     {"pump_torque_nm": "bar"})
+    path = write_mdf(
+        tmp_path / "m.mf4",
+        {"pump_torque_nm": ORIGINAL["pump_torque_nm"], "turbine_speed_rad_s": ORIGINAL["turbine_speed_rad_s"]},
+        {"pump_torque_nm": "bar"},
+    )
     with pytest.raises(InputError) as excinfo:
         read_measurement(path)
     assert_error(excinfo, path, "pump_torque_nm", "bar", "wrong units")

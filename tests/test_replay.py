@@ -11,14 +11,23 @@ import pandas as pd
 import pytest
 
 from tcsim import transient
-from tcsim.errors import InputError
 from tcsim.effective import smoothed_rate
+from tcsim.errors import InputError
 from tcsim.replay import error_metrics, metric_windows, parse_initial
 
 BUNDLED_TOML = Path(__file__).resolve().parents[1] / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
 STATOR_RELEASE_S = 2.37  # Hrovat & Tobler, isolated take-off of transient.isolated_takeoff()
-MODEL_COLUMNS = ["time_s", "pump_speed_rad_s", "turbine_speed_rad_s", "pump_torque_nm", "turbine_torque_nm",
-                 "speed_ratio", "torque_ratio", "effective_pump_torque_nm", "effective_turbine_torque_nm"]
+MODEL_COLUMNS = [
+    "time_s",
+    "pump_speed_rad_s",
+    "turbine_speed_rad_s",
+    "pump_torque_nm",
+    "turbine_torque_nm",
+    "speed_ratio",
+    "torque_ratio",
+    "effective_pump_torque_nm",
+    "effective_turbine_torque_nm",
+]
 PLOTS = ["inputs.png", "turbine_torque.png", "effective_pump_torque.png", "effective_turbine_torque.png"]
 # Replay accuracy of the Hrovat & Tobler pump speed against the run that made the measurement
 # (drive (a) instead of (c); the prescribed turbine speed's derivative is smoothed over 40 ms).
@@ -113,8 +122,13 @@ def test_smoothed_rate_is_exact_on_polynomials_and_matches_the_core(synthetic):
 
 def test_parse_initial():
     assert parse_initial(["pump_speed_rad_s=150", "flow_m3_s = 0.05"]) == {"pump_speed_rad_s": 150.0, "flow_m3_s": 0.05}
-    for bad in (["pump_speed_rad_s"], ["pump_speed=150"], ["pump_speed_rad_s=fast"], ["pump_speed_rad_s=nan"],
-                ["flow_m3_s=1", "flow_m3_s=2"]):
+    for bad in (
+        ["pump_speed_rad_s"],
+        ["pump_speed=150"],
+        ["pump_speed_rad_s=fast"],
+        ["pump_speed_rad_s=nan"],
+        ["flow_m3_s=1", "flow_m3_s=2"],
+    ):
         with pytest.raises(InputError, match="--initial"):
             parse_initial(bad)
 
@@ -135,19 +149,27 @@ def test_replay_reproduces_the_run_that_made_the_measurement(cli, tmp_path, meas
 
     metrics = pd.read_csv(out / "metrics.csv")
     whole = metrics[metrics["window"] == "all"].set_index("channel")
-    assert set(whole.index) == {"pump_speed_rad_s", "turbine_torque_nm", "effective_pump_torque_nm",
-                                "effective_turbine_torque_nm"}
+    assert set(whole.index) == {
+        "pump_speed_rad_s",
+        "turbine_torque_nm",
+        "effective_pump_torque_nm",
+        "effective_turbine_torque_nm",
+    }
     assert whole.loc["turbine_torque_nm", "nrmse"] < TURBINE_TORQUE_NRMSE
     assert whole.loc["pump_speed_rad_s", "rmse"] == pytest.approx(np.sqrt(np.mean(err**2)), rel=1e-6)
     assert (whole["n"] == len(synthetic)).all()
     # drive (a) prescribes ω_t and its smoothed derivative, so eq 3.4's error is the turbine torque's
-    assert whole.loc["effective_turbine_torque_nm", "rmse"] == pytest.approx(whole.loc["turbine_torque_nm", "rmse"], rel=1e-6)
+    assert whole.loc["effective_turbine_torque_nm", "rmse"] == pytest.approx(
+        whole.loc["turbine_torque_nm", "rmse"], rel=1e-6
+    )
     assert len(metrics) == 4 * (1 + 3)  # four channels × (all + three 1 s windows)
 
     events = pd.read_csv(out / "events.csv")
     assert list(events.columns) == ["model", "time_s", "kind", "stator_locked", "flow_direction"]
     release = events[events["kind"] == "stator-release"]
-    assert list(release["model"]) == ["hrovat-tobler"] and release["time_s"].iloc[0] == pytest.approx(STATOR_RELEASE_S, abs=0.01)
+    assert list(release["model"]) == ["hrovat-tobler"] and release["time_s"].iloc[0] == pytest.approx(
+        STATOR_RELEASE_S, abs=0.01
+    )
     for name in PLOTS + ["pump_speed.png", "measurement.csv"]:
         assert (out / name).stat().st_size > 0, name
 
@@ -178,8 +200,13 @@ def test_parquet_and_mdf4(cli, tmp_path, synthetic, fmt):
 
         units = {"pump_torque_nm": "Nm", "turbine_torque_nm": "Nm"}
         with MDF(version="4.10") as mdf:
-            mdf.append([Signal(synthetic[c].to_numpy(), synthetic["time_s"].to_numpy(), name=c, unit=units.get(c, "rad/s"))
-                        for c in synthetic.columns if c != "time_s"])
+            mdf.append(
+                [
+                    Signal(synthetic[c].to_numpy(), synthetic["time_s"].to_numpy(), name=c, unit=units.get(c, "rad/s"))
+                    for c in synthetic.columns
+                    if c != "time_s"
+                ]
+            )
             mdf.save(path, overwrite=True)
     out = replay_ok(cli, "li-sunden-2016", path, "--model", "hrovat-tobler", "--out", tmp_path / "r")
     assert len(pd.read_csv(out / "hrovat-tobler.csv")) == len(synthetic)
@@ -188,23 +215,54 @@ def test_parquet_and_mdf4(cli, tmp_path, synthetic, fmt):
 
 
 def test_channel_mapping_with_renamed_columns(cli, tmp_path, synthetic):
-    renamed = synthetic.rename(columns={"time_s": "t", "pump_torque_nm": "EngTrq", "turbine_speed_rad_s": "GbxInSpd",
-                                        "pump_speed_rad_s": "EngSpd", "turbine_torque_nm": "TurbTrq"})
+    renamed = synthetic.rename(
+        columns={
+            "time_s": "t",
+            "pump_torque_nm": "EngTrq",
+            "turbine_speed_rad_s": "GbxInSpd",
+            "pump_speed_rad_s": "EngSpd",
+            "turbine_torque_nm": "TurbTrq",
+        }
+    )
     renamed["GbxInSpd_rpm"] = renamed.pop("GbxInSpd") * 30.0 / math.pi  # mapped and converted by its suffix
     path = tmp_path / "logger.csv"
     renamed.to_csv(path, index=False, float_format="%.17g")
-    maps = ["time_s=t", "pump_torque_nm=EngTrq", "turbine_speed_rad_s=GbxInSpd_rpm", "pump_speed_rad_s=EngSpd",
-            "turbine_torque_nm=TurbTrq"]
-    out = replay_ok(cli, "li-sunden-2016", path, "--model", "hrovat-tobler", "--out", tmp_path / "r",
-                    *[a for m in maps for a in ("--channel", m)])
+    maps = [
+        "time_s=t",
+        "pump_torque_nm=EngTrq",
+        "turbine_speed_rad_s=GbxInSpd_rpm",
+        "pump_speed_rad_s=EngSpd",
+        "turbine_torque_nm=TurbTrq",
+    ]
+    out = replay_ok(
+        cli,
+        "li-sunden-2016",
+        path,
+        "--model",
+        "hrovat-tobler",
+        "--out",
+        tmp_path / "r",
+        *[a for m in maps for a in ("--channel", m)],
+    )
     whole = pd.read_csv(out / "metrics.csv").query("window == 'all'").set_index("channel")
     assert whole.loc["pump_speed_rad_s", "nrmse"] < PUMP_SPEED_REL_RMS
     assert whole.loc["turbine_torque_nm", "nrmse"] < TURBINE_TORQUE_NRMSE
 
 
 def test_initial_pump_speed_override(cli, tmp_path, meas_csv):
-    out = replay_ok(cli, "li-sunden-2016", meas_csv, "--model", "hrovat-tobler", "--model", "table",
-                    "--initial", "pump_speed_rad_s=150", "--out", tmp_path / "r")
+    out = replay_ok(
+        cli,
+        "li-sunden-2016",
+        meas_csv,
+        "--model",
+        "hrovat-tobler",
+        "--model",
+        "table",
+        "--initial",
+        "pump_speed_rad_s=150",
+        "--out",
+        tmp_path / "r",
+    )
     for model in ("hrovat-tobler", "table"):
         first = pd.read_csv(out / f"{model}.csv").iloc[0]
         assert first["pump_speed_rad_s"] == pytest.approx(150.0, rel=1e-9)
@@ -214,13 +272,21 @@ def test_initial_pump_speed_override(cli, tmp_path, meas_csv):
 def test_drive_speeds_and_inputs_only(cli, tmp_path, synthetic):
     path = tmp_path / "speeds.csv"
     synthetic.to_csv(path, index=False, float_format="%.17g")
-    out = replay_ok(cli, "li-sunden-2016", path, "--drive", "speeds", "--model", "hrovat-tobler", "--out", tmp_path / "b")
+    out = replay_ok(
+        cli, "li-sunden-2016", path, "--drive", "speeds", "--model", "hrovat-tobler", "--out", tmp_path / "b"
+    )
     whole = pd.read_csv(out / "metrics.csv").query("window == 'all'").set_index("channel")
-    assert set(whole.index) == {"pump_torque_nm", "turbine_torque_nm", "effective_pump_torque_nm",
-                                "effective_turbine_torque_nm"}
+    assert set(whole.index) == {
+        "pump_torque_nm",
+        "turbine_torque_nm",
+        "effective_pump_torque_nm",
+        "effective_turbine_torque_nm",
+    }
     # the prescribed pump speed's smoothed derivative rounds the corners of the torque ramp (0.1 s,
     # 0.3 s): measured NRMSE 1.2e-3 with the 40 ms window
-    assert whole.loc["pump_torque_nm", "nrmse"] < 5e-3 and whole.loc["turbine_torque_nm", "nrmse"] < TURBINE_TORQUE_NRMSE
+    assert (
+        whole.loc["pump_torque_nm", "nrmse"] < 5e-3 and whole.loc["turbine_torque_nm", "nrmse"] < TURBINE_TORQUE_NRMSE
+    )
     assert (out / "pump_torque.png").exists()
 
     bare = tmp_path / "inputs_only.csv"
@@ -256,14 +322,29 @@ CSV_CASES = {  # case: (extra args, words of the message)
 ARG_CASES = {  # case: (converter TOML edit or None, extra args, words)
     "unknown model": (None, ["--model", "lookup"], ["command line", "--model", "lookup"]),
     "unknown drive": (None, ["--drive", "torques"], ["command line", "--drive", "torques"]),
-    "malformed initial": (None, ["--initial", "pump_speed_rad_s:150"], ["command line", "--initial", "pump_speed_rad_s:150"]),
-    "unknown initial key": (None, ["--initial", "pump_speed_rpm=1500"], ["command line", "--initial", "pump_speed_rpm"]),
+    "malformed initial": (
+        None,
+        ["--initial", "pump_speed_rad_s:150"],
+        ["command line", "--initial", "pump_speed_rad_s:150"],
+    ),
+    "unknown initial key": (
+        None,
+        ["--initial", "pump_speed_rpm=1500"],
+        ["command line", "--initial", "pump_speed_rpm"],
+    ),
     "negative window": (None, ["--window", "-0.1"], ["command line", "--window", "-0.1"]),
     "bad channel map": (None, ["--channel", "pump_torque=EngTrq"], ["--channel", "pump_torque=EngTrq"]),
-    "no inertia, dynamic model": ("characteristic only", ["--model", "quasi-dynamic"], ["[inertia]", "missing", "quasi-dynamic"]),
+    "no inertia, dynamic model": (
+        "characteristic only",
+        ["--model", "quasi-dynamic"],
+        ["[inertia]", "missing", "quasi-dynamic"],
+    ),
     "no inertia, default models": ("characteristic only", [], ["[inertia]", "missing"]),
-    "inadmissible shape effect": ("big shape effect", ["--model", "hrovat-tobler"],
-                                  ["geometry.pump_shape_effect_m2", "|S| <"]),
+    "inadmissible shape effect": (
+        "big shape effect",
+        ["--model", "hrovat-tobler"],
+        ["geometry.pump_shape_effect_m2", "|S| <"],
+    ),
 }
 
 
@@ -332,7 +413,18 @@ def test_solver_failure_is_exit_1_with_the_message(monkeypatch, capsys, tmp_path
 
 
 def test_ignored_initial_state_warns(cli, tmp_path, meas_csv):
-    r = cli("replay", "li-sunden-2016", meas_csv, "--model", "table", "--initial", "turbine_speed_rad_s=3",
-            "--initial", "flow_m3_s=0.05", "--out", tmp_path / "r")
+    r = cli(
+        "replay",
+        "li-sunden-2016",
+        meas_csv,
+        "--model",
+        "table",
+        "--initial",
+        "turbine_speed_rad_s=3",
+        "--initial",
+        "flow_m3_s=0.05",
+        "--out",
+        tmp_path / "r",
+    )
     assert r.code == 0, r.stderr
     assert "turbine_speed_rad_s is ignored" in r.stderr and "flow_m3_s is ignored by the table model" in r.stderr

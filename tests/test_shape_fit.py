@@ -14,9 +14,17 @@ import pandas as pd
 import pytest
 
 from tcsim.errors import InputError
-from tcsim.shape_fit import (THESIS_PAIR_M2, THESIS_VALUES_M2, fit_shape_effects, mass_matrix_bound,
-                             measured_effective_torques, shape_effect_sweep, shape_fit_command, smoothed_rate,
-                             sweep_minima)
+from tcsim.shape_fit import (
+    THESIS_PAIR_M2,
+    THESIS_VALUES_M2,
+    fit_shape_effects,
+    mass_matrix_bound,
+    measured_effective_torques,
+    shape_effect_sweep,
+    shape_fit_command,
+    smoothed_rate,
+    sweep_minima,
+)
 from tcsim.transient import PumpTorqueTurbineSpeed, dynamic_model, isolated_takeoff, simulate
 
 CONVERTER = "li-sunden-2016"
@@ -50,7 +58,9 @@ def _held(takeoff, hold_until_s: float) -> PumpTorqueTurbineSpeed:
 def _stall(hold_until_s: float = 3.0) -> PumpTorqueTurbineSpeed:
     """Drive (a) with the turbine held at rest (brake on) and the take-off's torque ramp."""
     t = np.round(np.arange(0.0, hold_until_s + 5e-4, 1e-3), 6)
-    return PumpTorqueTurbineSpeed(t, np.interp(t, [0.0, 0.1, 0.3, hold_until_s], [40.0, 40.0, 250.0, 250.0]), np.zeros_like(t))
+    return PumpTorqueTurbineSpeed(
+        t, np.interp(t, [0.0, 0.1, 0.3, hold_until_s], [40.0, 40.0, 250.0, 250.0]), np.zeros_like(t)
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -74,7 +84,9 @@ def test_fit_bounds_follow_the_mass_matrix(drive_a):
     pump, physics notes §4); the quasi-dynamic model has no bound."""
     m = dynamic_model(CONVERTER, "hrovat-tobler")
     measured = simulate(m.with_shape_effects(0.03, 0.02), drive_a)
-    r = fit_shape_effects(CONVERTER, "hrovat-tobler", drive_a, measured["time_s"], measured["effective_turbine_torque_nm"])
+    r = fit_shape_effects(
+        CONVERTER, "hrovat-tobler", drive_a, measured["time_s"], measured["effective_turbine_torque_nm"]
+    )
     assert r.bound_m2[0] == pytest.approx(0.0614, abs=5e-4) and r.bound_m2[1] == pytest.approx(0.0440, abs=5e-4)
     assert r.pump_bounds_m2 == pytest.approx((-0.98 * r.bound_m2[0], 0.98 * r.bound_m2[0]))
     assert r.turbine_bounds_m2 == pytest.approx((-0.98 * r.bound_m2[1], 0.98 * r.bound_m2[1]))
@@ -82,8 +94,14 @@ def test_fit_bounds_follow_the_mass_matrix(drive_a):
     json.dumps(d, allow_nan=False)
     assert d["bound_m2"] == list(r.bound_m2)
     with pytest.raises(InputError, match="admissible"):
-        fit_shape_effects(CONVERTER, "hrovat-tobler", drive_a, measured["time_s"], measured["effective_turbine_torque_nm"],
-                          pump_bounds=(-0.1, 0.1))
+        fit_shape_effects(
+            CONVERTER,
+            "hrovat-tobler",
+            drive_a,
+            measured["time_s"],
+            measured["effective_turbine_torque_nm"],
+            pump_bounds=(-0.1, 0.1),
+        )
 
 
 def test_python_bound_agrees_with_the_core(drive_a):
@@ -100,8 +118,16 @@ def test_python_bound_agrees_with_the_core(drive_a):
 def test_equal_fit_and_time_window(drive_a):
     m = dynamic_model(CONVERTER, "quasi-dynamic")
     measured = simulate(m.with_shape_effects(0.1, 0.1), drive_a)
-    r = fit_shape_effects(CONVERTER, "quasi-dynamic", drive_a, measured["time_s"], measured["effective_torque_ratio"],
-                          "effective_torque_ratio", equal=True, time_window=(0.0, 1.0))
+    r = fit_shape_effects(
+        CONVERTER,
+        "quasi-dynamic",
+        drive_a,
+        measured["time_s"],
+        measured["effective_torque_ratio"],
+        "effective_torque_ratio",
+        equal=True,
+        time_window=(0.0, 1.0),
+    )
     assert r.equal and r.pump_shape_effect_m2 == r.turbine_shape_effect_m2
     assert abs(r.pump_shape_effect_m2 - 0.1) < 1e-3
     assert r.points == 1001 and r.time_window_s == (0.0, 1.0)
@@ -139,11 +165,21 @@ def test_sweep_on_the_takeoff(takeoff, model, values, pairs):
     print(model, "take-off: drop below S = 0:", dict(zip(minima.label, minima.drop_below_zero.round(4))))
     assert minima.drop_below_zero.iloc[0] == 0.0 and np.all(np.diff(minima.drop_below_zero) > 0)
     assert np.ptp(minima.final_effective_torque_ratio.to_numpy()) < 1e-3
-    assert set(df.columns) >= {"pump_shape_effect_m2", "turbine_shape_effect_m2", "time_s", "speed_ratio",
-                               "effective_torque_ratio", "effective_turbine_torque_nm", "admissible", "note"}
+    assert set(df.columns) >= {
+        "pump_shape_effect_m2",
+        "turbine_shape_effect_m2",
+        "time_s",
+        "speed_ratio",
+        "effective_torque_ratio",
+        "effective_turbine_torque_nm",
+        "admissible",
+        "note",
+    }
     if model == "hrovat-tobler":
         bad = df[~df.admissible]
-        assert len(bad) == 1 and tuple(bad.iloc[0][["pump_shape_effect_m2", "turbine_shape_effect_m2"]]) == HT_INADMISSIBLE
+        assert (
+            len(bad) == 1 and tuple(bad.iloc[0][["pump_shape_effect_m2", "turbine_shape_effect_m2"]]) == HT_INADMISSIBLE
+        )
         assert "positive definite" in bad.iloc[0].note and np.isnan(bad.iloc[0].effective_torque_ratio)
     else:
         assert df.admissible.all() and len(df.groupby(["pump_shape_effect_m2", "turbine_shape_effect_m2"])) == 5
@@ -157,12 +193,19 @@ def test_measured_effective_torques_on_a_ramp():
     """A linear speed ramp has an exact smoothed derivative, uniform or jittered samples alike."""
     rng = np.random.default_rng(1)
     for t in (np.arange(0.0, 1.0, 1e-3), np.sort(rng.uniform(0.0, 1.0, 700))):
-        arrays = {"time_s": t, "pump_speed_rad_s": 100.0 + 80.0 * t, "turbine_speed_rad_s": 20.0 * t,
-                  "pump_torque_nm": 200.0 + 0 * t, "turbine_torque_nm": 300.0 + 50.0 * t}
+        arrays = {
+            "time_s": t,
+            "pump_speed_rad_s": 100.0 + 80.0 * t,
+            "turbine_speed_rad_s": 20.0 * t,
+            "pump_torque_nm": 200.0 + 0 * t,
+            "turbine_torque_nm": 300.0 + 50.0 * t,
+        }
         e = measured_effective_torques(arrays, turbine_inertia_kg_m2=0.056, pump_inertia_kg_m2=0.109)
         np.testing.assert_allclose(e["effective_pump_torque_nm"], 200.0 - 0.109 * 80.0, rtol=1e-10)
         np.testing.assert_allclose(e["effective_turbine_torque_nm"], 300.0 + 50.0 * t + 0.056 * 20.0, rtol=1e-10)
-        np.testing.assert_allclose(e["effective_torque_ratio"], e["effective_turbine_torque_nm"] / e["effective_pump_torque_nm"])
+        np.testing.assert_allclose(
+            e["effective_torque_ratio"], e["effective_turbine_torque_nm"] / e["effective_pump_torque_nm"]
+        )
 
 
 def test_smoothed_rate_is_the_cores(drive_a):
@@ -194,8 +237,12 @@ def test_shape_fit_command_writes_its_files(tmp_path, drive_a):
     assert doc["rmse"] < doc["rmse_at_zero"]
     report = (out / "shape_fit.md").read_text()
     assert "RMSE with S = 0" in report and "fitted: Sp=0.15" in report
-    for name in ("shape_sweep.csv", "effective_torque_ratio_time.png", "effective_torque_ratio_speed_ratio.png",
-                 "effective_turbine_torque_time.png"):
+    for name in (
+        "shape_sweep.csv",
+        "effective_torque_ratio_time.png",
+        "effective_torque_ratio_speed_ratio.png",
+        "effective_turbine_torque_time.png",
+    ):
         assert (out / name).stat().st_size > 0
     assert not list(tmp_path.glob("*.partial"))
 

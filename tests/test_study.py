@@ -228,9 +228,13 @@ def test_flow_falls_as_a_loss_coefficient_rises(df, key):
 
 def test_invalid_values_and_missing_steady_states_are_nan_not_a_crash(conv):
     d = default_definition().replace(
-        parameters=(ParameterRange("stator_exit_angle_deg", "Stator exit angle", "°", -90.0, 90.0),
-                    ParameterRange("stator_shock_loss", "Stator shock-loss coefficient", "-", 1.0, 20.0)),
-        values_per_parameter=3, speed_ratio=(0.0, 0.5, 0.9, 1.0))
+        parameters=(
+            ParameterRange("stator_exit_angle_deg", "Stator exit angle", "°", -90.0, 90.0),
+            ParameterRange("stator_shock_loss", "Stator shock-loss coefficient", "-", 1.0, 20.0),
+        ),
+        values_per_parameter=3,
+        speed_ratio=(0.0, 0.5, 0.9, 1.0),
+    )
     res = run_study(conv, d)
     assert len(res) == (3 + 1) * 4 + 3 * 4  # the stator exit angle of 60° is added to -90, 0, 90
     at_90 = res["parameter_value"].abs() == 90.0

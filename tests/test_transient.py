@@ -16,22 +16,39 @@ from tcsim.errors import InputError
 T = np.linspace(0.0, 3.0, 301)
 
 
-@pytest.mark.parametrize("model, extra, absent", [
-    ("table", set(), {"flow_m3_s", "stator_speed_rad_s"}),
-    ("quasi-dynamic", {"flow_m3_s"}, {"stator_speed_rad_s"}),
-    ("hrovat-tobler", {"flow_m3_s", "stator_speed_rad_s", "stator_mode", "flow_direction"}, set()),
-])
+@pytest.mark.parametrize(
+    "model, extra, absent",
+    [
+        ("table", set(), {"flow_m3_s", "stator_speed_rad_s"}),
+        ("quasi-dynamic", {"flow_m3_s"}, {"stator_speed_rad_s"}),
+        ("hrovat-tobler", {"flow_m3_s", "stator_speed_rad_s", "stator_mode", "flow_direction"}, set()),
+    ],
+)
 def test_one_line_simulate_has_the_model_columns(model, extra, absent):
     r = tcsim.simulate("li-sunden-2016", tr.isolated_takeoff(), model=model, times_s=T)
     df = r.frame()
-    base = {"time_s", "pump_speed_rad_s", "turbine_speed_rad_s", "pump_torque_nm", "turbine_torque_nm", "speed_ratio",
-            "torque_ratio", "effective_pump_torque_nm", "effective_turbine_torque_nm", "effective_torque_ratio"}
+    base = {
+        "time_s",
+        "pump_speed_rad_s",
+        "turbine_speed_rad_s",
+        "pump_torque_nm",
+        "turbine_torque_nm",
+        "speed_ratio",
+        "torque_ratio",
+        "effective_pump_torque_nm",
+        "effective_turbine_torque_nm",
+        "effective_torque_ratio",
+    }
     assert base | extra <= set(df.columns)
     assert not absent & set(df.columns)
     assert len(df) == len(T) and df["time_s"].tolist() == T.tolist()
     # eq 3.1 holds column-wise: T_p = inertia + fluid + transferred
-    np.testing.assert_allclose(df["pump_torque_nm"], df["pump_inertia_torque_nm"] + df.get("pump_fluid_torque_nm", 0)
-                               + df["pump_transferred_torque_nm"], rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(
+        df["pump_torque_nm"],
+        df["pump_inertia_torque_nm"] + df.get("pump_fluid_torque_nm", 0) + df["pump_transferred_torque_nm"],
+        rtol=1e-9,
+        atol=1e-9,
+    )
 
 
 def test_batch_equals_single_runs_and_broadcasts():
@@ -93,8 +110,13 @@ def test_bad_signals_and_initial_states_are_input_errors():
 
 
 def test_initial_state_override():
-    r = tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="hrovat-tobler", times_s=T,
-                    initial={"pump_speed_rad_s": 150.0, "turbine_speed_rad_s": 20.0})
+    r = tr.simulate(
+        "li-sunden-2016",
+        tr.isolated_takeoff(),
+        model="hrovat-tobler",
+        times_s=T,
+        initial={"pump_speed_rad_s": 150.0, "turbine_speed_rad_s": 20.0},
+    )
     assert r["pump_speed_rad_s"][0] == 150.0 and r["turbine_speed_rad_s"][0] == 20.0
     default = tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="hrovat-tobler", times_s=T)
     # default: the steady state with the first pump torque (40 N·m) at stall
@@ -105,6 +127,7 @@ def test_initial_state_override():
 def test_quasi_dynamic_needs_its_section():
     conv = tcsim.load_converter("li-sunden-2016")
     from dataclasses import replace
+
     with pytest.raises(InputError, match=r"\[quasi_dynamic\]"):
         tr.dynamic_model(replace(conv, quasi_dynamic=None), "quasi-dynamic")
     assert tr.default_flow_time_constant_s(conv) == pytest.approx(2.93e-3, rel=1e-2)

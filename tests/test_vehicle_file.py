@@ -13,8 +13,7 @@ import pytest
 import tomli_w
 
 from tcsim.errors import InputError
-from tcsim.vehicle import (DEFAULT_VEHICLE, SECTIONS, Vehicle, bundled_vehicle_names, load_vehicle,
-                           parse_vehicle)
+from tcsim.vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, bundled_vehicle_names, load_vehicle, parse_vehicle
 
 REPO = Path(__file__).resolve().parents[1]
 BUNDLED = REPO / "python" / "tcsim" / "data" / "vehicles" / "midsize-awd-8at.toml"
@@ -40,7 +39,9 @@ def test_bundled_vehicle_loads_by_default():
     v = load_vehicle()
     assert isinstance(v, Vehicle) and v.name == DEFAULT_VEHICLE
     assert load_vehicle(DEFAULT_VEHICLE).name == v.name
-    assert v.converter.name == "li-sunden-2016-fitted" and {"table", "hrovat-tobler", "quasi-dynamic"} <= set(v.converter.models)
+    assert v.converter.name == "li-sunden-2016-fitted" and {"table", "hrovat-tobler", "quasi-dynamic"} <= set(
+        v.converter.models
+    )
     assert v.converter.inertia is not None  # the pump and turbine inertias are the converter's
     assert v.gearbox.gears == 8 and v.gearbox.ratios[0] == pytest.approx(5.25)
     assert v.overall_ratio(1) == pytest.approx(5.25 * v.driveline.final_drive_ratio)
@@ -104,12 +105,14 @@ def test_converter_path_relative_to_the_vehicle_file(tmp_path):
 def _set(section, key, value):
     def edit(d):
         (d[section] if section else d)[key] = value
+
     return edit
 
 
 def _item(section, key, index, value):
     def edit(d):
         d[section][key][index] = value
+
     return edit
 
 
@@ -119,12 +122,14 @@ def _drop(section, key=None):
             del d[section]
         else:
             del d[section][key]
+
     return edit
 
 
 def _pop_last(section, key):
     def edit(d):
         d[section][key] = d[section][key][:-1]
+
     return edit
 
 
@@ -152,38 +157,63 @@ BAD = {
     "negative inertia": (_set("engine", "inertia_kg_m2", -0.2), ["[engine].inertia_kg_m2", "-0.2", "greater than 0"]),
     "zero mass": (_set("body", "mass_kg", 0.0), ["[body].mass_kg", "0", "greater than 0"]),
     "nan value": (_set("tyres", "slip_stiffness", math.nan), ["[tyres].slip_stiffness", "nan", "finite"]),
-    "inf in an array": (_item("engine", "full_load_torque_nm", 2, math.inf), ["[engine].full_load_torque_nm[2]", "finite"]),
+    "inf in an array": (
+        _item("engine", "full_load_torque_nm", 2, math.inf),
+        ["[engine].full_load_torque_nm[2]", "finite"],
+    ),
     "text for a number": (_set("body", "mass_kg", "1930"), ["[body].mass_kg", "'1930'", "a number, not a string"]),
     "float for min_gear": (_set("lockup", "min_gear", 3.0), ["[lockup].min_gear", "an integer, not a float (3.0)"]),
     "full-load speed not increasing": (_repeat_speed, ["[engine].full_load_speed_rad_s[3]", "strictly increasing"]),
-    "full-load arrays mismatched": (_pop_last("engine", "full_load_torque_nm"),
-                                    ["[engine].full_load_torque_nm", "7 values", "8 values"]),
+    "full-load arrays mismatched": (
+        _pop_last("engine", "full_load_torque_nm"),
+        ["[engine].full_load_torque_nm", "7 values", "8 values"],
+    ),
     "idle outside the curve": (_set("engine", "idle_speed_rad_s", 10.0), ["[engine].idle_speed_rad_s", "10", "within"]),
     "idle below drag": (_idle_cannot_hold, ["[engine].full_load_torque_nm", "at idle", "drag"]),
     "boost fraction above 1": (_set("engine", "boost_fraction", 1.5), ["[engine].boost_fraction", "1.5", "at most 1"]),
     "efficiency above 1": (_item("gearbox", "efficiencies", 2, 1.1), ["[gearbox].efficiencies[2]", "1.1", "at most 1"]),
     "efficiency zero": (_item("gearbox", "efficiencies", 0, 0.0), ["[gearbox].efficiencies[0]", "0", "greater than 0"]),
-    "gear arrays mismatched": (_pop_last("gearbox", "efficiencies"), ["[gearbox].efficiencies", "7 values", "ratios has 8"]),
-    "inertia per gear mismatched": (_pop_last("gearbox", "input_inertia_kg_m2"), ["[gearbox].input_inertia_kg_m2", "7 values"]),
+    "gear arrays mismatched": (
+        _pop_last("gearbox", "efficiencies"),
+        ["[gearbox].efficiencies", "7 values", "ratios has 8"],
+    ),
+    "inertia per gear mismatched": (
+        _pop_last("gearbox", "input_inertia_kg_m2"),
+        ["[gearbox].input_inertia_kg_m2", "7 values"],
+    ),
     "ratios not decreasing": (_swap_ratios, ["[gearbox].ratios[2]", "strictly decreasing"]),
-    "schedule too long": (_set("gearbox", "upshift_speed_zero_pedal_m_s", [3.0, 5.0, 9.0, 12.0, 14.0, 17.0, 21.0, 25.0]),
-                          ["[gearbox].upshift_speed_zero_pedal_m_s", "8 values", "7 values"]),
+    "schedule too long": (
+        _set("gearbox", "upshift_speed_zero_pedal_m_s", [3.0, 5.0, 9.0, 12.0, 14.0, 17.0, 21.0, 25.0]),
+        ["[gearbox].upshift_speed_zero_pedal_m_s", "8 values", "7 values"],
+    ),
     "downshift above upshift": (_downshift_above_upshift, ["[gearbox].downshift_speed_full_pedal_m_s[1]", "below"]),
     "min gear above the gears": (_set("lockup", "min_gear", 9), ["[lockup].min_gear", "9", "from 1 to 8"]),
-    "static below kinetic": (_set("lockup", "static_to_kinetic", 0.9), ["[lockup].static_to_kinetic", "0.9", "at least 1"]),
-    "load fraction of one": (_set("tyres", "front_load_fraction", 1.0), ["[tyres].front_load_fraction", "1", "less than 1"]),
-    "negative damping": (_set("driveline", "rear_shaft_damping_nm_s_per_rad", -1.0),
-                         ["[driveline].rear_shaft_damping_nm_s_per_rad", "-1", "at least 0"]),
+    "static below kinetic": (
+        _set("lockup", "static_to_kinetic", 0.9),
+        ["[lockup].static_to_kinetic", "0.9", "at least 1"],
+    ),
+    "load fraction of one": (
+        _set("tyres", "front_load_fraction", 1.0),
+        ["[tyres].front_load_fraction", "1", "less than 1"],
+    ),
+    "negative damping": (
+        _set("driveline", "rear_shaft_damping_nm_s_per_rad", -1.0),
+        ["[driveline].rear_shaft_damping_nm_s_per_rad", "-1", "at least 0"],
+    ),
     "brake share above 1": (_set("brake", "front_fraction", 1.2), ["[brake].front_fraction", "1.2"]),
     "unknown key": (_set("engine", "inertia_kgm2", 0.2), ["[engine].inertia_kgm2", "unknown", "inertia_kg_m2"]),
     "unknown section": (_set(None, "turbo", {"lag_s": 1.0}), ["turbo", "unknown", "the top level"]),
     "missing key": (_drop("body", "mass_kg"), ["[body].mass_kg", "missing"]),
     "missing section": (_drop("brake"), ["[brake]", "missing", "section"]),
     "missing converter": (_drop("converter"), ["converter", "missing"]),
-    "converter not found": (_set(None, "converter", "no-such-converter.toml"),
-                            ["converter", "no-such-converter.toml", "bundled converter"]),
-    "unknown source key": (lambda d: d["sources"].update({"engine.turbo_lag_s": "assumed: x"}),
-                           ["[sources]", "engine.turbo_lag_s"]),
+    "converter not found": (
+        _set(None, "converter", "no-such-converter.toml"),
+        ["converter", "no-such-converter.toml", "bundled converter"],
+    ),
+    "unknown source key": (
+        lambda d: d["sources"].update({"engine.turbo_lag_s": "assumed: x"}),
+        ["[sources]", "engine.turbo_lag_s"],
+    ),
 }
 
 

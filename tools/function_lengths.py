@@ -18,8 +18,10 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
-RUST_FN = re.compile(r"^(\s*)(?:pub(?:\([a-z:]+\))?\s+)?(?:const\s+)?(?:async\s+)?(?:unsafe\s+)?"
-                     r"(?:extern\s+\"C\"\s+)?fn\s+([A-Za-z_][A-Za-z0-9_]*)")
+RUST_FN = re.compile(
+    r"^(\s*)(?:pub(?:\([a-z:]+\))?\s+)?(?:const\s+)?(?:async\s+)?(?:unsafe\s+)?"
+    r"(?:extern\s+\"C\"\s+)?fn\s+([A-Za-z_][A-Za-z0-9_]*)"
+)
 
 
 def rust_functions(path: Path) -> Iterator[tuple[str, int, int]]:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import warnings
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated
 
 import typer
 from rich.console import Console
@@ -18,8 +18,12 @@ from rich.table import Table
 
 from .errors import InputError, TcsimWarning
 
-app = typer.Typer(add_completion=False, no_args_is_help=True, pretty_exceptions_enable=False,
-                  help="tcsim: hydrodynamic torque converter models (table, Hrovat & Tobler, quasi-dynamic).")
+app = typer.Typer(
+    add_completion=False,
+    no_args_is_help=True,
+    pretty_exceptions_enable=False,
+    help="tcsim: hydrodynamic torque converter models (table, Hrovat & Tobler, quasi-dynamic).",
+)
 console = Console(stderr=True)
 stdout = Console()
 
@@ -51,7 +55,8 @@ def characterise(
     from .converter import load_converter
     from .outputs import output_dir
     from .plots import plot_characteristic
-    from .steady import characterise as run, coupling_point
+    from .steady import characterise as run
+    from .steady import coupling_point
 
     conv = load_converter(converter)
     model = model or ("hrovat-tobler" if "hrovat-tobler" in conv.models else "table")
@@ -61,8 +66,13 @@ def characterise(
     with output_dir(out) as stage:
         df.to_csv(stage / "characteristic.csv", index=False)
         table = conv.characteristic if model == "hrovat-tobler" else None
-        plot_characteristic({f"{model} model": df}, stage, f"{conv.name}, pump at {pump_speed_rpm:g} rpm",
-                            table=table, coupling_point=cp)
+        plot_characteristic(
+            {f"{model} model": df},
+            stage,
+            f"{conv.name}, pump at {pump_speed_rpm:g} rpm",
+            table=table,
+            coupling_point=cp,
+        )
     msg = f"{model}: {len(df)} points written to {out}/characteristic.csv and plots"
     if cp is not None:
         msg += f"; coupling point at SR {cp:.4f}"
@@ -72,11 +82,17 @@ def characterise(
 @app.command()
 def fit(
     converter: Annotated[str, typer.Argument(help="converter whose Hrovat & Tobler parameters are the start point")],
-    target: Annotated[str, typer.Option("--target", help="characteristic table to fit: .csv, .vtcc or converter .toml")],
+    target: Annotated[
+        str, typer.Option("--target", help="characteristic table to fit: .csv, .vtcc or converter .toml")
+    ],
     out: OutOpt = Path("fit"),
-    free: Annotated[Optional[str], typer.Option(help="comma-separated parameters to free (default: losses and the six angles)")] = None,
-    bound: Annotated[Optional[list[str]], typer.Option(help="NAME=LO:HI bounds of a free parameter, repeatable")] = None,
-    speed_ratio_max: Annotated[Optional[float], typer.Option(help="fit SR from 0 up to this (default: the table's coupling point)")] = None,
+    free: Annotated[
+        str | None, typer.Option(help="comma-separated parameters to free (default: losses and the six angles)")
+    ] = None,
+    bound: Annotated[list[str] | None, typer.Option(help="NAME=LO:HI bounds of a free parameter, repeatable")] = None,
+    speed_ratio_max: Annotated[
+        float | None, typer.Option(help="fit SR from 0 up to this (default: the table's coupling point)")
+    ] = None,
 ) -> None:
     """Fit Hrovat & Tobler parameters to a characteristic table: DIR/fitted.toml, report, plots."""
     from .fitting import fit_command
@@ -99,19 +115,43 @@ def study(
 def replay(
     converter: Annotated[str, typer.Argument(help="bundled name or converter .toml")],
     measurement: Annotated[str, typer.Argument(help="measured time series: .csv, .parquet, .mat or .mf4/.mdf")],
-    model: Annotated[Optional[list[str]], typer.Option("--model", "-m", help="table | hrovat-tobler | quasi-dynamic, repeatable (default: every model the converter supports)")] = None,
+    model: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--model",
+            "-m",
+            help="table | hrovat-tobler | quasi-dynamic, repeatable (default: every model the converter supports)",
+        ),
+    ] = None,
     out: OutOpt = Path("replay"),
-    channel: Annotated[Optional[list[str]], typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")] = None,
-    drive: Annotated[str, typer.Option("--drive", help="pump-torque (pump torque and turbine speed given) | speeds (both speeds given)")] = "pump-torque",
-    initial: Annotated[Optional[list[str]], typer.Option("--initial", help="NAME=VALUE initial state override (SI), repeatable")] = None,
-    window: Annotated[Optional[float], typer.Option("--window", help="derivative smoothing window S, s: local least-squares slope over ±S/2 [default: 0.04]")] = None,
-    metrics_window: Annotated[float, typer.Option("--metrics-window", help="width of the consecutive metric windows, s")] = 1.0,
+    channel: Annotated[
+        list[str] | None, typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")
+    ] = None,
+    drive: Annotated[
+        str,
+        typer.Option("--drive", help="pump-torque (pump torque and turbine speed given) | speeds (both speeds given)"),
+    ] = "pump-torque",
+    initial: Annotated[
+        list[str] | None, typer.Option("--initial", help="NAME=VALUE initial state override (SI), repeatable")
+    ] = None,
+    window: Annotated[
+        float | None,
+        typer.Option(
+            "--window", help="derivative smoothing window S, s: local least-squares slope over ±S/2 [default: 0.04]"
+        ),
+    ] = None,
+    metrics_window: Annotated[
+        float, typer.Option("--metrics-window", help="width of the consecutive metric windows, s")
+    ] = 1.0,
 ) -> None:
     """Isolated converter driven by measured signals: DIR/<model>.csv, events, metrics, plots."""
     from .replay import replay_command
 
-    stdout.print(replay_command(converter, measurement, model or [], out, channel or [], drive, initial or [],
-                                window, metrics_window))
+    stdout.print(
+        replay_command(
+            converter, measurement, model or [], out, channel or [], drive, initial or [], window, metrics_window
+        )
+    )
 
 
 @app.command("fit-shapes")
@@ -119,9 +159,13 @@ def fit_shapes(
     converter: Annotated[str, typer.Argument(help="bundled name or converter .toml")],
     measurement: Annotated[str, typer.Argument(help="take-off measurement: .csv, .parquet, .mat or .mf4/.mdf")],
     model: ModelOpt = "quasi-dynamic",
-    target: Annotated[str, typer.Option("--target", help="effective_turbine_torque_nm | effective_torque_ratio")] = "effective_turbine_torque_nm",
+    target: Annotated[
+        str, typer.Option("--target", help="effective_turbine_torque_nm | effective_torque_ratio")
+    ] = "effective_turbine_torque_nm",
     out: OutOpt = Path("shape_fit"),
-    channel: Annotated[Optional[list[str]], typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")] = None,
+    channel: Annotated[
+        list[str] | None, typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")
+    ] = None,
     drive: Annotated[str, typer.Option("--drive", help="pump-torque | speeds")] = "pump-torque",
     equal: Annotated[bool, typer.Option("--equal", help="fit one shape effect, S_p = S_t")] = False,
 ) -> None:
@@ -133,11 +177,28 @@ def fit_shapes(
 
 @app.command()
 def launch(
-    vehicle: Annotated[Optional[str], typer.Argument(help="bundled vehicle name or vehicle .toml (default: midsize-awd-8at)")] = None,
+    vehicle: Annotated[
+        str | None, typer.Argument(help="bundled vehicle name or vehicle .toml (default: midsize-awd-8at)")
+    ] = None,
     out: OutOpt = Path("launch"),
-    scenario: Annotated[str, typer.Option("--scenario", help="flip-flop | part-pedal | FILE with time_s, accelerator_pedal, brake_pedal")] = "flip-flop",
-    model: Annotated[Optional[list[str]], typer.Option("--model", "-m", help="table | hrovat-tobler | quasi-dynamic, repeatable (default: every model the converter supports)")] = None,
-    sweep_shape_effects: Annotated[bool, typer.Option("--sweep-shape-effects", help="also sweep S_p = S_t of the dynamic models (like thesis figs 4.3–4.6)")] = False,
+    scenario: Annotated[
+        str,
+        typer.Option("--scenario", help="flip-flop | part-pedal | FILE with time_s, accelerator_pedal, brake_pedal"),
+    ] = "flip-flop",
+    model: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--model",
+            "-m",
+            help="table | hrovat-tobler | quasi-dynamic, repeatable (default: every model the converter supports)",
+        ),
+    ] = None,
+    sweep_shape_effects: Annotated[
+        bool,
+        typer.Option(
+            "--sweep-shape-effects", help="also sweep S_p = S_t of the dynamic models (like thesis figs 4.3–4.6)"
+        ),
+    ] = False,
 ) -> None:
     """Vehicle take-off with every converter model: DIR/summary.csv, DIR/<model>.csv, plots like thesis figs 3.5, 3.6, 3.20."""
     from .launch import launch_command
@@ -150,7 +211,10 @@ def export_fmu(
     converter: Annotated[str, typer.Argument(help="bundled name or converter .toml")],
     model: Annotated[str, typer.Option("--model", "-m", help="table | hrovat-tobler | quasi-dynamic")],
     out: Annotated[Path, typer.Option("--out", "-o", help="the FMU file to write (*.fmu)")],
-    causality: Annotated[str, typer.Option("--causality", help="pump-torque (pump torque and turbine speed in) | speeds (both speeds in)")] = "pump-torque",
+    causality: Annotated[
+        str,
+        typer.Option("--causality", help="pump-torque (pump torque and turbine speed in) | speeds (both speeds in)"),
+    ] = "pump-torque",
 ) -> None:
     """Export one model as an FMI 2.0 FMU, Model Exchange and Co-Simulation (linux64 binary, sources to rebuild elsewhere; no Python inside)."""
     from .fmu import export_fmu_command
@@ -165,7 +229,7 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
         console.print(f"warning: {category.__name__}: {escape(str(message))}", highlight=False, soft_wrap=True)
 
 
-def main(argv: Optional[list[str]] = None) -> int:
+def main(argv: list[str] | None = None) -> int:
     """Entry point: runs the app and maps errors to exit codes."""
     warnings.showwarning = _show_warning
     try:

@@ -55,7 +55,7 @@ class Characteristic:
         source: str,
         where: str = "",
         rows: list[int] | None = None,
-    ) -> "Characteristic":
+    ) -> Characteristic:
         """Validate and convert a table read in capacity ``convention``.
 
         ``where`` prefixes field names (``"[characteristic]."`` for TOML); ``rows`` maps each
@@ -75,21 +75,30 @@ class Characteristic:
             if bad.size:
                 raise InputError(source, name(col, int(bad[0])), float(v[bad[0]]), "a finite number")
         if not (len(sr) == len(tr) == len(cap)):
-            raise InputError(source, f"{where}torque_ratio", f"{len(tr)} values",
-                             f"as many values as speed_ratio ({len(sr)}) and {convention} ({len(cap)})")
+            raise InputError(
+                source,
+                f"{where}torque_ratio",
+                f"{len(tr)} values",
+                f"as many values as speed_ratio ({len(sr)}) and {convention} ({len(cap)})",
+            )
         if len(sr) < 2:
             raise InputError(source, f"{where}speed_ratio", f"{len(sr)} points", "at least 2 points")
         dec = np.flatnonzero(np.diff(sr) <= 0)
         if dec.size:
             i = int(dec[0]) + 1
-            raise InputError(source, name("speed_ratio", i), float(sr[i]),
-                             f"strictly increasing speed ratio (previous value {sr[i - 1]:g})")
+            raise InputError(
+                source,
+                name("speed_ratio", i),
+                float(sr[i]),
+                f"strictly increasing speed ratio (previous value {sr[i - 1]:g})",
+            )
         drive = sr < 1.0
         for col, v in (("torque_ratio", tr), (convention, cap)):
             bad = np.flatnonzero(drive & (v <= 0))
             if bad.size:
-                raise InputError(source, name(col, int(bad[0])), float(v[bad[0]]),
-                                 "a positive value in drive (speed ratio below 1)")
+                raise InputError(
+                    source, name(col, int(bad[0])), float(v[bad[0]]), "a positive value in drive (speed ratio below 1)"
+                )
         cf = np.asarray(_core.capacity_to_cf(convention, np.ascontiguousarray(cap)))
         try:
             _core.table_check(sr, tr, cf)
@@ -225,7 +234,6 @@ class ConverterFile(_Section):
     sources: dict[str, str] = {}
 
 
-
 _SECTIONS = ("characteristic", "inertia", "geometry", "quasi_dynamic")
 _REQUIRED = {
     "table": ("characteristic",),
@@ -329,14 +337,24 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
     if doc.characteristic is not None:
         key, values = doc.characteristic.capacity()
         characteristic = Characteristic.from_columns(
-            doc.characteristic.speed_ratio, doc.characteristic.torque_ratio, values, key, path, "[characteristic].")
+            doc.characteristic.speed_ratio, doc.characteristic.torque_ratio, values, key, path, "[characteristic]."
+        )
     if doc.geometry is not None:
         try:
             _core.ht_check_geometry(doc.geometry.core_row())
         except _core.CoreInputError as e:
             raise from_core(e, path, "[geometry].") from None
-    return Converter(doc.name, doc.source, path, characteristic, doc.inertia, doc.geometry, doc.quasi_dynamic,
-                     doc.description, dict(doc.sources))
+    return Converter(
+        doc.name,
+        doc.source,
+        path,
+        characteristic,
+        doc.inertia,
+        doc.geometry,
+        doc.quasi_dynamic,
+        doc.description,
+        dict(doc.sources),
+    )
 
 
 def read_converter_toml(path: Path) -> Converter:
@@ -376,8 +394,12 @@ def load_converter(spec: str | Path) -> Converter:
             return read_converter_toml(Path(p))
     path = Path(spec)
     if not path.exists():
-        raise InputError(text, "converter", text,
-                         f"a bundled converter ({', '.join(bundled_names())}) or an existing .toml, .csv or .vtcc file")
+        raise InputError(
+            text,
+            "converter",
+            text,
+            f"a bundled converter ({', '.join(bundled_names())}) or an existing .toml, .csv or .vtcc file",
+        )
     suffix = path.suffix.lower()
     if suffix == ".toml":
         return read_converter_toml(path)

@@ -9,7 +9,8 @@ effective torques are therefore filtered alike.
 
 from __future__ import annotations
 
-from typing import Any, Mapping, Union
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
@@ -27,14 +28,18 @@ def smoothed_rate(time_s, values, window_s: float = DERIVATIVE_WINDOW_S) -> np.n
     return _core.smoothed_rate(t, y, float(window_s))
 
 
-def _channels(source: Union[Measurement, Mapping[str, Any]]) -> dict[str, np.ndarray]:
+def _channels(source: Measurement | Mapping[str, Any]) -> dict[str, np.ndarray]:
     if isinstance(source, Measurement):
         return {"time_s": source.time_s, **source.channels}
     return {k: np.asarray(v, dtype=float) for k, v in source.items()}
 
 
-def measured_effective_torques(measurement_or_arrays: Union[Measurement, Mapping[str, Any]], turbine_inertia_kg_m2: float,
-                               pump_inertia_kg_m2: float, window_s: float = DERIVATIVE_WINDOW_S) -> dict[str, np.ndarray]:
+def measured_effective_torques(
+    measurement_or_arrays: Measurement | Mapping[str, Any],
+    turbine_inertia_kg_m2: float,
+    pump_inertia_kg_m2: float,
+    window_s: float = DERIVATIVE_WINDOW_S,
+) -> dict[str, np.ndarray]:
     """Effective torques of a measurement (eqs 3.3 and 3.4):
 
     * effective pump input ``= pump_torque_nm − I_p·ω̇_p`` (needs ``pump_torque_nm`` and ``pump_speed_rad_s``),
@@ -54,7 +59,9 @@ def measured_effective_torques(measurement_or_arrays: Union[Measurement, Mapping
     if "turbine_speed_rad_s" in c:
         out["turbine_accel_rad_s2"] = smoothed_rate(t, c["turbine_speed_rad_s"], window_s)
         if "turbine_torque_nm" in c:
-            out["effective_turbine_torque_nm"] = c["turbine_torque_nm"] + turbine_inertia_kg_m2 * out["turbine_accel_rad_s2"]
+            out["effective_turbine_torque_nm"] = (
+                c["turbine_torque_nm"] + turbine_inertia_kg_m2 * out["turbine_accel_rad_s2"]
+            )
     if "effective_pump_torque_nm" in out and "effective_turbine_torque_nm" in out:
         with np.errstate(divide="ignore", invalid="ignore"):
             out["effective_torque_ratio"] = out["effective_turbine_torque_nm"] / out["effective_pump_torque_nm"]

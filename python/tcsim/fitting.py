@@ -26,9 +26,10 @@ import dataclasses
 import json
 import math
 import time
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 from scipy.optimize import least_squares
@@ -127,8 +128,9 @@ def default_bounds(name: str, start: float) -> tuple[float, float]:
     return min(lo, start), max(hi, start)
 
 
-def resolve_bounds(free: Sequence[str], bounds: Mapping[str, tuple[float, float]] | None,
-                   start: Mapping[str, float]) -> dict[str, tuple[float, float]]:
+def resolve_bounds(
+    free: Sequence[str], bounds: Mapping[str, tuple[float, float]] | None, start: Mapping[str, float]
+) -> dict[str, tuple[float, float]]:
     """Bounds of every free parameter: the user's where given, the defaults otherwise."""
     bounds = dict(bounds or {})
     for name, (lo, hi) in bounds.items():
@@ -136,17 +138,27 @@ def resolve_bounds(free: Sequence[str], bounds: Mapping[str, tuple[float, float]
         if name not in STEADY_KEYS:
             raise InputError("command line", "--bound", text, f"a bound on one of {', '.join(STEADY_KEYS)}")
         if name not in free:
-            raise InputError("command line", "--bound", text, f"a bound on a free parameter ({', '.join(free)}); add {name} to --free")
+            raise InputError(
+                "command line",
+                "--bound",
+                text,
+                f"a bound on a free parameter ({', '.join(free)}); add {name} to --free",
+            )
         if not lo < hi:
             raise InputError("command line", "--bound", text, "LO < HI")
         a_lo, a_hi, inclusive = _admissible(name)
         if lo < a_lo or (lo == a_lo and not inclusive) or hi >= a_hi:
             low = f"{'≥' if inclusive else '>'} {a_lo:g}"
-            raise InputError("command line", "--bound", text,
-                             f"bounds the model accepts: LO {low}" + (f", HI < {a_hi:g}" if math.isfinite(a_hi) else ""))
+            raise InputError(
+                "command line",
+                "--bound",
+                text,
+                f"bounds the model accepts: LO {low}" + (f", HI < {a_hi:g}" if math.isfinite(a_hi) else ""),
+            )
         if not lo <= start[name] <= hi:
-            raise InputError("command line", "--bound", text,
-                             f"bounds that contain the start value {name} = {start[name]:g}")
+            raise InputError(
+                "command line", "--bound", text, f"bounds that contain the start value {name} = {start[name]:g}"
+            )
     return {n: bounds.get(n) or default_bounds(n, start[n]) for n in free}
 
 
@@ -166,11 +178,15 @@ def default_speed_ratio_max(table: Characteristic) -> float:
     if coupled.size:
         return float(sr[coupled[0]])
     if not drive.any():
-        raise InputError(table.source, "speed_ratio", f"{sr[0]:g} to {sr[-1]:g}", "table points with SR from 0 to below 1")
+        raise InputError(
+            table.source, "speed_ratio", f"{sr[0]:g} to {sr[-1]:g}", "table points with SR from 0 to below 1"
+        )
     return float(sr[drive][-1])
 
 
-def fit_points(table: Characteristic, speed_ratio_max: float | None) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+def fit_points(
+    table: Characteristic, speed_ratio_max: float | None
+) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
     """SR_max and the table points with SR in [0, SR_max]."""
     if speed_ratio_max is None:
         speed_ratio_max = default_speed_ratio_max(table)
@@ -179,8 +195,12 @@ def fit_points(table: Characteristic, speed_ratio_max: float | None) -> tuple[fl
     sr, tr, cf = table.arrays()
     keep = (sr >= 0) & (sr <= speed_ratio_max + 1e-12)
     if keep.sum() < 2:
-        raise InputError("command line", "--speed-ratio-max", speed_ratio_max,
-                         f"a range from SR 0 holding at least 2 points of {table.source}")
+        raise InputError(
+            "command line",
+            "--speed-ratio-max",
+            speed_ratio_max,
+            f"a range from SR 0 holding at least 2 points of {table.source}",
+        )
     return float(speed_ratio_max), sr[keep], tr[keep], cf[keep]
 
 
@@ -246,8 +266,17 @@ class _Problem:
         cost0 = 0.5 * float(np.sum(self.residuals(u0) ** 2))
         # any infeasible point then costs more than the start, so steps into one are rejected
         self.penalty = 10.0 * (math.sqrt(2.0 * cost0) + 1.0)
-        return least_squares(self.residuals, u0, jac=self.jacobian, bounds=(0.0, 1.0), method="trf",
-                             ftol=1e-10, xtol=1e-10, gtol=1e-10, max_nfev=100 * (len(self.free) + 1))
+        return least_squares(
+            self.residuals,
+            u0,
+            jac=self.jacobian,
+            bounds=(0.0, 1.0),
+            method="trf",
+            ftol=1e-10,
+            xtol=1e-10,
+            gtol=1e-10,
+            max_nfev=100 * (len(self.free) + 1),
+        )
 
 
 def _starts(problem: _Problem, u0: np.ndarray, n_starts: int) -> list[np.ndarray]:
@@ -300,8 +329,13 @@ def _correlation(jac: np.ndarray, cost: float) -> dict[str, Any]:
         corr = np.where(np.outer(sd, sd) > 0, cov / np.outer(sd, sd), np.nan)
     s2 = 2.0 * cost / (m - k) if m > k else math.nan
     std = np.where(identifiable, sd * math.sqrt(s2), np.nan) if m > k else np.full(k, np.nan)
-    return {"rank": rank, "condition_number": cond, "correlation": np.clip(corr, -1.0, 1.0),
-            "std_scaled": std, "identifiable": identifiable}
+    return {
+        "rank": rank,
+        "condition_number": cond,
+        "correlation": np.clip(corr, -1.0, 1.0),
+        "std_scaled": std,
+        "identifiable": identifiable,
+    }
 
 
 # --------------------------------------------------------------------------------------------
@@ -374,6 +408,7 @@ class FitResult:
 
     def to_dict(self) -> dict[str, Any]:
         """The numbers of ``fit_report.json`` (relative errors as fractions, not %)."""
+
         def num(x):
             return None if not np.isfinite(x) else float(x)
 
@@ -381,42 +416,73 @@ class FitResult:
             "table": self.table_source,
             "speed_ratio_max": self.speed_ratio_max,
             "pump_speed_rpm": PUMP_SPEED_RAD_S / RAD_S_PER_RPM,
-            "parameters": {n: {"start": self.start_values[n], "fitted": self.values[n], "lower": self.bounds[n][0],
-                               "upper": self.bounds[n][1], "active": self.active.get(n), "std_error": num(self.std_error[i]),
-                               "identifiable": bool(self.identifiable[i])}
-                           for i, n in enumerate(self.free)},
-            "errors": {"rms_torque_ratio": self.rms_tr, "rms_capacity_factor": self.rms_cf,
-                       "max_torque_ratio": self.max_tr, "max_capacity_factor": self.max_cf},
-            "points": {"speed_ratio": self.speed_ratio.tolist(),
-                       "torque_ratio_table": self.torque_ratio_table.tolist(),
-                       "torque_ratio_model": self.torque_ratio_model.tolist(),
-                       "capacity_factor_table": self.capacity_factor_table.tolist(),
-                       "capacity_factor_model": self.capacity_factor_model.tolist()},
-            "correlation": {"parameters": list(self.free), "matrix": [[num(v) for v in row] for row in self.correlation],
-                            "jacobian_rank": self.jacobian_rank, "singular": self.singular,
-                            "condition_number": num(self.condition_number)},
-            "optimiser": {"method": "scipy.optimize.least_squares, trf, analytic Jacobian", "nfev": self.nfev,
-                          "njev": self.njev, "starts": self.starts, "seed": SEED, "message": self.message,
-                          "elapsed_s": self.elapsed_s},
+            "parameters": {
+                n: {
+                    "start": self.start_values[n],
+                    "fitted": self.values[n],
+                    "lower": self.bounds[n][0],
+                    "upper": self.bounds[n][1],
+                    "active": self.active.get(n),
+                    "std_error": num(self.std_error[i]),
+                    "identifiable": bool(self.identifiable[i]),
+                }
+                for i, n in enumerate(self.free)
+            },
+            "errors": {
+                "rms_torque_ratio": self.rms_tr,
+                "rms_capacity_factor": self.rms_cf,
+                "max_torque_ratio": self.max_tr,
+                "max_capacity_factor": self.max_cf,
+            },
+            "points": {
+                "speed_ratio": self.speed_ratio.tolist(),
+                "torque_ratio_table": self.torque_ratio_table.tolist(),
+                "torque_ratio_model": self.torque_ratio_model.tolist(),
+                "capacity_factor_table": self.capacity_factor_table.tolist(),
+                "capacity_factor_model": self.capacity_factor_model.tolist(),
+            },
+            "correlation": {
+                "parameters": list(self.free),
+                "matrix": [[num(v) for v in row] for row in self.correlation],
+                "jacobian_rank": self.jacobian_rank,
+                "singular": self.singular,
+                "condition_number": num(self.condition_number),
+            },
+            "optimiser": {
+                "method": "scipy.optimize.least_squares, trf, analytic Jacobian",
+                "nfev": self.nfev,
+                "njev": self.njev,
+                "starts": self.starts,
+                "seed": SEED,
+                "message": self.message,
+                "elapsed_s": self.elapsed_s,
+            },
             "notes": list(self.notes),
         }
 
     def summary(self) -> str:
         """One paragraph for the console."""
         active = ", ".join(f"{n} at {side} bound" for n, side in self.active.items()) or "none"
-        return (f"fitted {len(self.free)} parameters to {len(self.speed_ratio)} points of {self.table_source} "
-                f"(SR 0–{self.speed_ratio_max:g}): RMS error TR {100 * self.rms_tr:.3g} %, CF {100 * self.rms_cf:.3g} % "
-                f"(max {100 * self.max_tr:.3g} %, {100 * self.max_cf:.3g} %); active bounds: {active}; "
-                f"{self.nfev} evaluations, {self.starts} starts, {self.elapsed_s:.2f} s")
+        return (
+            f"fitted {len(self.free)} parameters to {len(self.speed_ratio)} points of {self.table_source} "
+            f"(SR 0–{self.speed_ratio_max:g}): RMS error TR {100 * self.rms_tr:.3g} %, CF {100 * self.rms_cf:.3g} % "
+            f"(max {100 * self.max_tr:.3g} %, {100 * self.max_cf:.3g} %); active bounds: {active}; "
+            f"{self.nfev} evaluations, {self.starts} starts, {self.elapsed_s:.2f} s"
+        )
 
 
 # --------------------------------------------------------------------------------------------
 # the fit
 
 
-def fit_hrovat_tobler(geometry: GeometrySection, table: Characteristic, free: Sequence[str] = DEFAULT_FREE,
-                      bounds: Mapping[str, tuple[float, float]] | None = None,
-                      speed_ratio_max: float | None = None, n_starts: int = N_STARTS) -> FitResult:
+def fit_hrovat_tobler(
+    geometry: GeometrySection,
+    table: Characteristic,
+    free: Sequence[str] = DEFAULT_FREE,
+    bounds: Mapping[str, tuple[float, float]] | None = None,
+    speed_ratio_max: float | None = None,
+    n_starts: int = N_STARTS,
+) -> FitResult:
     """Fit the ``free`` Hrovat & Tobler parameters of ``geometry`` to ``table``.
 
     Bounded least squares (scipy ``least_squares``, trust-region reflective, exact Jacobian) of
@@ -436,8 +502,12 @@ def fit_hrovat_tobler(geometry: GeometrySection, table: Characteristic, free: Se
     u0 = np.clip(problem.to_u([start[n] for n in free]), 0.0, 1.0)
     if not problem.feasible(u0):
         bad = sr[~np.isfinite(problem.raw_residuals(u0)[: len(sr)])]
-        raise InputError("start converter", "[geometry]", f"no steady state at SR {bad[0]:g}",
-                         "a start point with a steady state at every fitted speed ratio")
+        raise InputError(
+            "start converter",
+            "[geometry]",
+            f"no steady state at SR {bad[0]:g}",
+            "a start point with a steady state at every fitted speed ratio",
+        )
     best, n_run = _best_fit(problem, u0, max(1, n_starts))
     return _result(problem, best, geometry, resolved, srmax, table, n_run, time.perf_counter() - t0)
 
@@ -461,34 +531,57 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
     stats = _correlation(problem.jacobian(res.x), float(res.cost))
     notes = []
     if stats["rank"] < len(problem.free):
-        notes.append(f"JᵀJ is singular (rank {stats['rank']} of {len(problem.free)}): the table determines only "
-                     f"{stats['rank']} combinations of the free parameters, and the fit is one of many equivalent "
-                     "points; correlations from the pseudo-inverse, standard errors only for identifiable parameters")
+        notes.append(
+            f"JᵀJ is singular (rank {stats['rank']} of {len(problem.free)}): the table determines only "
+            f"{stats['rank']} combinations of the free parameters, and the fit is one of many equivalent "
+            "points; correlations from the pseudo-inverse, standard errors only for identifiable parameters"
+        )
     size = ("fluid_density_kg_m3" in problem.free, "flow_area_m2" in problem.free, bool(set(problem.free) & set(RADII)))
     if sum(size) > 1:
-        notes.append("CF scales with ρ·A·R³ (R a common scale of the three radii) and TR not at all, so density, "
-                     "flow area and a common radius scale are interchangeable: free only one of density, flow area "
-                     "and the set of radii for a unique size")
+        notes.append(
+            "CF scales with ρ·A·R³ (R a common scale of the three radii) and TR not at all, so density, "
+            "flow area and a common radius scale are interchangeable: free only one of density, flow area "
+            "and the set of radii for a unique size"
+        )
     if set(problem.free) & set(RADII):
-        notes.append("fluid_length_m and the shape effects are kept from the start converter; re-derive them "
-                     "for the fitted radii before dynamic use")
+        notes.append(
+            "fluid_length_m and the shape effects are kept from the start converter; re-derive them "
+            "for the fitted radii before dynamic use"
+        )
     return FitResult(
-        geometry=fitted, start=geometry, free=problem.free, bounds=bounds,
-        active=_active(problem, res.x, res.active_mask), speed_ratio_max=srmax, speed_ratio=problem.sr,
-        torque_ratio_table=problem.tr, capacity_factor_table=problem.cf,
-        torque_ratio_model=np.asarray(tr), capacity_factor_model=np.asarray(cf),
-        correlation=stats["correlation"], std_error=stats["std_scaled"] * problem.span,
-        jacobian_rank=stats["rank"], condition_number=stats["condition_number"],
-        identifiable=stats["identifiable"], nfev=problem.nfev, njev=int(res.njev or 0), starts=n_run,
-        elapsed_s=elapsed, message=str(res.message), table_source=table.source, notes=tuple(notes))
+        geometry=fitted,
+        start=geometry,
+        free=problem.free,
+        bounds=bounds,
+        active=_active(problem, res.x, res.active_mask),
+        speed_ratio_max=srmax,
+        speed_ratio=problem.sr,
+        torque_ratio_table=problem.tr,
+        capacity_factor_table=problem.cf,
+        torque_ratio_model=np.asarray(tr),
+        capacity_factor_model=np.asarray(cf),
+        correlation=stats["correlation"],
+        std_error=stats["std_scaled"] * problem.span,
+        jacobian_rank=stats["rank"],
+        condition_number=stats["condition_number"],
+        identifiable=stats["identifiable"],
+        nfev=problem.nfev,
+        njev=int(res.njev or 0),
+        starts=n_run,
+        elapsed_s=elapsed,
+        message=str(res.message),
+        table_source=table.source,
+        notes=tuple(notes),
+    )
 
 
 # --------------------------------------------------------------------------------------------
 # the command
 
 
-def fit_command(converter: str, target: str, out: Path, free: str | None, bounds: list[str],
-                speed_ratio_max: float | None) -> str:
+def fit_command(
+    converter: str, target: str, out: Path, free: str | None, bounds: list[str], speed_ratio_max: float | None
+) -> str:
     """``tcsim fit``: fit ``converter``'s [geometry] to the table of ``target``; write ``out``."""
     from .converter import load_converter
     from .outputs import output_dir
@@ -521,8 +614,12 @@ def target_table(target: str) -> Characteristic:
 
     conv = load_converter(target)
     if conv.characteristic is None:
-        raise InputError(conv.path, "[characteristic]", "missing",
-                         "a characteristic table to fit (.csv, .vtcc, or a converter .toml with [characteristic])")
+        raise InputError(
+            conv.path,
+            "[characteristic]",
+            "missing",
+            "a characteristic table to fit (.csv, .vtcc, or a converter .toml with [characteristic])",
+        )
     return conv.characteristic
 
 
@@ -534,18 +631,27 @@ def fitted_converter(start: Converter, result: FitResult, table: Characteristic,
     """
     sources = dict(start.sources)
     for n in result.free:
-        sources[f"geometry.{n}"] = (f"fitted by tcsim fit to {label} over SR 0–{result.speed_ratio_max:g} "
-                                    f"(start value {result.start_values[n]:g}; see fit_report.md)")
+        sources[f"geometry.{n}"] = (
+            f"fitted by tcsim fit to {label} over SR 0–{result.speed_ratio_max:g} "
+            f"(start value {result.start_values[n]:g}; see fit_report.md)"
+        )
     if set(result.free) & set(RADII):
         for n in ("fluid_length_m", "pump_shape_effect_m2", "turbine_shape_effect_m2", "stator_shape_effect_m2"):
             sources[f"geometry.{n}"] = sources.get(f"geometry.{n}", "start converter") + " (start radii, not refitted)"
     for col in ("speed_ratio", "torque_ratio", "capacity_factor_nm_s2"):
         sources[f"characteristic.{col}"] = f"fitting target {table.source}"
     return dataclasses.replace(
-        start, name=f"{start.name}-fit-{label}", characteristic=table, geometry=result.geometry,
-        description=(f"{start.name} with [geometry] fitted to {label}: RMS error TR {100 * result.rms_tr:.3g} %, "
-                     f"CF {100 * result.rms_cf:.3g} % over SR 0–{result.speed_ratio_max:g}"),
-        source=f"{start.source}; [geometry] fitted by tcsim fit to {table.source}", sources=sources)
+        start,
+        name=f"{start.name}-fit-{label}",
+        characteristic=table,
+        geometry=result.geometry,
+        description=(
+            f"{start.name} with [geometry] fitted to {label}: RMS error TR {100 * result.rms_tr:.3g} %, "
+            f"CF {100 * result.rms_cf:.3g} % over SR 0–{result.speed_ratio_max:g}"
+        ),
+        source=f"{start.source}; [geometry] fitted by tcsim fit to {table.source}",
+        sources=sources,
+    )
 
 
 def write_outputs(stage: Path, start: Converter, fitted: Converter, result: FitResult, table: Characteristic) -> None:
@@ -556,10 +662,14 @@ def write_outputs(stage: Path, start: Converter, fitted: Converter, result: FitR
 
     doc = fitted.to_toml_dict()
     parse_converter(doc, "fitted.toml")  # what every other command will read back
-    header = (f"# Written by tcsim fit: [geometry] of {start.name} fitted to {table.source}\n"
-              f"# over SR 0-{result.speed_ratio_max:g}. See fit_report.md.\n\n")
+    header = (
+        f"# Written by tcsim fit: [geometry] of {start.name} fitted to {table.source}\n"
+        f"# over SR 0-{result.speed_ratio_max:g}. See fit_report.md.\n\n"
+    )
     (stage / "fitted.toml").write_text(header + tomli_w.dumps(doc), encoding="utf-8")
-    (stage / "fit_report.json").write_text(json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    (stage / "fit_report.json").write_text(
+        json.dumps(result.to_dict(), indent=2, allow_nan=False) + "\n", encoding="utf-8"
+    )
     (stage / "fit_report.md").write_text(report_markdown(result, start, []), encoding="utf-8")
     _plots(stage, start, fitted, result, table)
 
@@ -577,8 +687,15 @@ def _model_curve(conv: Converter):
         tr, cf, _, _ = _core.ht_ratio_gradients(conv.core_geometry(), PUMP_SPEED_RAD_S, sr, [])
         with np.errstate(divide="ignore", invalid="ignore"):
             k = _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(cf))
-        return pd.DataFrame({"speed_ratio": sr, "torque_ratio": tr, "capacity_factor_nm_s2": cf,
-                             "k_factor_rpm_per_sqrt_nm": k, "efficiency": tr * sr})
+        return pd.DataFrame(
+            {
+                "speed_ratio": sr,
+                "torque_ratio": tr,
+                "capacity_factor_nm_s2": cf,
+                "k_factor_rpm_per_sqrt_nm": k,
+                "efficiency": tr * sr,
+            }
+        )
 
 
 def _plots(stage: Path, start: Converter, fitted: Converter, result: FitResult, table: Characteristic) -> None:
@@ -587,8 +704,9 @@ def _plots(stage: Path, start: Converter, fitted: Converter, result: FitResult, 
 
     curves = {"fitted Hrovat & Tobler": _model_curve(fitted), "start Hrovat & Tobler": _model_curve(start)}
     title = f"Fit to {Path(table.source).name or table.source} (SR 0–{result.speed_ratio_max:g})"
-    plot_characteristic(curves, stage, title, table=table, table_label="Target table",
-                        coupling_point=coupling_point(fitted))
+    plot_characteristic(
+        curves, stage, title, table=table, table_label="Target table", coupling_point=coupling_point(fitted)
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -604,17 +722,23 @@ def _parameter_table(r: FitResult) -> list[str]:
     shown = {True: _fmt, False: lambda x: "not identifiable"}
     for i, n in enumerate(r.free):
         lo, hi = r.bounds[n]
-        lines.append(f"| {n} | {_fmt(r.start_values[n])} | {_fmt(r.values[n])} | {_fmt(lo)} | {_fmt(hi)} | "
-                     f"{r.active.get(n, '')} | {shown[bool(r.identifiable[i])](r.std_error[i])} |")
+        lines.append(
+            f"| {n} | {_fmt(r.start_values[n])} | {_fmt(r.values[n])} | {_fmt(lo)} | {_fmt(hi)} | "
+            f"{r.active.get(n, '')} | {shown[bool(r.identifiable[i])](r.std_error[i])} |"
+        )
     return lines
 
 
 def _point_table(r: FitResult) -> list[str]:
-    lines = ["| SR | TR table | TR model | TR error % | CF table | CF model | CF error % |",
-             "|---|---|---|---|---|---|---|"]
+    lines = [
+        "| SR | TR table | TR model | TR error % | CF table | CF model | CF error % |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for i, s in enumerate(r.speed_ratio):
-        lines.append(f"| {s:g} | {r.torque_ratio_table[i]:.4g} | {r.torque_ratio_model[i]:.4f} | {100 * r.tr_error[i]:+.3f} | "
-                     f"{r.capacity_factor_table[i]:.4g} | {r.capacity_factor_model[i]:.4e} | {100 * r.cf_error[i]:+.3f} |")
+        lines.append(
+            f"| {s:g} | {r.torque_ratio_table[i]:.4g} | {r.torque_ratio_model[i]:.4f} | {100 * r.tr_error[i]:+.3f} | "
+            f"{r.capacity_factor_table[i]:.4g} | {r.capacity_factor_model[i]:.4e} | {100 * r.cf_error[i]:+.3f} |"
+        )
     return lines
 
 
@@ -622,15 +746,22 @@ def _correlation_table(r: FitResult) -> list[str]:
     short = [f"p{i + 1}" for i in range(len(r.free))]
     lines = ["| | " + " | ".join(short) + " |", "|---|" + "---|" * len(short)]
     for i, n in enumerate(r.free):
-        lines.append(f"| p{i + 1} {n} | " + " | ".join("–" if not np.isfinite(v) else f"{v:+.2f}" for v in r.correlation[i]) + " |")
+        lines.append(
+            f"| p{i + 1} {n} | "
+            + " | ".join("–" if not np.isfinite(v) else f"{v:+.2f}" for v in r.correlation[i])
+            + " |"
+        )
     return lines
 
 
 def report_markdown(r: FitResult, start: Converter, notes: Sequence[str] = ()) -> str:
     """``fit_report.md``: values, bounds, errors, correlations, optimiser statistics."""
     active = ", ".join(f"{n} ({side})" for n, side in r.active.items()) or "none"
-    singular = (f"singular, rank {r.jacobian_rank} of {len(r.free)} (correlations from the pseudo-inverse)"
-                if r.singular else "full rank")
+    singular = (
+        f"singular, rank {r.jacobian_rank} of {len(r.free)} (correlations from the pseudo-inverse)"
+        if r.singular
+        else "full rank"
+    )
     singular += f", condition number {r.condition_number:.3g} (scaled parameters, non-zero singular values)"
     lines = [
         "# Fit of Hrovat & Tobler parameters",

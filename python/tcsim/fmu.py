@@ -42,10 +42,11 @@ import tempfile
 import uuid
 import warnings
 import zipfile
+from collections.abc import Sequence
 from dataclasses import dataclass
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any, Sequence, Union
+from typing import Any
 from xml.sax.saxutils import quoteattr
 
 from . import _core
@@ -81,7 +82,11 @@ INPUT_START: dict[str, float] = {"pump_torque_nm": 50.0, "pump_speed_rad_s": 150
 #: last communication interval instead.
 RATE_INPUTS: dict[str, tuple[int, str, str]] = {
     "pump_speed_rad_s": (12, "pump_accel_rad_s2", "Rate of the pump speed input (Model Exchange; 0 if not connected)"),
-    "turbine_speed_rad_s": (13, "turbine_accel_rad_s2", "Rate of the turbine speed input (Model Exchange; 0 if not connected)"),
+    "turbine_speed_rad_s": (
+        13,
+        "turbine_accel_rad_s2",
+        "Rate of the turbine speed input (Model Exchange; 0 if not connected)",
+    ),
 }
 #: Value reference of the derivative of state coordinate c (0 pump speed, 2 stator speed, 3 flow).
 FIRST_DERIVATIVE = 20
@@ -125,8 +130,16 @@ UNITS: tuple[Unit, ...] = (
 
 # unit-suffix conventions (conventions.md) -> FMI unit; the longest suffix that matches wins
 _SUFFIX_UNITS: tuple[tuple[str, str], ...] = (
-    ("_nm_s2", "N.m.s2/rad2"), ("_kg_m2", "kg.m2"), ("_kg_m3", "kg/m3"), ("_m3_s", "m3/s"), ("_rad_s", "rad/s"),
-    ("_nm", "N.m"), ("_m2", "m2"), ("_rad", "rad"), ("_m", "m"), ("_s", "s"),
+    ("_nm_s2", "N.m.s2/rad2"),
+    ("_kg_m2", "kg.m2"),
+    ("_kg_m3", "kg/m3"),
+    ("_m3_s", "m3/s"),
+    ("_rad_s", "rad/s"),
+    ("_nm", "N.m"),
+    ("_m2", "m2"),
+    ("_rad", "rad"),
+    ("_m", "m"),
+    ("_s", "s"),
 )
 
 
@@ -166,8 +179,14 @@ SIGNALS: tuple[Signal, ...] = (
     Signal(4, "speed_ratio", "1", "Speed ratio SR = turbine speed / pump speed"),
     Signal(5, "torque_ratio", "1", "Torque ratio TR = turbine torque / pump torque"),
     Signal(6, "flow_m3_s", "m3/s", "Volume flow through the torus", ("hrovat-tobler", "quasi-dynamic"), state=True),
-    Signal(7, "stator_speed_rad_s", "rad/s", "Stator speed (zero while the one-way clutch holds it)", ("hrovat-tobler",),
-           state=True),
+    Signal(
+        7,
+        "stator_speed_rad_s",
+        "rad/s",
+        "Stator speed (zero while the one-way clutch holds it)",
+        ("hrovat-tobler",),
+        state=True,
+    ),
     Signal(8, "stator_torque_nm", "N.m", "Torque of the stator one-way clutch on the stator"),
     Signal(9, "effective_pump_torque_nm", "N.m", "Effective pump input torque T_p - I_p dw_p/dt (LS16 eq 3.3)"),
     Signal(10, "effective_turbine_torque_nm", "N.m", "Effective turbine output torque T_t + I_t dw_t/dt (LS16 eq 3.4)"),
@@ -224,7 +243,10 @@ def _name_and_description(key: str, index: int | None, size: int) -> tuple[str, 
     if key == "inertia_kg_m2" and index is not None and size == 3:
         return f"{_TRIPLE[index]}_inertia_kg_m2", f"Moment of inertia of the {_TRIPLE[index]}"
     if key == "shape_effect_m2" and index is not None and size <= 3:
-        return f"{_TRIPLE[index]}_shape_effect_m2", f"Shape effect S of the {_TRIPLE[index]} (signed, LS16 eqs 2.16-2.18)"
+        return (
+            f"{_TRIPLE[index]}_shape_effect_m2",
+            f"Shape effect S of the {_TRIPLE[index]} (signed, LS16 eqs 2.16-2.18)",
+        )
     if key == "geometry" and index is not None:
         names = _core.ht_parameter_names()
         if size == len(names):
@@ -265,8 +287,9 @@ def fmu_parameters(model: DynamicModel) -> list[Parameter]:
             name, description = _name_and_description(key, index, len(items))
             if not math.isfinite(float(v)):
                 raise InputError(model.source, name, float(v), "a finite number")
-            out.append(Parameter(FIRST_PARAMETER_VR + len(out), name, key, index or 0, float(v), unit_of(name),
-                                 description))
+            out.append(
+                Parameter(FIRST_PARAMETER_VR + len(out), name, key, index or 0, float(v), unit_of(name), description)
+            )
     names = [p.name for p in out]
     if len(set(names)) != len(names):
         raise ValueError(f"parameter names are not unique: {names}")
@@ -296,8 +319,13 @@ def _check_causality(causality: str) -> tuple[str, str]:
     return CAUSALITIES[causality]
 
 
-def model_description_xml(model: DynamicModel, causality: str = "pump-torque", model_name: str | None = None,
-                          guid: str | None = None, generation_time: datetime | None = None) -> str:
+def model_description_xml(
+    model: DynamicModel,
+    causality: str = "pump-torque",
+    model_name: str | None = None,
+    guid: str | None = None,
+    generation_time: datetime | None = None,
+) -> str:
     """The ``modelDescription.xml`` (FMI 2.0, Co-Simulation and Model Exchange) of a model under a
     causality."""
     inputs = _check_causality(causality)
@@ -306,91 +334,129 @@ def model_description_xml(model: DynamicModel, causality: str = "pump-torque", m
     version = _version()
     model_name = model_name or f"tcsim {Path(model.source).stem} {model.name}"
     guid = guid or "{" + str(uuid.uuid4()) + "}"
-    stamp = (generation_time or datetime.now(timezone.utc)).strftime("%Y-%m-%dT%H:%M:%SZ")
+    stamp = (generation_time or datetime.now(UTC)).strftime("%Y-%m-%dT%H:%M:%SZ")
     outputs = [s for s in signals if s.name not in inputs]
-    description = (f"Torque converter {Path(model.source).stem}, {model.name} model (tcsim {version}). Inputs "
-                   f"{', '.join(inputs)}; outputs {', '.join(s.name for s in outputs)}. Starts from the steady "
-                   "state consistent with the inputs.")
+    description = (
+        f"Torque converter {Path(model.source).stem}, {model.name} model (tcsim {version}). Inputs "
+        f"{', '.join(inputs)}; outputs {', '.join(s.name for s in outputs)}. Starts from the steady "
+        "state consistent with the inputs."
+    )
 
     a = quoteattr
-    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-             f'<fmiModelDescription fmiVersion="2.0" modelName={a(model_name)} guid={a(guid)}',
-             f'  description={a(description)}',
-             f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
-             f'  variableNamingConvention="flat" numberOfEventIndicators="{EVENT_INDICATORS.get(model.name, 0)}">',
-             f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
-             ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
-             f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
-             ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="false"'
-             ' canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
-             '  <UnitDefinitions>']
+    lines = [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<fmiModelDescription fmiVersion="2.0" modelName={a(model_name)} guid={a(guid)}',
+        f"  description={a(description)}",
+        f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
+        f'  variableNamingConvention="flat" numberOfEventIndicators="{EVENT_INDICATORS.get(model.name, 0)}">',
+        f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
+        ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+        f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
+        ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="false"'
+        ' canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+        "  <UnitDefinitions>",
+    ]
     for u in UNITS:
         base = " ".join(f'{k}="{v}"' for k, v in u.base.items())
-        lines.append(f'    <Unit name={a(u.name)}>')
-        lines.append(f'      <BaseUnit {base}/>' if base else '      <BaseUnit/>')
+        lines.append(f"    <Unit name={a(u.name)}>")
+        lines.append(f"      <BaseUnit {base}/>" if base else "      <BaseUnit/>")
         for name, factor in u.display:
             lines.append(f'      <DisplayUnit name={a(name)} factor="{_fmt(factor)}"/>')
-        lines.append('    </Unit>')
-    lines += ['  </UnitDefinitions>',
-              '  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>',
-              '  <ModelVariables>']
+        lines.append("    </Unit>")
+    lines += [
+        "  </UnitDefinitions>",
+        '  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>',
+        "  <ModelVariables>",
+    ]
 
     index: dict[str, int] = {}
 
     def variable(name: str, vr: int, description: str, attrs: str, real: str) -> None:
         index[name] = len(index) + 1
-        lines.append(f'    <!-- index {index[name]} -->')
+        lines.append(f"    <!-- index {index[name]} -->")
         lines.append(f'    <ScalarVariable name={a(name)} valueReference="{vr}" description={a(description)} {attrs}>')
-        lines.append(f'      <Real {real}/>')
-        lines.append('    </ScalarVariable>')
+        lines.append(f"      <Real {real}/>")
+        lines.append("    </ScalarVariable>")
 
     for s in signals:
         if s.name in inputs:
-            variable(s.name, s.vr, s.description, 'causality="input" variability="continuous"',
-                     f'unit="{s.unit}" start="{_fmt(INPUT_START[s.name])}"')
+            variable(
+                s.name,
+                s.vr,
+                s.description,
+                'causality="input" variability="continuous"',
+                f'unit="{s.unit}" start="{_fmt(INPUT_START[s.name])}"',
+            )
         else:
-            variable(s.name, s.vr, s.description, 'causality="output" variability="continuous" initial="calculated"',
-                     f'unit="{s.unit}"')
+            variable(
+                s.name,
+                s.vr,
+                s.description,
+                'causality="output" variability="continuous" initial="calculated"',
+                f'unit="{s.unit}"',
+            )
     for name in inputs:
         if name in RATE_INPUTS:
             vr, rate, text = RATE_INPUTS[name]
             variable(rate, vr, text, 'causality="input" variability="continuous"', 'unit="rad/s2" start="0"')
-    variable("start_from_steady_state", 30,
-             "1: start at the steady state consistent with the inputs (as tcsim replay); 0: at the initial_* values",
-             'causality="parameter" variability="fixed" initial="exact"', 'unit="1" start="1"')
-    for name, vr, unit, start in (("pump_speed_rad_s", 31, "rad/s", 150.0), ("stator_speed_rad_s", 32, "rad/s", 0.0),
-                                  ("flow_m3_s", 33, "m3/s", 0.05)):
+    variable(
+        "start_from_steady_state",
+        30,
+        "1: start at the steady state consistent with the inputs (as tcsim replay); 0: at the initial_* values",
+        'causality="parameter" variability="fixed" initial="exact"',
+        'unit="1" start="1"',
+    )
+    for name, vr, unit, start in (
+        ("pump_speed_rad_s", 31, "rad/s", 150.0),
+        ("stator_speed_rad_s", 32, "rad/s", 0.0),
+        ("flow_m3_s", 33, "m3/s", 0.05),
+    ):
         if name in index and name not in inputs:
-            variable(f"initial_{name}", vr, f"Initial {name.replace('_', ' ').rsplit(' ', 2)[0]} when start_from_steady_state = 0",
-                     'causality="parameter" variability="fixed" initial="exact"', f'unit="{unit}" start="{_fmt(start)}"')
+            variable(
+                f"initial_{name}",
+                vr,
+                f"Initial {name.replace('_', ' ').rsplit(' ', 2)[0]} when start_from_steady_state = 0",
+                'causality="parameter" variability="fixed" initial="exact"',
+                f'unit="{unit}" start="{_fmt(start)}"',
+            )
     states = [(name, c) for name, c in _STATES if name in index and name not in inputs]
     derivatives = []
     for name, c in states:
         der = f"der({name})"
         unit = "m3/s2" if c == 3 else "rad/s2"
-        variable(der, FIRST_DERIVATIVE + c, f"Time derivative of {name}", 'causality="local" variability="continuous" initial="calculated"',
-                 f'unit="{unit}" derivative="{index[name]}"')
+        variable(
+            der,
+            FIRST_DERIVATIVE + c,
+            f"Time derivative of {name}",
+            'causality="local" variability="continuous" initial="calculated"',
+            f'unit="{unit}" derivative="{index[name]}"',
+        )
         derivatives.append(der)
     for p in params:
         display = ' displayUnit="deg"' if p.unit == "rad" else ""
-        variable(p.name, p.vr, p.description, 'causality="parameter" variability="tunable"',
-                 f'unit="{p.unit}"{display} start="{_fmt(p.value)}"')
-    lines.append('  </ModelVariables>')
+        variable(
+            p.name,
+            p.vr,
+            p.description,
+            'causality="parameter" variability="tunable"',
+            f'unit="{p.unit}"{display} start="{_fmt(p.value)}"',
+        )
+    lines.append("  </ModelVariables>")
 
     both = " ".join(str(index[n]) for n in inputs)
-    lines += ['  <ModelStructure>', '    <Outputs>']
+    lines += ["  <ModelStructure>", "    <Outputs>"]
     for s in outputs:
         # a state (pump speed, flow, stator speed) does not depend directly on the inputs
         lines.append(f'      <Unknown index="{index[s.name]}" dependencies="{"" if s.state else both}"/>')
-    lines.append('    </Outputs>')
+    lines.append("    </Outputs>")
     if derivatives:
-        lines.append('    <Derivatives>')
+        lines.append("    <Derivatives>")
         lines += [f'      <Unknown index="{index[der]}"/>' for der in derivatives]
-        lines.append('    </Derivatives>')
-    lines.append('    <InitialUnknowns>')
+        lines.append("    </Derivatives>")
+    lines.append("    <InitialUnknowns>")
     for name in sorted([s.name for s in outputs] + derivatives, key=index.get):
         lines.append(f'      <Unknown index="{index[name]}"/>')
-    lines += ['    </InitialUnknowns>', '  </ModelStructure>', '</fmiModelDescription>', '']
+    lines += ["    </InitialUnknowns>", "  </ModelStructure>", "</fmiModelDescription>", ""]
     return "\n".join(lines)
 
 
@@ -448,14 +514,23 @@ def build_library(root: Path, timeout_s: float = 1800.0) -> Path:
     cargo = shutil.which("cargo")
     name = _local_library_file()
     if cargo is None:
-        raise FmuLibraryError(f"the FMU library {name} is not built and cargo is not on PATH: install Rust "
-                              f"(https://rustup.rs) and run 'cargo build --release -p tcsim-fmu' in {root}, or set "
-                              f"{LIBRARY_ENV}")
+        raise FmuLibraryError(
+            f"the FMU library {name} is not built and cargo is not on PATH: install Rust "
+            f"(https://rustup.rs) and run 'cargo build --release -p tcsim-fmu' in {root}, or set "
+            f"{LIBRARY_ENV}"
+        )
     try:
-        p = subprocess.run([cargo, "build", "--release", "-p", "tcsim-fmu"], cwd=root, capture_output=True, text=True,
-                           timeout=timeout_s)
+        p = subprocess.run(
+            [cargo, "build", "--release", "-p", "tcsim-fmu"],
+            cwd=root,
+            capture_output=True,
+            text=True,
+            timeout=timeout_s,
+        )
     except subprocess.TimeoutExpired:
-        raise FmuLibraryError(f"'cargo build --release -p tcsim-fmu' in {root} took more than {timeout_s:g} s") from None
+        raise FmuLibraryError(
+            f"'cargo build --release -p tcsim-fmu' in {root} took more than {timeout_s:g} s"
+        ) from None
     lib = root / "target" / "release" / name
     if p.returncode != 0 or not lib.is_file():
         tail = "\n".join(p.stderr.strip().splitlines()[-15:])
@@ -488,14 +563,19 @@ def find_libraries(build: bool = True) -> list[Path]:
             lib = root / "target" / profile / name
             if lib.is_file():
                 if lib.stat().st_mtime < _newest_source_mtime(root):
-                    warnings.warn(f"{lib} is older than the Rust sources; run 'cargo build --release -p tcsim-fmu' "
-                                  f"in {root} to package the current code", TcsimWarning, stacklevel=2)
+                    warnings.warn(
+                        f"{lib} is older than the Rust sources; run 'cargo build --release -p tcsim-fmu' "
+                        f"in {root} to package the current code",
+                        TcsimWarning,
+                        stacklevel=2,
+                    )
                 return [lib]
         if build:
             return [build_library(root)]
-    raise FmuLibraryError(f"the FMU library {name} was not found: set {LIBRARY_ENV} to it, or run "
-                          "'cargo build --release -p tcsim-fmu' in the tcsim source tree"
-                          + ("" if root is None else f" ({root})"))
+    raise FmuLibraryError(
+        f"the FMU library {name} was not found: set {LIBRARY_ENV} to it, or run "
+        "'cargo build --release -p tcsim-fmu' in the tcsim source tree" + ("" if root is None else f" ({root})")
+    )
 
 
 def find_library(build: bool = True) -> Path:
@@ -587,10 +667,15 @@ def _write_sources(root: Path | None, dest: Path) -> None:
     dest.mkdir(parents=True, exist_ok=True)
     missing = ""
     if root is None:
-        missing = ("\n**This FMU carries no Rust sources**: it was exported without the tcsim source tree. "
-                   "Get them from the tcsim repository (the same version) and build there.\n")
-        warnings.warn("the tcsim source tree was not found: the FMU's sources/ holds the rebuild instructions only",
-                      TcsimWarning, stacklevel=3)
+        missing = (
+            "\n**This FMU carries no Rust sources**: it was exported without the tcsim source tree. "
+            "Get them from the tcsim repository (the same version) and build there.\n"
+        )
+        warnings.warn(
+            "the tcsim source tree was not found: the FMU's sources/ holds the rebuild instructions only",
+            TcsimWarning,
+            stacklevel=3,
+        )
     else:
         ws = (root / "Cargo.toml").read_text()
         ws = re.sub(r"(?ms)^members\s*=\s*\[.*?\]", 'members = ["crates/tcsim-core", "crates/tcsim-fmu"]', ws, count=1)
@@ -628,7 +713,7 @@ def _check_model(model: DynamicModel, causality: str) -> None:
         pass  # the inputs of a real run differ; not a reason to refuse the export
 
 
-def _output_path(out_path: Union[str, Path]) -> Path:
+def _output_path(out_path: str | Path) -> Path:
     out = Path(out_path)
     if out.suffix.lower() != ".fmu":
         raise InputError("command line", "--out", str(out), "a file name ending in .fmu")
@@ -637,8 +722,12 @@ def _output_path(out_path: Union[str, Path]) -> Path:
     return out
 
 
-def export_fmu(converter: Union[Converter, str, Path, DynamicModel, None], model: Union[str, DynamicModel],
-               out_path: Union[str, Path], causality: str = "pump-torque") -> Path:
+def export_fmu(
+    converter: Converter | str | Path | DynamicModel | None,
+    model: str | DynamicModel,
+    out_path: str | Path,
+    causality: str = "pump-torque",
+) -> Path:
     """Write the FMU of ``model`` (a name of :data:`tcsim.converter.MODELS`, or a
     :class:`~tcsim.transient.DynamicModel`, with ``converter`` then ignored) of ``converter`` (a
     :class:`~tcsim.converter.Converter`, bundled name or file) to ``out_path`` (``*.fmu``), written
@@ -691,9 +780,19 @@ def export_fmu_command(converter: str, model: str, out: Path, causality: str) ->
         params = json.loads(zf.read("resources/model.json"))["parameters"]
         platforms = sorted({n.split("/")[1] for n in zf.namelist() if n.startswith("binaries/")})
     inputs = CAUSALITIES[causality]
-    return (f"{model} model of {converter} written to {path} (FMI 2.0 Model Exchange and Co-Simulation, {', '.join(platforms)}; "
-            f"inputs {' and '.join(inputs)}; {len(params)} tunable parameters)")
+    return (
+        f"{model} model of {converter} written to {path} (FMI 2.0 Model Exchange and Co-Simulation, {', '.join(platforms)}; "
+        f"inputs {' and '.join(inputs)}; {len(params)} tunable parameters)"
+    )
 
 
-__all__: Sequence[str] = ("export_fmu", "model_description_xml", "model_json", "fmu_parameters", "find_libraries",
-                          "FmuLibraryError", "SIGNALS", "CAUSALITIES")
+__all__: Sequence[str] = (
+    "export_fmu",
+    "model_description_xml",
+    "model_json",
+    "fmu_parameters",
+    "find_libraries",
+    "FmuLibraryError",
+    "SIGNALS",
+    "CAUSALITIES",
+)

@@ -85,12 +85,28 @@ BRAKE_RELEASED = 1e-3
 
 #: Columns every launch run has (more may follow).
 LAUNCH_COLUMNS: tuple[str, ...] = (
-    "time_s", "vehicle_speed_m_s", "vehicle_accel_m_s2", "pump_speed_rad_s", "turbine_speed_rad_s", "speed_ratio",
-    "torque_ratio", "effective_torque_ratio", "gear", "lockup_state", "engine_torque_nm", "pump_torque_nm",
-    "turbine_torque_nm")
+    "time_s",
+    "vehicle_speed_m_s",
+    "vehicle_accel_m_s2",
+    "pump_speed_rad_s",
+    "turbine_speed_rad_s",
+    "speed_ratio",
+    "torque_ratio",
+    "effective_torque_ratio",
+    "gear",
+    "lockup_state",
+    "engine_torque_nm",
+    "pump_torque_nm",
+    "turbine_torque_nm",
+)
 SUMMARY_COLUMNS: tuple[str, ...] = (
-    "model", "time_0_100_km_h_s", "time_0_50_km_h_s", "peak_accel_m_s2", "mean_accel_first_0_5_s_m_s2",
-    "min_effective_torque_ratio_first_0_5_s")
+    "model",
+    "time_0_100_km_h_s",
+    "time_0_50_km_h_s",
+    "peak_accel_m_s2",
+    "mean_accel_first_0_5_s_m_s2",
+    "min_effective_torque_ratio_first_0_5_s",
+)
 EVENT_COLUMNS: tuple[str, ...] = ("model", "time_s", "kind", "detail")
 SCENARIOS: tuple[str, ...] = ("flip-flop", "part-pedal")
 DYNAMIC_MODELS: tuple[str, ...] = ("hrovat-tobler", "quasi-dynamic")
@@ -149,12 +165,18 @@ class Scenario:
             i = int(steps[0]) + 1
             raise InputError(src, f"time_s[{i}]", float(t[i]), f"time strictly increasing (previous {t[i - 1]:g} s)")
         if not (math.isfinite(self.end_time_s) and self.end_time_s > t[0]):
-            raise InputError(src, "end_time_s", self.end_time_s, f"a finite time after the first time stamp ({t[0]:g} s)")
+            raise InputError(
+                src, "end_time_s", self.end_time_s, f"a finite time after the first time stamp ({t[0]:g} s)"
+            )
         if self.stop_speed_m_s is not None and not (math.isfinite(self.stop_speed_m_s) and self.stop_speed_m_s > 0):
             raise InputError(src, "stop_speed_m_s", self.stop_speed_m_s, "a positive speed or none")
         if not (math.isfinite(self.brake_release_time_s) and t[0] <= self.brake_release_time_s <= self.end_time_s):
-            raise InputError(src, "brake_release_time_s", self.brake_release_time_s,
-                             f"a time within the scenario [{t[0]:g}, {self.end_time_s:g}] s")
+            raise InputError(
+                src,
+                "brake_release_time_s",
+                self.brake_release_time_s,
+                f"a time within the scenario [{t[0]:g}, {self.end_time_s:g}] s",
+            )
         object.__setattr__(self, "end_time_s", float(self.end_time_s))
         object.__setattr__(self, "brake_release_time_s", float(self.brake_release_time_s))
         if self.stop_speed_m_s is not None:
@@ -175,16 +197,21 @@ class Scenario:
 
     def core_spec(self) -> dict[str, Any]:
         """The dict the core takes."""
-        spec = {"time_s": self.time_s.tolist(), "accelerator_pedal": self.accelerator_pedal.tolist(),
-                "brake_pedal": self.brake_pedal.tolist(), "end_time_s": self.end_time_s,
-                "stop_speed_m_s": self.stop_speed_m_s}
+        spec = {
+            "time_s": self.time_s.tolist(),
+            "accelerator_pedal": self.accelerator_pedal.tolist(),
+            "brake_pedal": self.brake_pedal.tolist(),
+            "end_time_s": self.end_time_s,
+            "stop_speed_m_s": self.stop_speed_m_s,
+        }
         if self.engine_torque_nm is not None:
             spec["engine_torque_nm"] = self.engine_torque_nm.tolist()
         return spec
 
     def frame(self) -> pd.DataFrame:
-        return pd.DataFrame({"time_s": self.time_s, "accelerator_pedal": self.accelerator_pedal,
-                             "brake_pedal": self.brake_pedal})
+        return pd.DataFrame(
+            {"time_s": self.time_s, "accelerator_pedal": self.accelerator_pedal, "brake_pedal": self.brake_pedal}
+        )
 
 
 def _release(name: str, pedal: float, hold_s: float, end_time_s: float, stop_speed_m_s: float) -> Scenario:
@@ -196,8 +223,16 @@ def _release(name: str, pedal: float, hold_s: float, end_time_s: float, stop_spe
     if not (math.isfinite(end_time_s) and end_time_s > hold_s + PEDAL_SWAP_S):
         raise InputError(src, "end_time_s", end_time_s, f"a time after the pedal swap ({hold_s + PEDAL_SWAP_S:g} s)")
     t = [0.0, hold_s, hold_s + PEDAL_SWAP_S, end_time_s]
-    return Scenario(name, np.array(t), np.array([0.0, 0.0, pedal, pedal]), np.array([1.0, 1.0, 0.0, 0.0]),
-                    end_time_s, stop_speed_m_s, hold_s, src)
+    return Scenario(
+        name,
+        np.array(t),
+        np.array([0.0, 0.0, pedal, pedal]),
+        np.array([1.0, 1.0, 0.0, 0.0]),
+        end_time_s,
+        stop_speed_m_s,
+        hold_s,
+        src,
+    )
 
 
 def flip_flop(hold_s: float = 5.0, end_time_s: float = 30.0) -> Scenario:
@@ -267,8 +302,12 @@ class _ScenarioPicker:
                 self.picks[canonical] = (column, factor)
                 return
         shown = ", ".join(list(names)[:12]) + (" ..." if len(names) > 12 else "")
-        raise InputError(str(self.path), canonical, "missing",
-                         f"a column named {' or '.join(options)}; columns found: {shown or '(none)'}")
+        raise InputError(
+            str(self.path),
+            canonical,
+            "missing",
+            f"a column named {' or '.join(options)}; columns found: {shown or '(none)'}",
+        )
 
     def __call__(self, names: Sequence[str]) -> list[str]:
         self._one("time_s", _TIME_COLUMNS, names)
@@ -294,8 +333,12 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
     path = Path(path)
     reader = meas._READERS.get(path.suffix.lower())
     if reader is None:
-        raise InputError(str(path), "(extension)", path.suffix or "(none)",
-                         f"a scenario file ending in one of {', '.join(meas._READERS)}")
+        raise InputError(
+            str(path),
+            "(extension)",
+            path.suffix or "(none)",
+            f"a scenario file ending in one of {', '.join(meas._READERS)}",
+        )
     if not path.is_file():
         raise InputError(str(path), "(file)", "not found", "an existing scenario file")
     picker = _ScenarioPicker(path)
@@ -325,8 +368,12 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
             bad = np.flatnonzero((values < 0) | (values > limit * (1 + 1e-12)))
             if bad.size:
                 row = int(bad[0])
-                raise InputError(str(path), column, f"{values[row]:g} at row {row + 1} (time_s {time_s[row]:g})",
-                                 f"a pedal position from 0 to {limit:g}")
+                raise InputError(
+                    str(path),
+                    column,
+                    f"{values[row]:g} at row {row + 1} (time_s {time_s[row]:g})",
+                    f"a pedal position from 0 to {limit:g}",
+                )
         values = np.clip(values * scale, 0.0, 1.0) if canonical != "time_s" else values * scale
         out[canonical] = values
         if canonical == "time_s":
@@ -334,8 +381,17 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
     t = out["time_s"] - out["time_s"][0]
     end = float(t[-1]) if end_time_s is None else end_time_s
     release = brake_release_time(t, out["brake_pedal"])
-    return Scenario(path.stem, t, out["accelerator_pedal"], out["brake_pedal"], end, stop_speed_m_s,
-                    min(release, end), str(path), out.get("engine_torque_nm"))
+    return Scenario(
+        path.stem,
+        t,
+        out["accelerator_pedal"],
+        out["brake_pedal"],
+        end,
+        stop_speed_m_s,
+        min(release, end),
+        str(path),
+        out.get("engine_torque_nm"),
+    )
 
 
 def scenario_from_option(value: str) -> Scenario:
@@ -345,8 +401,12 @@ def scenario_from_option(value: str) -> Scenario:
     if value == "part-pedal":
         return part_pedal()
     if not Path(value).is_file():
-        raise InputError("command line", "--scenario", value,
-                         "flip-flop, part-pedal, or an existing scenario file (.csv, .parquet, .mat, .mf4/.mdf)")
+        raise InputError(
+            "command line",
+            "--scenario",
+            value,
+            "flip-flop, part-pedal, or an existing scenario file (.csv, .parquet, .mat, .mf4/.mdf)",
+        )
     return read_scenario(value)
 
 
@@ -426,11 +486,13 @@ def summary_row(frame: pd.DataFrame, release_s: float) -> dict[str, float]:
     v = frame["vehicle_speed_m_s"].to_numpy(dtype=float)
     a = frame["vehicle_accel_m_s2"].to_numpy(dtype=float)
     etr = frame["effective_torque_ratio"].to_numpy(dtype=float)
-    return {"time_0_100_km_h_s": time_to_speed(t, v, SPEED_100_KM_H_M_S, release_s),
-            "time_0_50_km_h_s": time_to_speed(t, v, SPEED_50_KM_H_M_S, release_s),
-            "peak_accel_m_s2": peak_value(t, a, release_s),
-            "mean_accel_first_0_5_s_m_s2": window_mean(t, a, release_s, FIRST_WINDOW_S),
-            "min_effective_torque_ratio_first_0_5_s": window_min(t, etr, release_s, FIRST_WINDOW_S)}
+    return {
+        "time_0_100_km_h_s": time_to_speed(t, v, SPEED_100_KM_H_M_S, release_s),
+        "time_0_50_km_h_s": time_to_speed(t, v, SPEED_50_KM_H_M_S, release_s),
+        "peak_accel_m_s2": peak_value(t, a, release_s),
+        "mean_accel_first_0_5_s_m_s2": window_mean(t, a, release_s, FIRST_WINDOW_S),
+        "min_effective_torque_ratio_first_0_5_s": window_min(t, etr, release_s, FIRST_WINDOW_S),
+    }
 
 
 def launch_summary(frames: Mapping[str, pd.DataFrame], release_s: float) -> pd.DataFrame:
@@ -475,8 +537,15 @@ def _frame(columns: Mapping[str, Any], events: Sequence[Sequence[Any]]) -> pd.Da
     return df
 
 
-def run_launch(vehicle: Vehicle, scenario: Scenario, models: Sequence[DynamicModel], options: dict | None = None,
-               threads: int = 0, labels: Sequence[str] | None = None, on_error: str = "raise") -> dict[str, pd.DataFrame]:
+def run_launch(
+    vehicle: Vehicle,
+    scenario: Scenario,
+    models: Sequence[DynamicModel],
+    options: dict | None = None,
+    threads: int = 0,
+    labels: Sequence[str] | None = None,
+    on_error: str = "raise",
+) -> dict[str, pd.DataFrame]:
     """Every model on the vehicle under the scenario, in one core call (GIL released, ``threads``
     workers, 0 for all cores). Returns ``{label: time series}`` (labels default to the model names
     and must be unique); each frame's ``attrs["events"]`` holds its events ``(time_s, kind, ...)``.
@@ -490,8 +559,10 @@ def run_launch(vehicle: Vehicle, scenario: Scenario, models: Sequence[DynamicMod
     if len(names) != len(models) or len(set(names)) != len(names):
         raise ValueError(f"one unique label per model needed: {names}")
     if not core_has_vehicle():
-        raise RuntimeError("this build of tcsim._core has no vehicle plant (launch_runs); reinstall tcsim "
-                           "(python3 -m pip install .) from a source tree that has it")
+        raise RuntimeError(
+            "this build of tcsim._core has no vehicle plant (launch_runs); reinstall tcsim "
+            "(python3 -m pip install .) from a source tree that has it"
+        )
     try:
         raw = _core.launch_runs([m.spec for m in models], vehicle.core_spec(), scenario.core_spec(), options, threads)
     except _core.CoreInputError as e:
@@ -560,15 +631,31 @@ def sweep_cases(models: Sequence[DynamicModel]) -> list[SweepCase]:
     return cases
 
 
-_SWEEP_KEEP = ("time_s", "speed_ratio", "torque_ratio", "effective_torque_ratio", "vehicle_speed_m_s",
-               "vehicle_accel_m_s2", "pump_speed_rad_s", "turbine_speed_rad_s")
+_SWEEP_KEEP = (
+    "time_s",
+    "speed_ratio",
+    "torque_ratio",
+    "effective_torque_ratio",
+    "vehicle_speed_m_s",
+    "vehicle_accel_m_s2",
+    "pump_speed_rad_s",
+    "turbine_speed_rad_s",
+)
 
 
 def sweep_scenario(scenario: Scenario) -> Scenario:
     """The scenario of the sweep: the same pedals, ending :data:`SWEEP_SPAN_S` after the release."""
     end = min(scenario.end_time_s, scenario.brake_release_time_s + SWEEP_SPAN_S)
-    return Scenario(scenario.name, scenario.time_s, scenario.accelerator_pedal, scenario.brake_pedal, end,
-                    scenario.stop_speed_m_s, scenario.brake_release_time_s, scenario.source)
+    return Scenario(
+        scenario.name,
+        scenario.time_s,
+        scenario.accelerator_pedal,
+        scenario.brake_pedal,
+        end,
+        scenario.stop_speed_m_s,
+        scenario.brake_release_time_s,
+        scenario.source,
+    )
 
 
 def sweep_frame(cases: Sequence[SweepCase], frames: Mapping[str, pd.DataFrame]) -> pd.DataFrame:
@@ -580,8 +667,14 @@ def sweep_frame(cases: Sequence[SweepCase], frames: Mapping[str, pd.DataFrame]) 
         if f is None:
             continue
         cols = f[[k for k in _SWEEP_KEEP if k in f.columns]]
-        parts.append(cols.assign(model=c.model, pump_shape_effect_m2=c.pump_shape_effect_m2,
-                                 turbine_shape_effect_m2=c.turbine_shape_effect_m2, label=c.label))
+        parts.append(
+            cols.assign(
+                model=c.model,
+                pump_shape_effect_m2=c.pump_shape_effect_m2,
+                turbine_shape_effect_m2=c.turbine_shape_effect_m2,
+                label=c.label,
+            )
+        )
     if not parts:
         return pd.DataFrame(columns=["model", "pump_shape_effect_m2", "turbine_shape_effect_m2", "label", *_SWEEP_KEEP])
     df = pd.concat(parts, ignore_index=True)
@@ -600,9 +693,16 @@ def sweep_summary(cases: Sequence[SweepCase], frames: Mapping[str, pd.DataFrame]
     for c in cases:
         f = frames.get(f"{c.model} {c.label}")
         metrics = summary_row(f, release_s) if f is not None else {}
-        rows.append({"model": c.model, "pump_shape_effect_m2": c.pump_shape_effect_m2,
-                     "turbine_shape_effect_m2": c.turbine_shape_effect_m2, "label": c.label,
-                     "finished": f is not None, **{k: metrics.get(k, math.nan) for k in SWEEP_METRICS}})
+        rows.append(
+            {
+                "model": c.model,
+                "pump_shape_effect_m2": c.pump_shape_effect_m2,
+                "turbine_shape_effect_m2": c.turbine_shape_effect_m2,
+                "label": c.label,
+                "finished": f is not None,
+                **{k: metrics.get(k, math.nan) for k in SWEEP_METRICS},
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -642,22 +742,40 @@ def _progress(enabled: bool) -> Iterator[Any]:
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
 
     console = Console(stderr=True)
-    with Progress(SpinnerColumn(), TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                  TimeElapsedColumn(), console=console, transient=True,
-                  disable=not (enabled and console.is_terminal)) as progress:
+    with Progress(
+        SpinnerColumn(),
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+        disable=not (enabled and console.is_terminal),
+    ) as progress:
         yield progress
 
 
-def launch(vehicle: Vehicle | str | None = None, scenario: Scenario | str = "flip-flop", models: Sequence[str] = (),
-           sweep: bool = False, threads: int = 0, options: dict | None = None, progress: bool = False) -> Launch:
+def launch(
+    vehicle: Vehicle | str | None = None,
+    scenario: Scenario | str = "flip-flop",
+    models: Sequence[str] = (),
+    sweep: bool = False,
+    threads: int = 0,
+    options: dict | None = None,
+    progress: bool = False,
+) -> Launch:
     """Run the launch (no files written): every model, then the optional shape-effect sweep."""
     veh = vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)
     scen = scenario if isinstance(scenario, Scenario) else scenario_from_option(scenario)
     dyn = select_models(veh, models)
     cases = sweep_cases(dyn) if sweep else []
     if sweep and not cases:
-        raise InputError("command line", "--sweep-shape-effects", "set",
-                         f"at least one of {', '.join(DYNAMIC_MODELS)} among the models run")
+        raise InputError(
+            "command line",
+            "--sweep-shape-effects",
+            "set",
+            f"at least one of {', '.join(DYNAMIC_MODELS)} among the models run",
+        )
     with _progress(progress) as p:
         task = p.add_task(f"{veh.name}, {scen.name}: {len(dyn)} models", total=2 if cases else 1)
         t0 = time.perf_counter()
@@ -668,8 +786,15 @@ def launch(vehicle: Vehicle | str | None = None, scenario: Scenario | str = "fli
         if cases:
             p.update(task, description=f"shape-effect sweep: {len(cases)} runs")
             t0 = time.perf_counter()
-            sweep_frames = run_launch(veh, sweep_scenario(scen), [c.dynamic for c in cases], options, threads,
-                                      labels=[f"{c.model} {c.label}" for c in cases], on_error="warn")
+            sweep_frames = run_launch(
+                veh,
+                sweep_scenario(scen),
+                [c.dynamic for c in cases],
+                options,
+                threads,
+                labels=[f"{c.model} {c.label}" for c in cases],
+                on_error="warn",
+            )
             result.sweep_compute_s = time.perf_counter() - t0
             result.sweep = sweep_frame(cases, sweep_frames)
             result.sweep_summary = sweep_summary(cases, sweep_frames, scen.brake_release_time_s)
@@ -683,8 +808,14 @@ def write_launch(result: Launch, out_dir: Path) -> list[Path]:
 
     out_dir = Path(out_dir)
     files: dict[str, pd.DataFrame] = {f"{name}.csv": f for name, f in result.frames.items()}
-    files.update({"summary.csv": result.summary, "timeseries.csv": result.timeseries(), "events.csv": result.events,
-                  "scenario.csv": result.scenario.frame()})
+    files.update(
+        {
+            "summary.csv": result.summary,
+            "timeseries.csv": result.timeseries(),
+            "events.csv": result.events,
+            "scenario.csv": result.scenario.frame(),
+        }
+    )
     if result.sweep is not None:
         files["shape_sweep.csv"] = result.sweep
         files["shape_sweep_summary.csv"] = result.sweep_summary
@@ -708,19 +839,34 @@ def summary(result: Launch, out: Path):
     from rich.table import Table
 
     s = result.scenario
-    table = Table(title=f"launch of {result.vehicle.name} ({result.vehicle.converter.name}), scenario {s.name}, "
-                        f"brake release at {s.brake_release_time_s:g} s")
-    for col in ("model", "0–50 km/h [s]", "0–100 km/h [s]", "peak accel [m/s²]", "mean accel first 0.5 s [m/s²]",
-                "min eff. TR first 0.5 s"):
+    table = Table(
+        title=f"launch of {result.vehicle.name} ({result.vehicle.converter.name}), scenario {s.name}, "
+        f"brake release at {s.brake_release_time_s:g} s"
+    )
+    for col in (
+        "model",
+        "0–50 km/h [s]",
+        "0–100 km/h [s]",
+        "peak accel [m/s²]",
+        "mean accel first 0.5 s [m/s²]",
+        "min eff. TR first 0.5 s",
+    ):
         table.add_column(col)
     for _, r in result.summary.iterrows():
-        table.add_row(r["model"], _fmt(r["time_0_50_km_h_s"], 2), _fmt(r["time_0_100_km_h_s"], 2),
-                      _fmt(r["peak_accel_m_s2"], 2), _fmt(r["mean_accel_first_0_5_s_m_s2"], 2),
-                      _fmt(r["min_effective_torque_ratio_first_0_5_s"], 3))
-    lines = [f"compute {result.compute_s * 1e3:.0f} ms for {len(result.frames)} models"
-             + (f", sweep {result.sweep_compute_s * 1e3:.0f} ms" if result.sweep is not None else ""),
-             f"written to {out}/: summary.csv, {', '.join(f'{m}.csv' for m in result.frames)}, timeseries.csv, "
-             f"events.csv, scenario.csv{', shape_sweep*.csv' if result.sweep is not None else ''} and plots"]
+        table.add_row(
+            r["model"],
+            _fmt(r["time_0_50_km_h_s"], 2),
+            _fmt(r["time_0_100_km_h_s"], 2),
+            _fmt(r["peak_accel_m_s2"], 2),
+            _fmt(r["mean_accel_first_0_5_s_m_s2"], 2),
+            _fmt(r["min_effective_torque_ratio_first_0_5_s"], 3),
+        )
+    lines = [
+        f"compute {result.compute_s * 1e3:.0f} ms for {len(result.frames)} models"
+        + (f", sweep {result.sweep_compute_s * 1e3:.0f} ms" if result.sweep is not None else ""),
+        f"written to {out}/: summary.csv, {', '.join(f'{m}.csv' for m in result.frames)}, timeseries.csv, "
+        f"events.csv, scenario.csv{', shape_sweep*.csv' if result.sweep is not None else ''} and plots",
+    ]
     return Group(table, *lines)
 
 

@@ -23,8 +23,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.ticker import MaxNLocator  # noqa: E402
 import pandas as pd  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 if TYPE_CHECKING:  # pragma: no cover
     from .launch import Launch
@@ -57,7 +57,7 @@ def _release_line(ax, release: float) -> None:
     ax.axvline(release, color="0.6", ls=":", lw=1)
 
 
-def plot_ratios(result: "Launch", out_dir: Path) -> list[Path]:
+def plot_ratios(result: Launch, out_dir: Path) -> list[Path]:
     """Figure 3.5 (TR and SR against time) and the effective TR, around the brake release."""
     release = result.scenario.brake_release_time_s
     a, b = release - RATIO_WINDOW_S[0], release + RATIO_WINDOW_S[1]
@@ -72,8 +72,12 @@ def plot_ratios(result: "Launch", out_dir: Path) -> list[Path]:
     _release_line(ax, release)
     ax.set_ylabel("Ratio [-]")
     ax.set_ylim(bottom=0)
-    p1 = _save(fig, ax, Path(out_dir) / "torque_speed_ratio.png",
-               "Effective torque ratio (solid) and speed ratio (dashed), cf. thesis fig. 3.5")
+    p1 = _save(
+        fig,
+        ax,
+        Path(out_dir) / "torque_speed_ratio.png",
+        "Effective torque ratio (solid) and speed ratio (dashed), cf. thesis fig. 3.5",
+    )
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
     for name, f in result.frames.items():
@@ -81,12 +85,16 @@ def plot_ratios(result: "Launch", out_dir: Path) -> list[Path]:
         ax.plot(w["time_s"], w["effective_torque_ratio"], lw=1.3, **_style(name))
     _release_line(ax, release)
     ax.set_ylabel("Effective torque ratio [-]")
-    p2 = _save(fig, ax, Path(out_dir) / "effective_torque_ratio.png",
-               "Effective torque ratio (eqs 3.1–3.4) around the brake release")
+    p2 = _save(
+        fig,
+        ax,
+        Path(out_dir) / "effective_torque_ratio.png",
+        "Effective torque ratio (eqs 3.1–3.4) around the brake release",
+    )
     return [p1, p2]
 
 
-def _mark_events(ax, result: "Launch", start: float) -> None:
+def _mark_events(ax, result: Launch, start: float) -> None:
     if not result.frames:
         return
     name, f = next(iter(result.frames.items()))
@@ -95,11 +103,20 @@ def _mark_events(ax, result: "Launch", start: float) -> None:
         if t < start or kind in _CONVERTER_EVENTS:
             continue
         ax.axvline(t, color="0.5", lw=0.8, ls=":")
-        ax.text(t, 0.98, f" {kind}", transform=ax.get_xaxis_transform(), rotation=90, va="top", ha="left",
-                fontsize="x-small", color="0.35")
+        ax.text(
+            t,
+            0.98,
+            f" {kind}",
+            transform=ax.get_xaxis_transform(),
+            rotation=90,
+            va="top",
+            ha="left",
+            fontsize="x-small",
+            color="0.35",
+        )
 
 
-def plot_acceleration(result: "Launch", out_dir: Path) -> list[Path]:
+def plot_acceleration(result: Launch, out_dir: Path) -> list[Path]:
     """Figures 3.6 (around the release) and 3.20 (the whole run) of the vehicle acceleration."""
     release = result.scenario.brake_release_time_s
     paths = []
@@ -109,8 +126,14 @@ def plot_acceleration(result: "Launch", out_dir: Path) -> list[Path]:
         ax.plot(w["time_s"], w["vehicle_accel_m_s2"], lw=1.3, **_style(name))
     _release_line(ax, release)
     ax.set_ylabel("Acceleration [m/s²]")
-    paths.append(_save(fig, ax, Path(out_dir) / "vehicle_accel_release.png",
-                       "Vehicle acceleration around the brake release, cf. thesis fig. 3.6"))
+    paths.append(
+        _save(
+            fig,
+            ax,
+            Path(out_dir) / "vehicle_accel_release.png",
+            "Vehicle acceleration around the brake release, cf. thesis fig. 3.6",
+        )
+    )
 
     fig, ax = plt.subplots(figsize=(7.2, 4.2), layout="constrained")
     start = release - ACCEL_WINDOW_S[0]
@@ -119,12 +142,18 @@ def plot_acceleration(result: "Launch", out_dir: Path) -> list[Path]:
         ax.plot(w["time_s"], w["vehicle_accel_m_s2"], lw=1.1, **_style(name))
     _mark_events(ax, result, start)
     ax.set_ylabel("Acceleration [m/s²]")
-    paths.append(_save(fig, ax, Path(out_dir) / "vehicle_accel.png",
-                       "Vehicle acceleration over the run (events of the first model), cf. thesis fig. 3.20"))
+    paths.append(
+        _save(
+            fig,
+            ax,
+            Path(out_dir) / "vehicle_accel.png",
+            "Vehicle acceleration over the run (events of the first model), cf. thesis fig. 3.20",
+        )
+    )
     return paths
 
 
-def plot_speeds(result: "Launch", out_dir: Path) -> list[Path]:
+def plot_speeds(result: Launch, out_dir: Path) -> list[Path]:
     """Vehicle speed with the gear, and the pump and turbine speeds."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
     gear_ax = ax.twinx()
@@ -142,25 +171,41 @@ def plot_speeds(result: "Launch", out_dir: Path) -> list[Path]:
     for name, f in result.frames.items():
         style = _style(name)
         ax.plot(f["time_s"], f["pump_speed_rad_s"], lw=1.3, color=style["color"], label=f"{style['label']}: pump")
-        ax.plot(f["time_s"], f["turbine_speed_rad_s"], lw=1.1, ls="--", color=style["color"],
-                label=f"{style['label']}: turbine")
+        ax.plot(
+            f["time_s"],
+            f["turbine_speed_rad_s"],
+            lw=1.1,
+            ls="--",
+            color=style["color"],
+            label=f"{style['label']}: turbine",
+        )
     ax.set_ylabel("Speed [rad/s]")
     p2 = _save(fig, ax, Path(out_dir) / "speeds.png", "Pump (engine) and turbine speeds")
     return [p1, p2]
 
 
-def plot_launch(result: "Launch", out_dir: Path) -> list[Path]:
+def plot_launch(result: Launch, out_dir: Path) -> list[Path]:
     """All figures of a launch."""
     return [*plot_ratios(result, out_dir), *plot_acceleration(result, out_dir), *plot_speeds(result, out_dir)]
 
 
 _SWEEP_FIGURES = (
-    ("effective_torque_ratio", "Effective torque ratio [-]", "effective TR", {"hrovat-tobler": "4.4", "quasi-dynamic": "4.3"}),
-    ("vehicle_accel_m_s2", "Acceleration [m/s²]", "vehicle acceleration", {"hrovat-tobler": "4.6", "quasi-dynamic": "4.5"}),
+    (
+        "effective_torque_ratio",
+        "Effective torque ratio [-]",
+        "effective TR",
+        {"hrovat-tobler": "4.4", "quasi-dynamic": "4.3"},
+    ),
+    (
+        "vehicle_accel_m_s2",
+        "Acceleration [m/s²]",
+        "vehicle acceleration",
+        {"hrovat-tobler": "4.6", "quasi-dynamic": "4.5"},
+    ),
 )
 
 
-def plot_sweep(result: "Launch", out_dir: Path) -> list[Path]:
+def plot_sweep(result: Launch, out_dir: Path) -> list[Path]:
     """Per dynamic model of the sweep: effective TR and vehicle acceleration against time, one line
     per shape effect, with the table model dashed (figures 4.3–4.6)."""
     if result.sweep is None or result.sweep.empty:
@@ -181,5 +226,7 @@ def plot_sweep(result: "Launch", out_dir: Path) -> list[Path]:
             _release_line(ax, release)
             ax.set_ylabel(ylabel)
             title = f"Shape effect and {what}, {LABELS.get(model, model)}, cf. thesis fig. {figure.get(model, '4.3')}"
-            paths.append(_save(fig, ax, Path(out_dir) / f"shape_sweep_{model}_{column.removesuffix('_m_s2')}.png", title))
+            paths.append(
+                _save(fig, ax, Path(out_dir) / f"shape_sweep_{model}_{column.removesuffix('_m_s2')}.png", title)
+            )
     return paths

@@ -43,8 +43,14 @@ _SUFFIXES: dict[str, dict[str, float]] = {
 #: Unit strings from file metadata (normalised by :func:`_normalise_unit`) -> factor to SI.
 _UNITS: dict[str, dict[str, float]] = {
     "time": {"s": 1.0, "ms": 1e-3},
-    "speed": {"rad/s": 1.0, "1/s": 1.0, "rpm": math.pi / 30.0, "1/min": math.pi / 30.0,
-              "min-1": math.pi / 30.0, "deg/s": math.pi / 180.0},
+    "speed": {
+        "rad/s": 1.0,
+        "1/s": 1.0,
+        "rpm": math.pi / 30.0,
+        "1/min": math.pi / 30.0,
+        "min-1": math.pi / 30.0,
+        "deg/s": math.pi / 180.0,
+    },
     "torque": {"nm": 1.0, "knm": 1e3, "lbfft": LBF_FT_IN_NM},
     "flow": {"m3/s": 1.0, "l/s": 1e-3},
 }
@@ -68,7 +74,7 @@ _PLAUSIBLE_MAX = {"speed": 1500.0, "torque": 20_000.0}
 _IMPLAUSIBLE = {
     "speed": "a speed in rad/s (values look like rpm; name the column *_rpm or map it with --channel)",
     "torque": "a torque in N·m below 20 000 N·m (values look like another unit, e.g. N·mm; "
-              "check the column's unit or map it with --channel)",
+    "check the column's unit or map it with --channel)",
 }
 MAX_TIME_SPAN_S = 1e6
 
@@ -128,8 +134,9 @@ def _unit_factor(path: Path, column: str, unit: str, canonical: str) -> float:
     factor = _UNITS[quantity].get(_normalise_unit(unit))
     if factor is None:
         accepted = ", ".join(_UNITS[quantity])
-        raise InputError(str(path), f"{column} (unit)", unit,
-                         f"a {quantity} unit for {canonical} (one of {accepted}): wrong units")
+        raise InputError(
+            str(path), f"{column} (unit)", unit, f"a {quantity} unit for {canonical} (one of {accepted}): wrong units"
+        )
     return factor
 
 
@@ -171,8 +178,7 @@ class _Picker:
     Returns the columns to load; ``picks`` keeps where each canonical channel comes from.
     """
 
-    def __init__(self, path: Path, channels: Mapping[str, str], required: Sequence[str],
-                 optional: Sequence[str]):
+    def __init__(self, path: Path, channels: Mapping[str, str], required: Sequence[str], optional: Sequence[str]):
         self.path = path
         self.channels = channels
         self.wanted = list(dict.fromkeys(["time_s", *required, *channels, *optional]))
@@ -189,9 +195,12 @@ class _Picker:
         if canonical in self.channels:
             column = self.channels[canonical]
             if column not in names:
-                raise InputError(str(self.path), column, "missing",
-                                 f"a column named {column} (--channel {canonical}={column}); "
-                                 f"columns found: {_shorten(list(names))}")
+                raise InputError(
+                    str(self.path),
+                    column,
+                    "missing",
+                    f"a column named {column} (--channel {canonical}={column}); columns found: {_shorten(list(names))}",
+                )
             return _Pick(canonical, column, _suffix_factor(column, quantity))
         candidates = _candidates(canonical)
         for column, factor in candidates:
@@ -199,9 +208,13 @@ class _Picker:
                 return _Pick(canonical, column, factor)
         if canonical in self.needed:
             alternatives = " or ".join(c for c, _ in candidates[1:])
-            raise InputError(str(self.path), canonical, "missing",
-                             f"a column named {canonical} or {alternatives}, or --channel "
-                             f"{canonical}=COLUMN; columns found: {_shorten(list(names))}")
+            raise InputError(
+                str(self.path),
+                canonical,
+                "missing",
+                f"a column named {canonical} or {alternatives}, or --channel "
+                f"{canonical}=COLUMN; columns found: {_shorten(list(names))}",
+            )
         return None
 
 
@@ -252,8 +265,11 @@ def _read_mat_v5(path: Path, pick: _Chooser) -> _Loaded:
 
     with _reading(path, "MATLAB .mat"):
         variables = scipy.io.loadmat(path)
-    vectors = {k: v for k, v in variables.items()
-               if not k.startswith("__") and isinstance(v, np.ndarray) and _is_vector(v.shape, v.dtype)}
+    vectors = {
+        k: v
+        for k, v in variables.items()
+        if not k.startswith("__") and isinstance(v, np.ndarray) and _is_vector(v.shape, v.dtype)
+    }
     return {c: vectors[c].ravel() for c in pick(list(vectors))}, {}
 
 
@@ -262,8 +278,13 @@ def _read_mat_v73(path: Path, pick: _Chooser) -> _Loaded:
     import h5py
 
     with _reading(path, "MATLAB v7.3 (HDF5) .mat"), h5py.File(path, "r") as f:
-        datasets = {k: v for k, v in f.items() if isinstance(v, h5py.Dataset) and _is_vector(v.shape, v.dtype)
-                    and v.attrs.get("MATLAB_class", b"double") not in (b"char", b"logical")}
+        datasets = {
+            k: v
+            for k, v in f.items()
+            if isinstance(v, h5py.Dataset)
+            and _is_vector(v.shape, v.dtype)
+            and v.attrs.get("MATLAB_class", b"double") not in (b"char", b"logical")
+        }
         return {c: np.asarray(datasets[c][()]).ravel() for c in pick(list(datasets))}, {}
 
 
@@ -342,44 +363,60 @@ def _finite(path: Path, column: str, values: np.ndarray, time_s: np.ndarray | No
     if len(bad):
         value = values[bad[0]]
         shown = "NaN" if np.isnan(value) else str(value)
-        raise InputError(str(path), column, f"{shown} at {_at(int(bad[0]), time_s)}",
-                         "finite numbers (no NaN or inf, no empty cells)")
+        raise InputError(
+            str(path),
+            column,
+            f"{shown} at {_at(int(bad[0]), time_s)}",
+            "finite numbers (no NaN or inf, no empty cells)",
+        )
 
 
 def _increasing(path: Path, column: str, time: np.ndarray) -> None:
     steps = np.flatnonzero(np.diff(time) <= 0)
     if len(steps):
         i = int(steps[0]) + 1
-        raise InputError(str(path), column, f"{time[i]:g} at row {i + 1} after {time[i - 1]:g}",
-                         "time strictly increasing")
+        raise InputError(
+            str(path), column, f"{time[i]:g} at row {i + 1} after {time[i - 1]:g}", "time strictly increasing"
+        )
 
 
-def _plausible(path: Path, column: str, canonical: str, values_si: np.ndarray, converted: bool,
-               time_s: np.ndarray | None) -> None:
+def _plausible(
+    path: Path, column: str, canonical: str, values_si: np.ndarray, converted: bool, time_s: np.ndarray | None
+) -> None:
     """Values that suggest the wrong unit: a time span over 1e6 s, speeds or torques far too large."""
     quantity = _QUANTITY[canonical]
     if quantity == "time":
         span = values_si[-1] - values_si[0]
         if span > MAX_TIME_SPAN_S:
-            raise InputError(str(path), column, f"span {span:g} s",
-                             f"time in seconds (a span under {MAX_TIME_SPAN_S:g} s; name the column time_ms "
-                             "or map it with --channel)")
+            raise InputError(
+                str(path),
+                column,
+                f"span {span:g} s",
+                f"time in seconds (a span under {MAX_TIME_SPAN_S:g} s; name the column time_ms "
+                "or map it with --channel)",
+            )
         return
     limit = _PLAUSIBLE_MAX.get(quantity)
     row = int(np.argmax(np.abs(values_si)))
     if limit is not None and abs(values_si[row]) > limit:
         si_unit = "rad/s" if quantity == "speed" else "N·m"
-        expected = (f"|{canonical}| at most {limit:g} {si_unit} after conversion (check the column's unit)"
-                    if converted else _IMPLAUSIBLE[quantity])
+        expected = (
+            f"|{canonical}| at most {limit:g} {si_unit} after conversion (check the column's unit)"
+            if converted
+            else _IMPLAUSIBLE[quantity]
+        )
         raise InputError(str(path), column, f"{values_si[row]:g} {si_unit} at {_at(row, time_s)}", expected)
 
 
 # --------------------------------------------------------------------------------------------
 
 
-def read_measurement(path, channels: Mapping[str, str] | None = None,
-                     required: Sequence[str] = ("pump_torque_nm", "turbine_speed_rad_s"),
-                     optional: Sequence[str] = ("pump_speed_rad_s", "turbine_torque_nm")) -> Measurement:
+def read_measurement(
+    path,
+    channels: Mapping[str, str] | None = None,
+    required: Sequence[str] = ("pump_torque_nm", "turbine_speed_rad_s"),
+    optional: Sequence[str] = ("pump_speed_rad_s", "turbine_torque_nm"),
+) -> Measurement:
     """Read a measured time series (CSV, Parquet, .mat v5/v7.3, MDF4) into SI channels.
 
     ``channels`` maps canonical names to columns of the file (see :func:`parse_channel_map`);
@@ -396,8 +433,12 @@ def read_measurement(path, channels: Mapping[str, str] | None = None,
     path = Path(path)
     reader = _READERS.get(path.suffix.lower())
     if reader is None:
-        raise InputError(str(path), "(extension)", path.suffix or "(none)",
-                         f"a measurement file ending in one of {', '.join(_READERS)}")
+        raise InputError(
+            str(path),
+            "(extension)",
+            path.suffix or "(none)",
+            f"a measurement file ending in one of {', '.join(_READERS)}",
+        )
     if not path.is_file():
         raise InputError(str(path), "(file)", "not found", "an existing measurement file")
 

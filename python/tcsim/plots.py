@@ -38,13 +38,25 @@ def table_columns(table: Characteristic) -> pd.DataFrame:
     sr, tr, cf = table.arrays()
     with np.errstate(divide="ignore", invalid="ignore"):
         k = _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(cf))
-    return pd.DataFrame({"speed_ratio": sr, "torque_ratio": tr, "capacity_factor_nm_s2": cf,
-                         "k_factor_rpm_per_sqrt_nm": k, "efficiency": tr * sr})
+    return pd.DataFrame(
+        {
+            "speed_ratio": sr,
+            "torque_ratio": tr,
+            "capacity_factor_nm_s2": cf,
+            "k_factor_rpm_per_sqrt_nm": k,
+            "efficiency": tr * sr,
+        }
+    )
 
 
-def plot_characteristic(curves: dict[str, pd.DataFrame], out_dir: Path, title: str,
-                        table: Characteristic | None = None, table_label: str = "Manufacturer table",
-                        coupling_point: float | None = None) -> list[Path]:
+def plot_characteristic(
+    curves: dict[str, pd.DataFrame],
+    out_dir: Path,
+    title: str,
+    table: Characteristic | None = None,
+    table_label: str = "Manufacturer table",
+    coupling_point: float | None = None,
+) -> list[Path]:
     """One PNG per quantity against SR; model curves as lines, the table as markers beside them."""
     ref = table_columns(table) if table is not None else None
     paths = []
@@ -55,7 +67,9 @@ def plot_characteristic(curves: dict[str, pd.DataFrame], out_dir: Path, title: s
             ax.plot(df["speed_ratio"], np.where(np.isfinite(y), y, np.nan), label=name)
         if ref is not None:
             y = ref[column].to_numpy(dtype=float)
-            ax.plot(ref["speed_ratio"], np.where(np.isfinite(y), y, np.nan), "o", mfc="none", color="k", label=table_label)
+            ax.plot(
+                ref["speed_ratio"], np.where(np.isfinite(y), y, np.nan), "o", mfc="none", color="k", label=table_label
+            )
         if coupling_point is not None:
             ax.axvline(coupling_point, color="0.6", ls=":", lw=1, label=f"coupling point SR {coupling_point:.3f}")
         ax.set_xlabel("Speed ratio [-]")

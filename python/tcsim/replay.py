@@ -124,8 +124,18 @@ from .measurement import Measurement, parse_channel_map, read_measurement
 METRICS_WINDOW_S = 1.0
 #: Keys of ``--initial``.
 INITIAL_KEYS: tuple[str, ...] = ("pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s")
-METRIC_COLUMNS = ["model", "channel", "window", "window_start_s", "window_end_s", "rmse", "nrmse",
-                  "max_abs_error", "max_abs_error_time_s", "n"]
+METRIC_COLUMNS = [
+    "model",
+    "channel",
+    "window",
+    "window_start_s",
+    "window_end_s",
+    "rmse",
+    "nrmse",
+    "max_abs_error",
+    "max_abs_error_time_s",
+    "n",
+]
 EVENT_COLUMNS = ["model", "time_s", "kind", "stator_locked", "flow_direction"]
 EFFECTIVE = ("effective_pump_torque_nm", "effective_turbine_torque_nm")
 
@@ -145,10 +155,15 @@ class DriveKind:
 
 
 DRIVES: dict[str, DriveKind] = {
-    "pump-torque": DriveKind("pump-torque", ("pump_torque_nm", "turbine_speed_rad_s"),
-                             ("pump_speed_rad_s", "turbine_torque_nm"), transient.PumpTorqueTurbineSpeed),
-    "speeds": DriveKind("speeds", ("pump_speed_rad_s", "turbine_speed_rad_s"),
-                        ("pump_torque_nm", "turbine_torque_nm"), transient.Speeds),
+    "pump-torque": DriveKind(
+        "pump-torque",
+        ("pump_torque_nm", "turbine_speed_rad_s"),
+        ("pump_speed_rad_s", "turbine_torque_nm"),
+        transient.PumpTorqueTurbineSpeed,
+    ),
+    "speeds": DriveKind(
+        "speeds", ("pump_speed_rad_s", "turbine_speed_rad_s"), ("pump_torque_nm", "turbine_torque_nm"), transient.Speeds
+    ),
 }
 
 
@@ -182,7 +197,9 @@ def parse_initial(items: Sequence[str]) -> dict[str, float]:
 def _check_window(option: str, value: float, positive: bool) -> float:
     ok = math.isfinite(value) and (value > 0 if positive else value >= 0)
     if not ok:
-        raise InputError("command line", option, value, f"a finite {'positive' if positive else 'non-negative'} number of seconds")
+        raise InputError(
+            "command line", option, value, f"a finite {'positive' if positive else 'non-negative'} number of seconds"
+        )
     return float(value)
 
 
@@ -209,19 +226,23 @@ def select_models(converter: Any, requested: Sequence[str]) -> list[transient.Dy
 # runs
 
 
-def _warn_ignored_initial(initial: dict[str, float], drive: DriveKind, models: Sequence[transient.DynamicModel]) -> None:
+def _warn_ignored_initial(
+    initial: dict[str, float], drive: DriveKind, models: Sequence[transient.DynamicModel]
+) -> None:
     for key in initial:
         if key in drive.inputs:
             warnings.warn(f"--initial {key} is ignored: drive {drive.name} prescribes it", TcsimWarning, stacklevel=3)
     lacking = {"table": ("stator_speed_rad_s", "flow_m3_s"), "quasi-dynamic": ("stator_speed_rad_s",)}
     for m in models:
         for key in set(initial) & set(lacking.get(m.name, ())):
-            warnings.warn(f"--initial {key} is ignored by the {m.name} model (it has no such state)", TcsimWarning,
-                          stacklevel=3)
+            warnings.warn(
+                f"--initial {key} is ignored by the {m.name} model (it has no such state)", TcsimWarning, stacklevel=3
+            )
 
 
-def run_models(models: Sequence[transient.DynamicModel], drive: transient.Drive,
-               initial: dict[str, float] | None = None) -> dict[str, transient.TransientResult]:
+def run_models(
+    models: Sequence[transient.DynamicModel], drive: transient.Drive, initial: dict[str, float] | None = None
+) -> dict[str, transient.TransientResult]:
     """Each model under the drive, sampled at the drive's time stamps. An error about the initial
     state is reported against ``--initial``."""
     results = {}
@@ -257,8 +278,13 @@ def _stats(time_s: np.ndarray, measured: np.ndarray, simulated: np.ndarray) -> d
     rmse = float(np.sqrt(np.mean(err * err)))
     span = float(np.max(measured) - np.min(measured))
     j = int(np.argmax(np.abs(err)))
-    return {"rmse": rmse, "nrmse": rmse / span if span > 0 else math.nan, "max_abs_error": float(abs(err[j])),
-            "max_abs_error_time_s": float(time_s[j]), "n": int(len(err))}
+    return {
+        "rmse": rmse,
+        "nrmse": rmse / span if span > 0 else math.nan,
+        "max_abs_error": float(abs(err[j])),
+        "max_abs_error_time_s": float(time_s[j]),
+        "n": int(len(err)),
+    }
 
 
 def metric_windows(time_s: np.ndarray, window_s: float | None) -> list[tuple[str, float, float, np.ndarray]]:
@@ -286,13 +312,19 @@ def error_metrics(time_s, measured, simulated, window_s: float | None = METRICS_
     t, m, s = (np.asarray(a, dtype=float) for a in (time_s, measured, simulated))
     if not (len(t) == len(m) == len(s)) or len(t) == 0:
         raise ValueError(f"time, measured and simulated need the same non-zero length ({len(t)}, {len(m)}, {len(s)})")
-    rows = [{"window": name, "window_start_s": a, "window_end_s": b, **_stats(t[mask], m[mask], s[mask])}
-            for name, a, b, mask in metric_windows(t, window_s)]
+    rows = [
+        {"window": name, "window_start_s": a, "window_end_s": b, **_stats(t[mask], m[mask], s[mask])}
+        for name, a, b, mask in metric_windows(t, window_s)
+    ]
     return pd.DataFrame(rows, columns=METRIC_COLUMNS[2:])
 
 
-def metrics_table(time_s: np.ndarray, results: dict[str, transient.TransientResult],
-                  references: dict[str, np.ndarray], window_s: float | None) -> pd.DataFrame:
+def metrics_table(
+    time_s: np.ndarray,
+    results: dict[str, transient.TransientResult],
+    references: dict[str, np.ndarray],
+    window_s: float | None,
+) -> pd.DataFrame:
     """:func:`error_metrics` for every model × reference channel the model outputs."""
     parts = []
     for name, result in results.items():
@@ -308,8 +340,17 @@ def metrics_table(time_s: np.ndarray, results: dict[str, transient.TransientResu
 
 def events_table(results: dict[str, transient.TransientResult]) -> pd.DataFrame:
     """All models' events: ``model, time_s, kind, stator_locked, flow_direction``."""
-    rows = [{"model": name, "time_s": e.time_s, "kind": e.kind, "stator_locked": e.stator_locked,
-             "flow_direction": e.flow_direction} for name, r in results.items() for e in r.events]
+    rows = [
+        {
+            "model": name,
+            "time_s": e.time_s,
+            "kind": e.kind,
+            "stator_locked": e.stator_locked,
+            "flow_direction": e.flow_direction,
+        }
+        for name, r in results.items()
+        for e in r.events
+    ]
     return pd.DataFrame(rows, columns=EVENT_COLUMNS)
 
 
@@ -336,9 +377,16 @@ class Replay:
         return self.measurement.to_frame().assign(**self.measured_effective)
 
 
-def replay(converter, measurement, models: Sequence[str] = (), drive: str = "pump-torque",
-           channels: dict[str, str] | None = None, initial: dict[str, float] | None = None,
-           window_s: float = transient.DERIVATIVE_WINDOW_S, metrics_window_s: float | None = METRICS_WINDOW_S) -> Replay:
+def replay(
+    converter,
+    measurement,
+    models: Sequence[str] = (),
+    drive: str = "pump-torque",
+    channels: dict[str, str] | None = None,
+    initial: dict[str, float] | None = None,
+    window_s: float = transient.DERIVATIVE_WINDOW_S,
+    metrics_window_s: float | None = METRICS_WINDOW_S,
+) -> Replay:
     """Run the replay (no files written): read, simulate every model, measure the errors."""
     kind = drive_kind(drive)
     window_s = _check_window("--window", window_s, positive=False)
@@ -350,8 +398,11 @@ def replay(converter, measurement, models: Sequence[str] = (), drive: str = "pum
     _warn_ignored_initial(initial or {}, kind, dyn)
     results = run_models(dyn, kind.make(meas, window_s), initial)
     inertia = dyn[0].spec["inertia_kg_m2"]
-    effective = {k: v for k, v in measured_effective_torques(meas, inertia[1], inertia[0], window_s).items()
-                 if k.startswith("effective_") and k != "effective_torque_ratio"}
+    effective = {
+        k: v
+        for k, v in measured_effective_torques(meas, inertia[1], inertia[0], window_s).items()
+        if k.startswith("effective_") and k != "effective_torque_ratio"
+    }
     metrics = metrics_table(meas.time_s, results, reference_channels(meas, kind, effective), metrics_window_s)
     return Replay(conv.name, kind, meas, results, effective, metrics)
 
@@ -378,8 +429,10 @@ def summary(rep: Replay, out: Path):
     from rich.console import Group
     from rich.table import Table
 
-    table = Table(title=f"replay of {rep.measurement.source} on {rep.converter}, drive {rep.drive.name}, "
-                        f"{len(rep.measurement.time_s)} samples")
+    table = Table(
+        title=f"replay of {rep.measurement.source} on {rep.converter}, drive {rep.drive.name}, "
+        f"{len(rep.measurement.time_s)} samples"
+    )
     for col in ("model", "events", "turbine torque RMSE [N·m]", "NRMSE"):
         table.add_column(col)
     rows = rep.metrics[(rep.metrics["channel"] == "turbine_torque_nm") & (rep.metrics["window"] == "all")]
@@ -388,18 +441,38 @@ def summary(rep: Replay, out: Path):
         row = rows[rows["model"] == name]
         rmse, nrmse = (f"{row[c].iloc[0]:.4g}" for c in ("rmse", "nrmse")) if len(row) else ("n/a", "n/a")
         table.add_row(name, events, rmse, nrmse)
-    return Group(table, f"written to {out}/: {', '.join(f'{m}.csv' for m in rep.results)}, events.csv, "
-                        f"measurement.csv{', metrics.csv' if len(rep.metrics) else ''} and plots")
+    return Group(
+        table,
+        f"written to {out}/: {', '.join(f'{m}.csv' for m in rep.results)}, events.csv, "
+        f"measurement.csv{', metrics.csv' if len(rep.metrics) else ''} and plots",
+    )
 
 
-def replay_command(converter: str, measurement: str, models: Sequence[str], out: str | Path, channel: Sequence[str],
-                   drive: str, initial: Sequence[str], window_s: float | None, metrics_window_s: float):
+def replay_command(
+    converter: str,
+    measurement: str,
+    models: Sequence[str],
+    out: str | Path,
+    channel: Sequence[str],
+    drive: str,
+    initial: Sequence[str],
+    window_s: float | None,
+    metrics_window_s: float,
+):
     """``tcsim replay``: runs, writes DIR all at once, returns the summary to print."""
     from .outputs import output_dir
 
     window_s = transient.DERIVATIVE_WINDOW_S if window_s is None else window_s
-    rep = replay(converter, measurement, models, drive, parse_channel_map(channel), parse_initial(initial),
-                 window_s, metrics_window_s)
+    rep = replay(
+        converter,
+        measurement,
+        models,
+        drive,
+        parse_channel_map(channel),
+        parse_initial(initial),
+        window_s,
+        metrics_window_s,
+    )
     with output_dir(out) as stage:
         write_replay(rep, stage)
     return summary(rep, Path(out))

@@ -21,21 +21,30 @@ FIGURES = {
     "pump_speed_rad_s": ("Pump speed [rad/s]", "pump_speed.png", "cf. thesis fig. 3.14"),
     "pump_torque_nm": ("Pump torque [N·m]", "pump_torque.png", "drive (b) output"),
     "turbine_torque_nm": ("Turbine torque [N·m]", "turbine_torque.png", "cf. thesis fig. 3.13"),
-    "effective_pump_torque_nm": ("Effective pump input torque [N·m]", "effective_pump_torque.png",
-                                 "T_p − I_p·dω_p/dt, thesis eq 3.3, fig. 3.16"),
-    "effective_turbine_torque_nm": ("Effective turbine output torque [N·m]", "effective_turbine_torque.png",
-                                    "T_t + I_t·dω_t/dt, thesis eq 3.4, fig. 3.17"),
+    "effective_pump_torque_nm": (
+        "Effective pump input torque [N·m]",
+        "effective_pump_torque.png",
+        "T_p − I_p·dω_p/dt, thesis eq 3.3, fig. 3.16",
+    ),
+    "effective_turbine_torque_nm": (
+        "Effective turbine output torque [N·m]",
+        "effective_turbine_torque.png",
+        "T_t + I_t·dω_t/dt, thesis eq 3.4, fig. 3.17",
+    ),
 }
 from .plots import finish_figure  # noqa: E402
 
-INPUT_LABELS = {"pump_torque_nm": "Pump torque [N·m]", "pump_speed_rad_s": "Pump speed [rad/s]",
-                "turbine_speed_rad_s": "Turbine speed [rad/s]"}
+INPUT_LABELS = {
+    "pump_torque_nm": "Pump torque [N·m]",
+    "pump_speed_rad_s": "Pump speed [rad/s]",
+    "turbine_speed_rad_s": "Turbine speed [rad/s]",
+}
 
 
 _finish = finish_figure
 
 
-def plot_inputs(rep: "Replay", out_dir: Path) -> Path:
+def plot_inputs(rep: Replay, out_dir: Path) -> Path:
     """The drive's measured input signals, one panel each (thesis figures 3.11 and 3.12)."""
     meas = rep.measurement
     fig, axes = plt.subplots(len(rep.drive.inputs), 1, figsize=(6.4, 5.6), sharex=True, layout="constrained")
@@ -51,7 +60,7 @@ def plot_inputs(rep: "Replay", out_dir: Path) -> Path:
     return path
 
 
-def plot_channel(rep: "Replay", channel: str, out_dir: Path) -> Path:
+def plot_channel(rep: Replay, channel: str, out_dir: Path) -> Path:
     """One channel of every model over time, with the measured one when there is one."""
     label, filename, note = FIGURES[channel]
     measured = {**rep.measurement.channels, **rep.measured_effective}.get(channel)
@@ -66,7 +75,7 @@ def plot_channel(rep: "Replay", channel: str, out_dir: Path) -> Path:
     return _finish(fig, ax, out_dir / filename, title)
 
 
-def plot_replay(rep: "Replay", out_dir: Path) -> list[Path]:
+def plot_replay(rep: Replay, out_dir: Path) -> list[Path]:
     """All figures of a replay: inputs, the drive's outputs, the effective torques."""
     channels = [*rep.drive.outputs, "effective_pump_torque_nm", "effective_turbine_torque_nm"]
     return [plot_inputs(rep, out_dir), *(plot_channel(rep, c, out_dir) for c in channels)]

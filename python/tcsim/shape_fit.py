@@ -25,9 +25,10 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping, Sequence, Union
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -37,8 +38,17 @@ from .converter import Converter, load_converter
 from .effective import measured_effective_torques, smoothed_rate  # noqa: F401 (re-exported)
 from .errors import InputError
 from .measurement import Measurement, parse_channel_map, read_measurement
-from .transient import (DERIVATIVE_WINDOW_S, DynamicModel, resolve_model, PumpTorqueTurbineSpeed, SolverError, Speeds,
-                        TransientResult, dynamic_model, simulate_batch)
+from .transient import (
+    DERIVATIVE_WINDOW_S,
+    DynamicModel,
+    PumpTorqueTurbineSpeed,
+    SolverError,
+    Speeds,
+    TransientResult,
+    dynamic_model,
+    resolve_model,
+    simulate_batch,
+)
 
 MODELS = ("quasi-dynamic", "hrovat-tobler")
 TARGETS = ("effective_turbine_torque_nm", "effective_torque_ratio")
@@ -98,8 +108,10 @@ class MassMatrixBound:
     def single(self) -> tuple[float, float]:
         """Largest admissible |S_p| with S_t = 0 and |S_t| with S_p = 0, m²."""
         room = max(self.room, 0.0)
-        return (math.sqrt(room * self.pump_inertia_kg_m2) / self.density_kg_m3,
-                math.sqrt(room * self.turbine_inertia_kg_m2) / self.density_kg_m3)
+        return (
+            math.sqrt(room * self.pump_inertia_kg_m2) / self.density_kg_m3,
+            math.sqrt(room * self.turbine_inertia_kg_m2) / self.density_kg_m3,
+        )
 
     def equal(self) -> float:
         """Largest admissible |S| with S_p = S_t = S, m²."""
@@ -119,16 +131,18 @@ def mass_matrix_bound(model: DynamicModel) -> MassMatrixBound | None:
 
 
 def _inadmissible_note(bound: MassMatrixBound, pump_m2: float, turbine_m2: float) -> str:
-    return (f"inadmissible for hrovat-tobler: ρ²S_p²/I_p + ρ²S_t²/I_t = {bound.load(pump_m2, turbine_m2):.6g} "
-            f"must stay below ρL_f/A − ρ²S_s²/I_s = {bound.room:.6g} kg/m⁴ (mass matrix positive definite, "
-            f"physics notes §4); largest S_p = S_t is {bound.equal():.4g} m²")
+    return (
+        f"inadmissible for hrovat-tobler: ρ²S_p²/I_p + ρ²S_t²/I_t = {bound.load(pump_m2, turbine_m2):.6g} "
+        f"must stay below ρL_f/A − ρ²S_s²/I_s = {bound.room:.6g} kg/m⁴ (mass matrix positive definite, "
+        f"physics notes §4); largest S_p = S_t is {bound.equal():.4g} m²"
+    )
 
 
 # ---------------------------------------------------------------------------------------------
 # shared helpers
 
 
-def _model(converter: Union[Converter, str, DynamicModel], model: Union[str, DynamicModel]) -> DynamicModel:
+def _model(converter: Converter | str | DynamicModel, model: str | DynamicModel) -> DynamicModel:
     """The dynamic model to fit or sweep; only the two models with shape effects."""
     return resolve_model(converter, model, MODELS, " (the table model has no shape effects)")
 
@@ -184,20 +198,34 @@ class ShapeFitResult:
     def to_dict(self) -> dict[str, Any]:
         """The numbers of ``shape_fit.json``."""
         return {
-            "model": self.model, "target": self.target, "equal": self.equal,
-            "pump_shape_effect_m2": self.pump_shape_effect_m2, "turbine_shape_effect_m2": self.turbine_shape_effect_m2,
-            "rmse": self.rmse, "rmse_at_zero": self.rmse_at_zero, "unit": self.unit,
+            "model": self.model,
+            "target": self.target,
+            "equal": self.equal,
+            "pump_shape_effect_m2": self.pump_shape_effect_m2,
+            "turbine_shape_effect_m2": self.turbine_shape_effect_m2,
+            "rmse": self.rmse,
+            "rmse_at_zero": self.rmse_at_zero,
+            "unit": self.unit,
             "bound_m2": list(self.bound_m2) if self.bound_m2 is not None else None,
-            "pump_bounds_m2": list(self.pump_bounds_m2), "turbine_bounds_m2": list(self.turbine_bounds_m2),
-            "active_bounds": dict(self.active), "points": self.points, "time_window_s": list(self.time_window_s),
-            "optimiser": {"method": "scipy.optimize.least_squares, trf, batched forward differences",
-                          "evaluations": self.evaluations, "message": self.message, "elapsed_s": self.elapsed_s},
+            "pump_bounds_m2": list(self.pump_bounds_m2),
+            "turbine_bounds_m2": list(self.turbine_bounds_m2),
+            "active_bounds": dict(self.active),
+            "points": self.points,
+            "time_window_s": list(self.time_window_s),
+            "optimiser": {
+                "method": "scipy.optimize.least_squares, trf, batched forward differences",
+                "evaluations": self.evaluations,
+                "message": self.message,
+                "elapsed_s": self.elapsed_s,
+            },
         }
 
     def summary(self) -> str:
-        return (f"{self.model}: S_p = {self.pump_shape_effect_m2:.5g} m², S_t = {self.turbine_shape_effect_m2:.5g} m²; "
-                f"RMSE of {self.target} {self.rmse:.4g} {self.unit} (S = 0: {self.rmse_at_zero:.4g}); "
-                f"{self.evaluations} runs, {self.elapsed_s:.2f} s")
+        return (
+            f"{self.model}: S_p = {self.pump_shape_effect_m2:.5g} m², S_t = {self.turbine_shape_effect_m2:.5g} m²; "
+            f"RMSE of {self.target} {self.rmse:.4g} {self.unit} (S = 0: {self.rmse_at_zero:.4g}); "
+            f"{self.evaluations} runs, {self.elapsed_s:.2f} s"
+        )
 
 
 class _Problem:
@@ -265,9 +293,13 @@ def _check_bounds(name: str, given, default: tuple[float, float], bound: float |
     if not (math.isfinite(lo) and math.isfinite(hi) and lo < hi):
         raise InputError("command line", name, f"{lo:g}:{hi:g}", "finite bounds LO < HI, m²")
     if bound is not None and max(abs(lo), abs(hi)) >= bound:
-        raise InputError("command line", name, f"{lo:g}:{hi:g}",
-                         f"bounds within the admissible ±{bound:.4g} m² of the Hrovat & Tobler model "
-                         "(mass matrix positive definite, physics notes §4)")
+        raise InputError(
+            "command line",
+            name,
+            f"{lo:g}:{hi:g}",
+            f"bounds within the admissible ±{bound:.4g} m² of the Hrovat & Tobler model "
+            "(mass matrix positive definite, physics notes §4)",
+        )
     return lo, hi
 
 
@@ -279,8 +311,11 @@ def _fit_bounds(bound: MassMatrixBound | None, pump_bounds, turbine_bounds, equa
     else:
         single = (bound.equal(), bound.equal()) if equal else bound.single()
         dp, dt = ((-BOUND_FRACTION * b, BOUND_FRACTION * b) for b in single)
-    return (single, _check_bounds("pump_bounds", pump_bounds, dp, single and single[0]),
-            _check_bounds("turbine_bounds", turbine_bounds, dt, single and single[1]))
+    return (
+        single,
+        _check_bounds("pump_bounds", pump_bounds, dp, single and single[0]),
+        _check_bounds("turbine_bounds", turbine_bounds, dt, single and single[1]),
+    )
 
 
 def _fit_points(measured_time_s, measured_target, time_window) -> tuple[np.ndarray, np.ndarray]:
@@ -310,11 +345,19 @@ def _active(x, lo, hi, names) -> dict[str, str]:
     return out
 
 
-def fit_shape_effects(converter: Union[Converter, str, DynamicModel], model: Union[str, DynamicModel], drive,
-                      measured_time_s, measured_target, target: str = "effective_turbine_torque_nm",
-                      pump_bounds: tuple[float, float] | None = None, turbine_bounds: tuple[float, float] | None = None,
-                      equal: bool = False, time_window: tuple[float, float] | None = None,
-                      rtol: float = FIT_RTOL) -> ShapeFitResult:
+def fit_shape_effects(
+    converter: Converter | str | DynamicModel,
+    model: str | DynamicModel,
+    drive,
+    measured_time_s,
+    measured_target,
+    target: str = "effective_turbine_torque_nm",
+    pump_bounds: tuple[float, float] | None = None,
+    turbine_bounds: tuple[float, float] | None = None,
+    equal: bool = False,
+    time_window: tuple[float, float] | None = None,
+    rtol: float = FIT_RTOL,
+) -> ShapeFitResult:
     """Fit the shape effects (S_p, S_t) of ``model`` so that its ``target`` under ``drive``
     matches the measured one (Li & Sundén 2016 §4.1, done as an optimisation).
 
@@ -338,20 +381,46 @@ def fit_shape_effects(converter: Union[Converter, str, DynamicModel], model: Uni
     x0 = np.clip(np.zeros(len(lo)), lo, hi)
     r0 = problem.evaluate([x0])[0]
     if r0 is None or not np.isfinite(r0).all():
-        raise InputError("command line", "bounds", f"start {problem.shapes(x0)}",
-                         "a start point (S clipped into the bounds) that the model can run")
+        raise InputError(
+            "command line",
+            "bounds",
+            f"start {problem.shapes(x0)}",
+            "a start point (S clipped into the bounds) that the model can run",
+        )
     problem.penalty = 10.0 * (float(np.linalg.norm(r0)) + 1.0)
-    res = least_squares(problem.fun, x0, jac=problem.jac, bounds=(lo, hi), method="trf", x_scale=hi - lo,
-                        ftol=1e-12, xtol=1e-10, gtol=1e-12, max_nfev=60 * (len(x0) + 1))
+    res = least_squares(
+        problem.fun,
+        x0,
+        jac=problem.jac,
+        bounds=(lo, hi),
+        method="trf",
+        x_scale=hi - lo,
+        ftol=1e-12,
+        xtol=1e-10,
+        gtol=1e-12,
+        max_nfev=60 * (len(x0) + 1),
+    )
     sp, st = problem.shapes(res.x)
     zero = problem.evaluate([np.zeros(len(lo))])[0]
     names = ("shape_effect_m2",) if equal else ("pump_shape_effect_m2", "turbine_shape_effect_m2")
     return ShapeFitResult(
-        model=base.name, target=target, pump_shape_effect_m2=sp, turbine_shape_effect_m2=st,
-        rmse=_rmse(problem.evaluate([res.x])[0]), rmse_at_zero=_rmse(zero), evaluations=problem.runs,
-        bound_m2=single, pump_bounds_m2=bp, turbine_bounds_m2=bp if equal else bt, equal=equal,
-        points=len(times), time_window_s=(float(times[0]), float(times[-1])),
-        active=_active(res.x, lo, hi, names), message=str(res.message), elapsed_s=time.perf_counter() - t0)
+        model=base.name,
+        target=target,
+        pump_shape_effect_m2=sp,
+        turbine_shape_effect_m2=st,
+        rmse=_rmse(problem.evaluate([res.x])[0]),
+        rmse_at_zero=_rmse(zero),
+        evaluations=problem.runs,
+        bound_m2=single,
+        pump_bounds_m2=bp,
+        turbine_bounds_m2=bp if equal else bt,
+        equal=equal,
+        points=len(times),
+        time_window_s=(float(times[0]), float(times[-1])),
+        active=_active(res.x, lo, hi, names),
+        message=str(res.message),
+        elapsed_s=time.perf_counter() - t0,
+    )
 
 
 # ---------------------------------------------------------------------------------------------
@@ -378,22 +447,36 @@ def _sweep_times(drive, times_s) -> np.ndarray:
     return np.linspace(stamps[0], stamps[-1], min(max(n, 1), 20_000) + 1)
 
 
-SWEEP_COLUMNS = ("time_s", "speed_ratio", "effective_torque_ratio", "effective_turbine_torque_nm",
-                 "effective_pump_torque_nm", "pump_speed_rad_s", "turbine_speed_rad_s")
+SWEEP_COLUMNS = (
+    "time_s",
+    "speed_ratio",
+    "effective_torque_ratio",
+    "effective_turbine_torque_nm",
+    "effective_pump_torque_nm",
+    "pump_speed_rad_s",
+    "turbine_speed_rad_s",
+)
 
 
 def _sweep_rows(pair, run: TransientResult | str | None, note: str) -> pd.DataFrame:
     head = {"pump_shape_effect_m2": pair[0], "turbine_shape_effect_m2": pair[1], "label": _label(*pair)}
     if not isinstance(run, TransientResult):
-        return pd.DataFrame([{**head, "admissible": False, "note": note or str(run),
-                              **{c: math.nan for c in SWEEP_COLUMNS}}])
+        return pd.DataFrame(
+            [{**head, "admissible": False, "note": note or str(run), **{c: math.nan for c in SWEEP_COLUMNS}}]
+        )
     cols = {c: run[c] for c in SWEEP_COLUMNS}
     return pd.DataFrame({**head, "admissible": True, "note": "", **cols})
 
 
-def shape_effect_sweep(converter: Union[Converter, str, DynamicModel], model: Union[str, DynamicModel], drive,
-                       values_m2: Sequence[float] = THESIS_VALUES_M2, pairs: Sequence[tuple[float, float]] | None = None,
-                       times_s: Sequence[float] | None = None, rtol: float | None = None) -> pd.DataFrame:
+def shape_effect_sweep(
+    converter: Converter | str | DynamicModel,
+    model: str | DynamicModel,
+    drive,
+    values_m2: Sequence[float] = THESIS_VALUES_M2,
+    pairs: Sequence[tuple[float, float]] | None = None,
+    times_s: Sequence[float] | None = None,
+    rtol: float | None = None,
+) -> pd.DataFrame:
     """Effective TR for S_p = S_t = v (each v in ``values_m2``) and for the explicit ``pairs``
     (e.g. the thesis's (0.4, 0.3)), all in one batched core call (Li & Sundén 2016 §4.1,
     figures 4.1–4.4).
@@ -434,13 +517,19 @@ def sweep_minima(df: pd.DataFrame, time_window: tuple[float, float] | None = Non
         tr, t = w["effective_torque_ratio"].to_numpy(dtype=float), w["time_s"].to_numpy(dtype=float)
         below = zero.reindex(t).to_numpy() - tr if zero is not None else np.full(len(tr), np.nan)
         i, j = _argmin(tr), _argmin(-below)
-        rows.append({"pump_shape_effect_m2": sp, "turbine_shape_effect_m2": st, "label": g["label"].iloc[0],
-                     "admissible": bool(g["admissible"].iloc[0]),
-                     "min_effective_torque_ratio": tr[i] if i is not None else math.nan,
-                     "time_of_min_s": t[i] if i is not None else math.nan,
-                     "drop_below_zero": below[j] if j is not None else math.nan,
-                     "time_of_drop_s": t[j] if j is not None else math.nan,
-                     "final_effective_torque_ratio": float(g["effective_torque_ratio"].iloc[-1])})
+        rows.append(
+            {
+                "pump_shape_effect_m2": sp,
+                "turbine_shape_effect_m2": st,
+                "label": g["label"].iloc[0],
+                "admissible": bool(g["admissible"].iloc[0]),
+                "min_effective_torque_ratio": tr[i] if i is not None else math.nan,
+                "time_of_min_s": t[i] if i is not None else math.nan,
+                "drop_below_zero": below[j] if j is not None else math.nan,
+                "time_of_drop_s": t[j] if j is not None else math.nan,
+                "final_effective_torque_ratio": float(g["effective_torque_ratio"].iloc[-1]),
+            }
+        )
     return pd.DataFrame(rows)
 
 
@@ -448,15 +537,32 @@ def sweep_minima(df: pd.DataFrame, time_window: tuple[float, float] | None = Non
 # plots (thesis figures 4.1/4.2)
 
 
-_PLOTS = (("time_s", "effective_torque_ratio", "Time [s]", "Effective torque ratio [-]", "effective_torque_ratio_time.png"),
-          ("speed_ratio", "effective_torque_ratio", "Speed ratio [-]", "Effective torque ratio [-]",
-           "effective_torque_ratio_speed_ratio.png"),
-          ("time_s", "effective_turbine_torque_nm", "Time [s]", "Effective turbine output torque [N·m]",
-           "effective_turbine_torque_time.png"))
+_PLOTS = (
+    ("time_s", "effective_torque_ratio", "Time [s]", "Effective torque ratio [-]", "effective_torque_ratio_time.png"),
+    (
+        "speed_ratio",
+        "effective_torque_ratio",
+        "Speed ratio [-]",
+        "Effective torque ratio [-]",
+        "effective_torque_ratio_speed_ratio.png",
+    ),
+    (
+        "time_s",
+        "effective_turbine_torque_nm",
+        "Time [s]",
+        "Effective turbine output torque [N·m]",
+        "effective_turbine_torque_time.png",
+    ),
+)
 
 
-def plot_shape_effect_sweep(df: pd.DataFrame, out_dir, title: str, measured: pd.DataFrame | Mapping | None = None,
-                            steady: pd.DataFrame | Mapping | None = None) -> list[Path]:
+def plot_shape_effect_sweep(
+    df: pd.DataFrame,
+    out_dir,
+    title: str,
+    measured: pd.DataFrame | Mapping | None = None,
+    steady: pd.DataFrame | Mapping | None = None,
+) -> list[Path]:
     """Effective TR against time and against SR, and the effective turbine torque against time,
     one line per admissible shape-effect pair (like thesis figures 4.1/4.2), with the measurement
     (black) and the steady-state table model (dashed) when given. PNG files in ``out_dir``."""
@@ -465,8 +571,14 @@ def plot_shape_effect_sweep(df: pd.DataFrame, out_dir, title: str, measured: pd.
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    extra = [(d, style) for d, style in ((steady, dict(color="0.4", ls="--", label="SS model")),
-                                         (measured, dict(color="k", lw=1.2, label="Measurement"))) if d is not None]
+    extra = [
+        (d, style)
+        for d, style in (
+            (steady, dict(color="0.4", ls="--", label="SS model")),
+            (measured, dict(color="k", lw=1.2, label="Measurement")),
+        )
+        if d is not None
+    ]
     paths = []
     for x, y, xlabel, ylabel, filename in _PLOTS:
         fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
@@ -493,8 +605,14 @@ def plot_shape_effect_sweep(df: pd.DataFrame, out_dir, title: str, measured: pd.
 
 
 def _required(target: str, drive: str) -> tuple[str, ...]:
-    inputs = ("pump_torque_nm", "turbine_speed_rad_s") if drive == "pump-torque" else ("pump_speed_rad_s", "turbine_speed_rad_s")
-    wanted = ("turbine_torque_nm",) + (("pump_torque_nm", "pump_speed_rad_s") if target == "effective_torque_ratio" else ())
+    inputs = (
+        ("pump_torque_nm", "turbine_speed_rad_s")
+        if drive == "pump-torque"
+        else ("pump_speed_rad_s", "turbine_speed_rad_s")
+    )
+    wanted = ("turbine_torque_nm",) + (
+        ("pump_torque_nm", "pump_speed_rad_s") if target == "effective_torque_ratio" else ()
+    )
     return tuple(dict.fromkeys(inputs + wanted))
 
 
@@ -534,8 +652,16 @@ def _steady_run(conv: Converter, drive, times) -> pd.DataFrame | None:
     return run.frame() if isinstance(run, TransientResult) else None
 
 
-def shape_fit_command(converter: str, measurement: str, out, model: str, target: str, channels: Sequence[str] = (),
-                      drive: str = "pump-torque", equal: bool = False) -> str:
+def shape_fit_command(
+    converter: str,
+    measurement: str,
+    out,
+    model: str,
+    target: str,
+    channels: Sequence[str] = (),
+    drive: str = "pump-torque",
+    equal: bool = False,
+) -> str:
     """``tcsim fit-shapes``: fit the shape effects of ``converter``'s ``model`` to ``measurement``.
 
     Drive ``pump-torque`` (a): time_s, pump_torque_nm, turbine_speed_rad_s are the inputs;
@@ -551,8 +677,12 @@ def shape_fit_command(converter: str, measurement: str, out, model: str, target:
     _check_choice("--drive", drive, DRIVES)
     conv = load_converter(converter)
     conv.require(model)
-    meas = read_measurement(measurement, parse_channel_map(channels), required=_required(target, drive),
-                            optional=("pump_speed_rad_s", "pump_torque_nm"))
+    meas = read_measurement(
+        measurement,
+        parse_channel_map(channels),
+        required=_required(target, drive),
+        optional=("pump_speed_rad_s", "pump_torque_nm"),
+    )
     base = dynamic_model(conv, model)
     inertia = base.spec["inertia_kg_m2"]
     effective = measured_effective_torques(meas, inertia[1], inertia[0])
@@ -561,7 +691,8 @@ def shape_fit_command(converter: str, measurement: str, out, model: str, target:
     fitted = (result.pump_shape_effect_m2, result.turbine_shape_effect_m2)
     sweep = shape_effect_sweep(conv, base, drv, sweep_values(base), pairs=[fitted], times_s=meas.time_s)
     sweep.loc[(sweep.pump_shape_effect_m2 == fitted[0]) & (sweep.turbine_shape_effect_m2 == fitted[1]), "label"] = (
-        f"fitted: Sp={fitted[0]:.4g}, St={fitted[1]:.4g}")
+        f"fitted: Sp={fitted[0]:.4g}, St={fitted[1]:.4g}"
+    )
     measured = _measured_frame(meas, effective)
     steady = _steady_run(conv, drv, meas.time_s)
     with output_dir(out) as stage:
@@ -569,15 +700,31 @@ def shape_fit_command(converter: str, measurement: str, out, model: str, target:
     return f"{result.summary()}. Written to {out}/: shape_fit.json, shape_fit.md, shape_sweep.csv and plots."
 
 
-def _write(stage: Path, conv: Converter, meas: Measurement, result: ShapeFitResult, sweep: pd.DataFrame,
-           measured: pd.DataFrame, steady: pd.DataFrame | None, drive: str) -> None:
+def _write(
+    stage: Path,
+    conv: Converter,
+    meas: Measurement,
+    result: ShapeFitResult,
+    sweep: pd.DataFrame,
+    measured: pd.DataFrame,
+    steady: pd.DataFrame | None,
+    drive: str,
+) -> None:
     title = f"{conv.name}, {result.model}: shape effects"
     plots = plot_shape_effect_sweep(sweep, stage, title, measured=measured, steady=steady)
     sweep.to_csv(stage / "shape_sweep.csv", index=False)
     minima = sweep_minima(sweep)
-    doc = {**result.to_dict(), "converter": conv.path, "measurement": meas.source, "drive": drive,
-           "sweep": _json_safe(minima.to_dict(orient="records")), "files": [p.name for p in plots]}
-    (stage / "shape_fit.json").write_text(json.dumps(_json_safe(doc), indent=2, allow_nan=False) + "\n", encoding="utf-8")
+    doc = {
+        **result.to_dict(),
+        "converter": conv.path,
+        "measurement": meas.source,
+        "drive": drive,
+        "sweep": _json_safe(minima.to_dict(orient="records")),
+        "files": [p.name for p in plots],
+    }
+    (stage / "shape_fit.json").write_text(
+        json.dumps(_json_safe(doc), indent=2, allow_nan=False) + "\n", encoding="utf-8"
+    )
     (stage / "shape_fit.md").write_text(report_markdown(result, conv, meas, drive, minima, sweep), encoding="utf-8")
 
 
@@ -597,19 +744,27 @@ def _fmt(x: float, spec: str = ".5g") -> str:
     return "–" if x is None or not np.isfinite(x) else format(x, spec)
 
 
-def report_markdown(r: ShapeFitResult, conv: Converter, meas: Measurement, drive: str, minima: pd.DataFrame,
-                    sweep: pd.DataFrame) -> str:
+def report_markdown(
+    r: ShapeFitResult, conv: Converter, meas: Measurement, drive: str, minima: pd.DataFrame, sweep: pd.DataFrame
+) -> str:
     """``shape_fit.md``: fitted values, RMSE against S = 0, bounds, and the sweep's minima."""
     gain = 100.0 * (1.0 - r.rmse / r.rmse_at_zero) if r.rmse_at_zero > 0 else math.nan
-    bound = ("none (the quasi-dynamic model has no mass-matrix bound, physics notes §5)" if r.bound_m2 is None else
-             f"|S_p| < {r.bound_m2[0]:.4g} m², |S_t| < {r.bound_m2[1]:.4g} m² (each with the other at 0"
-             + (", S_p = S_t" if r.equal else "") + "; mass matrix positive definite, physics notes §4)")
+    bound = (
+        "none (the quasi-dynamic model has no mass-matrix bound, physics notes §5)"
+        if r.bound_m2 is None
+        else f"|S_p| < {r.bound_m2[0]:.4g} m², |S_t| < {r.bound_m2[1]:.4g} m² (each with the other at 0"
+        + (", S_p = S_t" if r.equal else "")
+        + "; mass matrix positive definite, physics notes §4)"
+    )
     lines = [
-        f"# Shape effects of {conv.name} ({r.model}) fitted to a transient measurement", "",
+        f"# Shape effects of {conv.name} ({r.model}) fitted to a transient measurement",
+        "",
         f"Measurement: {meas.source}, drive {drive}, {r.points} samples over "
         f"{r.time_window_s[0]:g}–{r.time_window_s[1]:g} s. Target: {r.target}, measured by eqs 3.3/3.4 "
-        f"(Li & Sundén 2016 §3.5.2) with ω̇ the local least-squares slope over ±{DERIVATIVE_WINDOW_S / 2 * 1e3:g} ms.", "",
-        "| quantity | value |", "|---|---|",
+        f"(Li & Sundén 2016 §3.5.2) with ω̇ the local least-squares slope over ±{DERIVATIVE_WINDOW_S / 2 * 1e3:g} ms.",
+        "",
+        "| quantity | value |",
+        "|---|---|",
         f"| S_p (pump shape effect) | {r.pump_shape_effect_m2:.6g} m² |",
         f"| S_t (turbine shape effect) | {r.turbine_shape_effect_m2:.6g} m² |",
         f"| RMSE at the fit | {_fmt(r.rmse, '.4g')} {r.unit} |",
@@ -618,23 +773,31 @@ def report_markdown(r: ShapeFitResult, conv: Converter, meas: Measurement, drive
         f"| bounds S_t | {r.turbine_bounds_m2[0]:.4g} to {r.turbine_bounds_m2[1]:.4g} m² |",
         f"| admissible (mass matrix) | {bound} |",
         f"| active bounds | {', '.join(f'{n} ({s})' for n, s in r.active.items()) or 'none'} |",
-        f"| optimiser | scipy least_squares (trf), {r.evaluations} model runs, {r.elapsed_s:.2f} s; {r.message} |", "",
+        f"| optimiser | scipy least_squares (trf), {r.evaluations} model runs, {r.elapsed_s:.2f} s; {r.message} |",
+        "",
         "Sign convention: effective turbine output = T_transfer,t − ρS_t·Q̇, effective pump input = "
         "T_transfer,p + ρS_p·Q̇ (eqs 2.12–2.18); positive S deepens the drop in effective TR while the flow builds up.",
         "",
-        "## Sweep (thesis figures 4.1/4.2)", "",
-        "Deepest drop: the largest amount by which the effective TR falls below that of S = 0 at the same time.", "",
+        "## Sweep (thesis figures 4.1/4.2)",
+        "",
+        "Deepest drop: the largest amount by which the effective TR falls below that of S = 0 at the same time.",
+        "",
         "| shape effects | admissible | min effective TR | at [s] | deepest drop below S = 0 | at [s] | final effective TR |",
         "|---|---|---|---|---|---|---|",
-        *[f"| {m.label} | {'yes' if m.admissible else 'no'} | {_fmt(m.min_effective_torque_ratio, '.4f')} | "
-          f"{_fmt(m.time_of_min_s, '.3f')} | {_fmt(m.drop_below_zero, '.4f')} | {_fmt(m.time_of_drop_s, '.3f')} | "
-          f"{_fmt(m.final_effective_torque_ratio, '.4f')} |" for m in minima.itertuples()],
+        *[
+            f"| {m.label} | {'yes' if m.admissible else 'no'} | {_fmt(m.min_effective_torque_ratio, '.4f')} | "
+            f"{_fmt(m.time_of_min_s, '.3f')} | {_fmt(m.drop_below_zero, '.4f')} | {_fmt(m.time_of_drop_s, '.3f')} | "
+            f"{_fmt(m.final_effective_torque_ratio, '.4f')} |"
+            for m in minima.itertuples()
+        ],
         "",
     ]
     notes = [n for n in dict.fromkeys(sweep.loc[~sweep["admissible"], "note"]) if n]
     if r.bound_m2 is not None and r.active:
-        notes.append("The fit stopped at a bound near the mass-matrix limit: the Hrovat & Tobler model cannot give a "
-                     "deeper drop with this geometry and these inertias (thesis §4.1: it could only be run up to S = 0.15).")
+        notes.append(
+            "The fit stopped at a bound near the mass-matrix limit: the Hrovat & Tobler model cannot give a "
+            "deeper drop with this geometry and these inertias (thesis §4.1: it could only be run up to S = 0.15)."
+        )
     if notes:
         lines += ["## Notes", "", *[f"- {n}" for n in notes], ""]
     return "\n".join(lines)

@@ -46,8 +46,9 @@ def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
     return np.unique(np.concatenate([np.linspace(sr[0], sr[-1], n), sr]))
 
 
-def characterise_table(conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
-                       speed_ratio: np.ndarray | None = None) -> pd.DataFrame:
+def characterise_table(
+    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
+) -> pd.DataFrame:
     """Steady state of the table model at a fixed pump speed over ``speed_ratio``.
 
     Inside the table TR and CF are interpolated linearly; outside it the end values are held and
@@ -61,28 +62,32 @@ def characterise_table(conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPE
         out = _core.table_steady_states(*conv.characteristic.arrays(), pump, np.ascontiguousarray(sr * wp))
     except _core.CoreInputError as e:
         raise from_core(e, conv.path) from None
-    df = pd.DataFrame({
-        "speed_ratio": sr,
-        "torque_ratio": out["torque_ratio"],
-        "pump_speed_rad_s": pump,
-        "turbine_speed_rad_s": sr * wp,
-        "pump_torque_nm": out["pump_torque_nm"],
-        "turbine_torque_nm": out["turbine_torque_nm"],
-        "stator_torque_nm": out["stator_torque_nm"],
-        "extrapolated": out["extrapolated"],
-    })
+    df = pd.DataFrame(
+        {
+            "speed_ratio": sr,
+            "torque_ratio": out["torque_ratio"],
+            "pump_speed_rad_s": pump,
+            "turbine_speed_rad_s": sr * wp,
+            "pump_torque_nm": out["pump_torque_nm"],
+            "turbine_torque_nm": out["turbine_torque_nm"],
+            "stator_torque_nm": out["stator_torque_nm"],
+            "extrapolated": out["extrapolated"],
+        }
+    )
     return _order(_derived(df))
 
 
-def characterise_quasi_dynamic(conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
-                               speed_ratio: np.ndarray | None = None) -> pd.DataFrame:
+def characterise_quasi_dynamic(
+    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
+) -> pd.DataFrame:
     """The quasi-dynamic model at steady state is its table, for any shape effect."""
     conv.require("quasi-dynamic")
     return characterise_table(conv, pump_speed_rpm, speed_ratio)
 
 
-def hrovat_tobler_steady_state(geometry: np.ndarray, pump_speed_rad_s, turbine_speed_rad_s,
-                               strict: bool = True) -> dict[str, np.ndarray]:
+def hrovat_tobler_steady_state(
+    geometry: np.ndarray, pump_speed_rad_s, turbine_speed_rad_s, strict: bool = True
+) -> dict[str, np.ndarray]:
     """Closed-form steady states, batched in the core (GIL released).
 
     ``geometry`` is one row of the fifteen core parameters (``tcsim._core.ht_parameter_names()``,
@@ -100,8 +105,9 @@ def coupling_point(conv: Converter) -> float | None:
     return _core.ht_coupling_point(conv.core_geometry())
 
 
-def characterise_hrovat_tobler(conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
-                               speed_ratio: np.ndarray | None = None) -> pd.DataFrame:
+def characterise_hrovat_tobler(
+    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
+) -> pd.DataFrame:
     """Closed-form steady state over SR 0–1 with the one-way clutch, coupling point included."""
     conv.require("hrovat-tobler")
     wp = _check_speed(pump_speed_rpm)
@@ -114,26 +120,36 @@ def characterise_hrovat_tobler(conv: Converter, pump_speed_rpm: float = DEFAULT_
         sr = np.asarray(speed_ratio, dtype=float)
     bad = np.flatnonzero((sr < 0) | (sr > 1) | ~np.isfinite(sr))
     if bad.size:
-        raise InputError("command line", "speed ratio", float(sr[bad[0]]),
-                         "0 to 1 for the hrovat-tobler model (reverse rotation and overrun are not modelled yet)")
+        raise InputError(
+            "command line",
+            "speed ratio",
+            float(sr[bad[0]]),
+            "0 to 1 for the hrovat-tobler model (reverse rotation and overrun are not modelled yet)",
+        )
     pump = np.full(sr.shape, wp)
     try:
         out = hrovat_tobler_steady_state(conv.core_geometry(), pump, sr * wp)
     except _core.CoreInputError as e:
         raise from_core(e, conv.path, "[geometry] at ") from None
-    tr = np.where(out["stator_mode"] == 2, 1.0, out["turbine_torque_nm"] / np.where(out["pump_torque_nm"] == 0, 1.0, out["pump_torque_nm"]))
-    df = pd.DataFrame({
-        "speed_ratio": sr,
-        "torque_ratio": tr,
-        "pump_speed_rad_s": pump,
-        "turbine_speed_rad_s": sr * wp,
-        "pump_torque_nm": out["pump_torque_nm"],
-        "turbine_torque_nm": out["turbine_torque_nm"],
-        "stator_torque_nm": out["stator_torque_nm"],
-        "flow_m3_s": out["flow_m3_s"],
-        "stator_speed_rad_s": out["stator_speed_rad_s"],
-        "stator_mode": [STATOR_MODES[int(m)] for m in out["stator_mode"]],
-    })
+    tr = np.where(
+        out["stator_mode"] == 2,
+        1.0,
+        out["turbine_torque_nm"] / np.where(out["pump_torque_nm"] == 0, 1.0, out["pump_torque_nm"]),
+    )
+    df = pd.DataFrame(
+        {
+            "speed_ratio": sr,
+            "torque_ratio": tr,
+            "pump_speed_rad_s": pump,
+            "turbine_speed_rad_s": sr * wp,
+            "pump_torque_nm": out["pump_torque_nm"],
+            "turbine_torque_nm": out["turbine_torque_nm"],
+            "stator_torque_nm": out["stator_torque_nm"],
+            "flow_m3_s": out["flow_m3_s"],
+            "stator_speed_rad_s": out["stator_speed_rad_s"],
+            "stator_mode": [STATOR_MODES[int(m)] for m in out["stator_mode"]],
+        }
+    )
     return _order(_derived(df))
 
 
@@ -143,16 +159,30 @@ CHARACTERISE = {
     "quasi-dynamic": characterise_quasi_dynamic,
 }
 
-_FIRST = ["speed_ratio", "torque_ratio", "capacity_factor_nm_s2", "k_factor_rpm_per_sqrt_nm", "efficiency",
-          "pump_speed_rad_s", "turbine_speed_rad_s", "pump_torque_nm", "turbine_torque_nm", "stator_torque_nm"]
+_FIRST = [
+    "speed_ratio",
+    "torque_ratio",
+    "capacity_factor_nm_s2",
+    "k_factor_rpm_per_sqrt_nm",
+    "efficiency",
+    "pump_speed_rad_s",
+    "turbine_speed_rad_s",
+    "pump_torque_nm",
+    "turbine_torque_nm",
+    "stator_torque_nm",
+]
 
 
 def _order(df: pd.DataFrame) -> pd.DataFrame:
     return df[_FIRST + [c for c in df.columns if c not in _FIRST]]
 
 
-def characterise(conv: Converter, model: str = "hrovat-tobler", pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
-                 speed_ratio: np.ndarray | None = None) -> pd.DataFrame:
+def characterise(
+    conv: Converter,
+    model: str = "hrovat-tobler",
+    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
+    speed_ratio: np.ndarray | None = None,
+) -> pd.DataFrame:
     """Steady-state characteristic of ``conv`` with ``model`` (``table``, ``hrovat-tobler``, ``quasi-dynamic``)."""
     conv.require(model)
     return CHARACTERISE[model](conv, pump_speed_rpm, speed_ratio)

@@ -34,8 +34,19 @@ from .steady import STATOR_MODES, hrovat_tobler_steady_state
 #: Status of a parameter value the model does not accept (CSV column ``stator_mode``).
 INVALID_PARAMETER = "invalid-parameter"
 
-COLUMNS = ["parameter", "parameter_value", "speed_ratio", "torque_ratio", "capacity_factor_nm_s2", "flow_m3_s",
-           "pump_torque_nm", "turbine_torque_nm", "stator_torque_nm", "stator_speed_rad_s", "stator_mode"]
+COLUMNS = [
+    "parameter",
+    "parameter_value",
+    "speed_ratio",
+    "torque_ratio",
+    "capacity_factor_nm_s2",
+    "flow_m3_s",
+    "pump_torque_nm",
+    "turbine_torque_nm",
+    "stator_torque_nm",
+    "stator_speed_rad_s",
+    "stator_mode",
+]
 
 
 @dataclass(frozen=True)
@@ -73,7 +84,7 @@ class StudyDefinition:
     pump_speed_rpm: float = 2000.0
     speed_ratio: tuple[float, ...] = tuple(np.round(np.arange(19) * 0.05, 12))
 
-    def replace(self, **changes) -> "StudyDefinition":
+    def replace(self, **changes) -> StudyDefinition:
         return dataclasses.replace(self, **changes)
 
     def parameter(self, key: str) -> ParameterRange:
@@ -166,8 +177,10 @@ def _columns(out: dict[str, np.ndarray], pump_speed_rad_s: float) -> dict[str, n
     mode = out["stator_mode"]
     tp, tt = out["pump_torque_nm"], out["turbine_torque_nm"]
     tr = np.where(mode == 2, 1.0, tt / np.where(tp == 0, 1.0, tp))
-    cols = {k: np.asarray(out[k], dtype=float) for k in
-            ("flow_m3_s", "pump_torque_nm", "turbine_torque_nm", "stator_torque_nm", "stator_speed_rad_s")}
+    cols = {
+        k: np.asarray(out[k], dtype=float)
+        for k in ("flow_m3_s", "pump_torque_nm", "turbine_torque_nm", "stator_torque_nm", "stator_speed_rad_s")
+    }
     cols["torque_ratio"] = np.where(mode < 0, np.nan, tr)
     cols["capacity_factor_nm_s2"] = tp / pump_speed_rad_s**2
     return cols
@@ -196,13 +209,15 @@ def run_study(converter: Converter, definition: StudyDefinition | None = None) -
         for k, v in _columns(out, wp).items():
             cols[k][ok] = v
         mode[ok] = [STATOR_MODES[int(m)] for m in out["stator_mode"]]
-    df = pd.DataFrame({
-        "parameter": np.repeat(cases["parameter"].to_numpy(), n_sr),
-        "parameter_value": np.repeat(cases["parameter_value"].to_numpy(), n_sr),
-        "speed_ratio": np.tile(sr, len(rows)),
-        **cols,
-        "stator_mode": mode,
-    })
+    df = pd.DataFrame(
+        {
+            "parameter": np.repeat(cases["parameter"].to_numpy(), n_sr),
+            "parameter_value": np.repeat(cases["parameter_value"].to_numpy(), n_sr),
+            "speed_ratio": np.tile(sr, len(rows)),
+            **cols,
+            "stator_mode": mode,
+        }
+    )
     return df[COLUMNS]
 
 
@@ -248,10 +263,13 @@ def plot_parameter(df: pd.DataFrame, p: ParameterRange, reference: float, path: 
 
 def plot_study(df: pd.DataFrame, converter: Converter, definition: StudyDefinition, out_dir: Path) -> list[Path]:
     """One PNG per parameter, ``study_<parameter>.png``, like thesis figures D.1–D.15."""
-    title = (f"{converter.name}, pump at {definition.pump_speed_rpm:g} rpm "
-             "(stator free-wheeling above the coupling point)")
-    return [plot_parameter(df, p, getattr(converter.geometry, p.key), _figure_path(out_dir, p.key), title)
-            for p in definition.parameters]
+    title = (
+        f"{converter.name}, pump at {definition.pump_speed_rpm:g} rpm (stator free-wheeling above the coupling point)"
+    )
+    return [
+        plot_parameter(df, p, getattr(converter.geometry, p.key), _figure_path(out_dir, p.key), title)
+        for p in definition.parameters
+    ]
 
 
 # --------------------------------------------------------------------------------------------
@@ -262,9 +280,11 @@ def summary(df: pd.DataFrame, definition: StudyDefinition, out: Path) -> str:
     n_values = df.groupby("parameter", sort=False)["parameter_value"].nunique().sum()
     solved = int(np.isfinite(df["torque_ratio"]).sum())
     free = int(df["stator_mode"].isin(["free-wheeling", "no-flow"]).sum())
-    return (f"study: {len(definition.parameters)} parameters, {n_values} values, {len(df)} points "
-            f"({solved} with a steady state, {free} of them past the coupling point) written to {out}/study.csv "
-            f"and {len(definition.parameters)} figures")
+    return (
+        f"study: {len(definition.parameters)} parameters, {n_values} values, {len(df)} points "
+        f"({solved} with a steady state, {free} of them past the coupling point) written to {out}/study.csv "
+        f"and {len(definition.parameters)} figures"
+    )
 
 
 def study_command(converter: str, out: str | Path, definition: StudyDefinition | None = None) -> str:

@@ -48,7 +48,12 @@ def _columns(path: Path, rows, names: list[str]):
     lines = []
     for lineno, cells in rows:
         if len(cells) != len(names):
-            raise InputError(str(path), f"line {lineno}", ",".join(cells), f"{len(names)} comma-separated values ({', '.join(names)})")
+            raise InputError(
+                str(path),
+                f"line {lineno}",
+                ",".join(cells),
+                f"{len(names)} comma-separated values ({', '.join(names)})",
+            )
         for n, c in zip(names, cells):
             cols[n].append(_number(path, lineno, n, c))
         lines.append(lineno)
@@ -64,14 +69,23 @@ def read_table_csv(path: Path) -> Characteristic:
     capacity = [h for h in header if h in CAPACITY_KEYS]
     unknown = [h for h in header if h not in CAPACITY_KEYS and h not in ("speed_ratio", "torque_ratio")]
     if unknown:
-        raise InputError(str(path), f"line {header_line} (header)", unknown[0],
-                         f"only speed_ratio, torque_ratio and one capacity column of {', '.join(CAPACITY_KEYS)}")
+        raise InputError(
+            str(path),
+            f"line {header_line} (header)",
+            unknown[0],
+            f"only speed_ratio, torque_ratio and one capacity column of {', '.join(CAPACITY_KEYS)}",
+        )
     if len(capacity) != 1:
-        raise InputError(str(path), f"line {header_line} (header)", ",".join(header),
-                         f"exactly one capacity column of {', '.join(CAPACITY_KEYS)}")
+        raise InputError(
+            str(path),
+            f"line {header_line} (header)",
+            ",".join(header),
+            f"exactly one capacity column of {', '.join(CAPACITY_KEYS)}",
+        )
     cols, lines = _columns(path, rows[1:], header)
-    table = Characteristic.from_columns(cols["speed_ratio"], cols["torque_ratio"], cols[capacity[0]], capacity[0],
-                                        str(path), rows=lines)
+    table = Characteristic.from_columns(
+        cols["speed_ratio"], cols["torque_ratio"], cols[capacity[0]], capacity[0], str(path), rows=lines
+    )
     table.warn_if_implausible()
     return table
 
@@ -86,12 +100,17 @@ def read_vtcc(path: Path) -> Characteristic:
     except ValueError:
         low = [h.lower() for h in header]
         if len(header) != 3 or "speed" not in low[0] or "torque" not in low[1]:
-            raise InputError(str(path), f"line {header_line} (header)", ",".join(header),
-                             "the VECTO header 'Speed Ratio, Torque Ratio, MP1000'") from None
+            raise InputError(
+                str(path),
+                f"line {header_line} (header)",
+                ",".join(header),
+                "the VECTO header 'Speed Ratio, Torque Ratio, MP1000'",
+            ) from None
         data = rows[1:]
     cols, lines = _columns(path, data, names)
-    table = Characteristic.from_columns(cols["speed_ratio"], cols["torque_ratio"], cols["mp1000_nm"], "mp1000_nm",
-                                        str(path), rows=lines)
+    table = Characteristic.from_columns(
+        cols["speed_ratio"], cols["torque_ratio"], cols["mp1000_nm"], "mp1000_nm", str(path), rows=lines
+    )
     table.warn_if_implausible()
     return table
 

@@ -74,5 +74,13 @@ def torus_estimate(
         inertia[name] = fluid_density_kg_m3 * flow_area_m2 * integrate(r * r)
         length += integrate(1.0 + tan * tan)
         path += a * (t1 - t0)
-    return TorusEstimate(length, shape["pump"], shape["turbine"], shape["stator"],
-                         inertia["pump"], inertia["turbine"], inertia["stator"], path)
+    return TorusEstimate(
+        length,
+        shape["pump"],
+        shape["turbine"],
+        shape["stator"],
+        inertia["pump"],
+        inertia["turbine"],
+        inertia["stator"],
+        path,
+    )

@@ -18,8 +18,9 @@ API tiers (after FMPy):
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any, Sequence, Union
+from typing import Any, Union
 
 import numpy as np
 import pandas as pd
@@ -60,7 +61,7 @@ class DynamicModel:
         """The shape effects (pump, turbine[, stator]); empty for the table model."""
         return tuple(self.spec.get("shape_effect_m2", ()))
 
-    def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> "DynamicModel":
+    def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:
         """The same model with other shape effects (eqs 2.16–2.18 sign convention)."""
         if self.name == "table":
             raise ValueError("the table model has no shape effects")
@@ -79,8 +80,11 @@ def _require(conv: Converter, section: str, model: str) -> Any:
 
 def _table_spec(conv: Converter) -> dict[str, Any]:
     c = conv.characteristic
-    return {"speed_ratio": c.speed_ratio.tolist(), "torque_ratio": c.torque_ratio.tolist(),
-            "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist()}
+    return {
+        "speed_ratio": c.speed_ratio.tolist(),
+        "torque_ratio": c.torque_ratio.tolist(),
+        "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
+    }
 
 
 def _inertia(conv: Converter, model: str) -> list[float]:
@@ -110,7 +114,7 @@ def default_flow_time_constant_s(conv: Converter) -> float:
     return g.fluid_length_m / abs(slope)
 
 
-def dynamic_model(converter: Union[Converter, str], model: str = "hrovat-tobler") -> DynamicModel:
+def dynamic_model(converter: Converter | str, model: str = "hrovat-tobler") -> DynamicModel:
     """The transient model ``model`` of a converter (a :class:`Converter`, bundled name or file).
 
     * ``table``: [characteristic] and [inertia];
@@ -126,8 +130,11 @@ def dynamic_model(converter: Union[Converter, str], model: str = "hrovat-tobler"
         spec.update(_table_spec(conv))
     elif model == "hrovat-tobler":
         g = conv.geometry
-        spec.update(geometry=conv.core_geometry()[0].tolist(), fluid_length_m=g.fluid_length_m,
-                    shape_effect_m2=[g.pump_shape_effect_m2, g.turbine_shape_effect_m2, g.stator_shape_effect_m2])
+        spec.update(
+            geometry=conv.core_geometry()[0].tolist(),
+            fluid_length_m=g.fluid_length_m,
+            shape_effect_m2=[g.pump_shape_effect_m2, g.turbine_shape_effect_m2, g.stator_shape_effect_m2],
+        )
     else:
         qd = _require(conv, "quasi_dynamic", model)
         spec.update(_table_spec(conv))
@@ -142,8 +149,12 @@ def dynamic_model(converter: Union[Converter, str], model: str = "hrovat-tobler"
     return DynamicModel(model, spec, conv.path)
 
 
-def resolve_model(converter: Union[Converter, str, "DynamicModel", None], model: Union[str, "DynamicModel"],
-                  allowed: Sequence[str] = MODELS, why: str = "") -> DynamicModel:
+def resolve_model(
+    converter: Converter | str | DynamicModel | None,
+    model: str | DynamicModel,
+    allowed: Sequence[str] = MODELS,
+    why: str = "",
+) -> DynamicModel:
     """A :class:`DynamicModel` given directly (as ``model``, or as ``converter``), or the model named
     ``model`` of ``converter`` (a :class:`Converter`, bundled name or file). A model outside
     ``allowed`` is an InputError on ``--model`` (``why`` explains the restriction)."""
@@ -183,8 +194,13 @@ class PumpTorqueTurbineSpeed:
     derivative_window_s: float = DERIVATIVE_WINDOW_S
 
     def spec(self) -> dict[str, Any]:
-        return {"kind": "pump-torque-turbine-speed", "time_s": _arr(self.time_s), "pump_torque_nm": _arr(self.pump_torque_nm),
-                "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s), "derivative_window_s": self.derivative_window_s}
+        return {
+            "kind": "pump-torque-turbine-speed",
+            "time_s": _arr(self.time_s),
+            "pump_torque_nm": _arr(self.pump_torque_nm),
+            "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
+            "derivative_window_s": self.derivative_window_s,
+        }
 
 
 @dataclass(frozen=True)
@@ -197,8 +213,13 @@ class Speeds:
     derivative_window_s: float = DERIVATIVE_WINDOW_S
 
     def spec(self) -> dict[str, Any]:
-        return {"kind": "speeds", "time_s": _arr(self.time_s), "pump_speed_rad_s": _arr(self.pump_speed_rad_s),
-                "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s), "derivative_window_s": self.derivative_window_s}
+        return {
+            "kind": "speeds",
+            "time_s": _arr(self.time_s),
+            "pump_speed_rad_s": _arr(self.pump_speed_rad_s),
+            "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
+            "derivative_window_s": self.derivative_window_s,
+        }
 
 
 @dataclass(frozen=True)
@@ -209,13 +230,18 @@ class PumpTorqueLoad:
     time_s: np.ndarray
     pump_torque_nm: np.ndarray
     load_inertia_kg_m2: float
-    load_torque_nm: Union[np.ndarray, float] = 0.0
+    load_torque_nm: np.ndarray | float = 0.0
     load_drag_nm_s2: float = 0.0
 
     def spec(self) -> dict[str, Any]:
-        return {"kind": "pump-torque-load", "time_s": _arr(self.time_s), "pump_torque_nm": _arr(self.pump_torque_nm),
-                "load_torque_nm": _arr(self.load_torque_nm), "load_inertia_kg_m2": float(self.load_inertia_kg_m2),
-                "load_drag_nm_s2": float(self.load_drag_nm_s2)}
+        return {
+            "kind": "pump-torque-load",
+            "time_s": _arr(self.time_s),
+            "pump_torque_nm": _arr(self.pump_torque_nm),
+            "load_torque_nm": _arr(self.load_torque_nm),
+            "load_inertia_kg_m2": float(self.load_inertia_kg_m2),
+            "load_drag_nm_s2": float(self.load_drag_nm_s2),
+        }
 
 
 Drive = Union[PumpTorqueTurbineSpeed, Speeds, PumpTorqueLoad]
@@ -283,13 +309,21 @@ def _initial(initial: dict[str, float] | None) -> dict[str, float] | None:
     if initial:
         bad = set(initial) - allowed
         if bad:
-            raise InputError("initial state", sorted(bad)[0], initial[sorted(bad)[0]], f"one of {', '.join(sorted(allowed))}")
+            raise InputError(
+                "initial state", sorted(bad)[0], initial[sorted(bad)[0]], f"one of {', '.join(sorted(allowed))}"
+            )
     return initial
 
 
-def simulate(converter: Union[Converter, str, DynamicModel], drive: Drive, model: str = "hrovat-tobler",
-             times_s: Sequence[float] | None = None, initial: dict[str, float] | None = None,
-             rtol: float | None = None, **solver_options) -> TransientResult:
+def simulate(
+    converter: Converter | str | DynamicModel,
+    drive: Drive,
+    model: str = "hrovat-tobler",
+    times_s: Sequence[float] | None = None,
+    initial: dict[str, float] | None = None,
+    rtol: float | None = None,
+    **solver_options,
+) -> TransientResult:
     """Run one model under one drive; samples at ``times_s`` (default: the drive's time stamps).
 
     The initial state is the steady state consistent with the first input sample (drive c: with
@@ -300,9 +334,15 @@ def simulate(converter: Union[Converter, str, DynamicModel], drive: Drive, model
     return simulate_batch([m], [drive], times_s, initial, rtol, threads=1, **solver_options)[0]
 
 
-def simulate_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], times_s: Sequence[float] | None = None,
-                   initial: dict[str, float] | None = None, rtol: float | None = None, threads: int = 0,
-                   **solver_options) -> list[TransientResult]:
+def simulate_batch(
+    models: Sequence[DynamicModel],
+    drives: Sequence[Drive],
+    times_s: Sequence[float] | None = None,
+    initial: dict[str, float] | None = None,
+    rtol: float | None = None,
+    threads: int = 0,
+    **solver_options,
+) -> list[TransientResult]:
     """Run ``models[i]`` under ``drives[i]``; a sequence of length one is broadcast. The runs go to
     the core in one call, which releases the GIL and uses ``threads`` workers (0: all cores).
     Raises :class:`InputError` or :class:`SolverError` for the first run that fails."""
@@ -313,9 +353,13 @@ def simulate_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], time
             s["output_time_s"] = np.asarray(times_s, dtype=float).tolist()
         specs.append(s)
     try:
-        raw = _core.transient_runs([m.spec for m in models], specs, _initial(initial), _options(rtol, **solver_options), threads)
+        raw = _core.transient_runs(
+            [m.spec for m in models], specs, _initial(initial), _options(rtol, **solver_options), threads
+        )
     except _core.CoreInputError as e:
         _msg, fld, value, expected = e.args
-        raise InputError(models[0].source if len(models) == 1 else "model or drive", fld, core_value(value), expected) from None
+        raise InputError(
+            models[0].source if len(models) == 1 else "model or drive", fld, core_value(value), expected
+        ) from None
     n = len(raw)
     return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None) for i, r in enumerate(raw)]

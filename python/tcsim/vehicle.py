@@ -42,15 +42,17 @@ length or order are :class:`~tcsim.errors.InputError` naming the file, the field
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
-from typing import Annotated, Any, Sequence
+from typing import Annotated, Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
-from .converter import Converter, bundled_names as bundled_converter_names, load_converter
+from .converter import Converter, load_converter
+from .converter import bundled_names as bundled_converter_names
 from .errors import InputError
 
 #: The bundled vehicle used when none is named.
@@ -302,8 +304,9 @@ def _strictly(path: str, section: str, key: str, values: Sequence[float], increa
     if bad.size:
         i = int(bad[0]) + 1
         word = "increasing" if increasing else "decreasing"
-        raise InputError(path, _name(section, key, i), float(v[i]),
-                         f"strictly {word} values (previous value {v[i - 1]:g})")
+        raise InputError(
+            path, _name(section, key, i), float(v[i]), f"strictly {word} values (previous value {v[i - 1]:g})"
+        )
 
 
 def _length(path: str, section: str, key: str, values: Sequence[float], n: int, what: str) -> None:
@@ -313,16 +316,30 @@ def _length(path: str, section: str, key: str, values: Sequence[float], n: int, 
 
 def _check_engine(e: EngineSection, path: str) -> None:
     _strictly(path, "engine", "full_load_speed_rad_s", e.full_load_speed_rad_s, increasing=True)
-    _length(path, "engine", "full_load_torque_nm", e.full_load_torque_nm, len(e.full_load_speed_rad_s),
-            "one per full_load_speed_rad_s")
+    _length(
+        path,
+        "engine",
+        "full_load_torque_nm",
+        e.full_load_torque_nm,
+        len(e.full_load_speed_rad_s),
+        "one per full_load_speed_rad_s",
+    )
     lo, hi = e.full_load_speed_rad_s[0], e.full_load_speed_rad_s[-1]
     if not lo <= e.idle_speed_rad_s < hi:
-        raise InputError(path, _name("engine", "idle_speed_rad_s"), e.idle_speed_rad_s,
-                         f"a speed within the full-load curve's speeds [{lo:g}, {hi:g}) rad/s")
+        raise InputError(
+            path,
+            _name("engine", "idle_speed_rad_s"),
+            e.idle_speed_rad_s,
+            f"a speed within the full-load curve's speeds [{lo:g}, {hi:g}) rad/s",
+        )
     available, drag = e.full_load_torque_at(e.idle_speed_rad_s), e.drag_at(e.idle_speed_rad_s)
     if available <= drag:
-        raise InputError(path, _name("engine", "full_load_torque_nm"), f"{available:g} N·m at idle",
-                         f"more than the drag torque at idle ({drag:g} N·m), or the engine cannot hold idle")
+        raise InputError(
+            path,
+            _name("engine", "full_load_torque_nm"),
+            f"{available:g} N·m at idle",
+            f"more than the drag torque at idle ({drag:g} N·m), or the engine cannot hold idle",
+        )
 
 
 def _check_gearbox(g: GearboxSection, path: str) -> None:
@@ -330,19 +347,27 @@ def _check_gearbox(g: GearboxSection, path: str) -> None:
     _strictly(path, "gearbox", "ratios", g.ratios, increasing=False)
     for key in ("efficiencies", "input_inertia_kg_m2"):
         _length(path, "gearbox", key, getattr(g, key), n, f"one per gear: ratios has {n}")
-    pairs = (("upshift_speed_zero_pedal_m_s", "downshift_speed_zero_pedal_m_s"),
-             ("upshift_speed_full_pedal_m_s", "downshift_speed_full_pedal_m_s"))
+    pairs = (
+        ("upshift_speed_zero_pedal_m_s", "downshift_speed_zero_pedal_m_s"),
+        ("upshift_speed_full_pedal_m_s", "downshift_speed_full_pedal_m_s"),
+    )
     for up_key, down_key in pairs:
         for key in (up_key, down_key):
-            what = f"gears − 1 = {n - 1}: {'upshift from' if key.startswith('up') else 'downshift into'} gears 1..{n - 1}"
+            what = (
+                f"gears − 1 = {n - 1}: {'upshift from' if key.startswith('up') else 'downshift into'} gears 1..{n - 1}"
+            )
             _length(path, "gearbox", key, getattr(g, key), n - 1, what)
             _strictly(path, "gearbox", key, getattr(g, key), increasing=True)
         up, down = getattr(g, up_key), getattr(g, down_key)
         for k, (u, d) in enumerate(zip(up, down)):
             if d >= u:
-                raise InputError(path, _name("gearbox", down_key, k), d,
-                                 f"a speed below {up_key}[{k}] = {u:g} m/s (downshift {k + 2}→{k + 1} below "
-                                 f"upshift {k + 1}→{k + 2}, or the gearbox hunts)")
+                raise InputError(
+                    path,
+                    _name("gearbox", down_key, k),
+                    d,
+                    f"a speed below {up_key}[{k}] = {u:g} m/s (downshift {k + 2}→{k + 1} below "
+                    f"upshift {k + 1}→{k + 2}, or the gearbox hunts)",
+                )
 
 
 def _check_lockup(lu: LockupSection, gears: int, path: str) -> None:
@@ -363,9 +388,13 @@ def _load_named_converter(spec: str, path: str) -> Converter:
     base = Path(path).parent
     candidate = Path(spec) if Path(spec).is_absolute() else base / spec
     if not candidate.is_file() or candidate.suffix.lower() != ".toml":
-        raise InputError(path, "converter", spec,
-                         f"a bundled converter ({', '.join(bundled_converter_names())}) or a converter .toml file "
-                         f"relative to the vehicle file ({candidate} does not exist or is not .toml)")
+        raise InputError(
+            path,
+            "converter",
+            spec,
+            f"a bundled converter ({', '.join(bundled_converter_names())}) or a converter .toml file "
+            f"relative to the vehicle file ({candidate} does not exist or is not .toml)",
+        )
     return load_converter(candidate)
 
 
@@ -380,8 +409,22 @@ def parse_vehicle(data: dict[str, Any], path: str) -> Vehicle:
     _check_lockup(doc.lockup, doc.gearbox.gears, path)
     _check_sources(doc, path)
     conv = _load_named_converter(doc.converter, path)
-    return Vehicle(doc.name, doc.source, path, conv, doc.engine, doc.gearbox, doc.lockup, doc.driveline, doc.tyres,
-                   doc.body, doc.brake, doc.description, doc.converter, dict(doc.sources))
+    return Vehicle(
+        doc.name,
+        doc.source,
+        path,
+        conv,
+        doc.engine,
+        doc.gearbox,
+        doc.lockup,
+        doc.driveline,
+        doc.tyres,
+        doc.body,
+        doc.brake,
+        doc.description,
+        doc.converter,
+        dict(doc.sources),
+    )
 
 
 def read_vehicle_toml(path: Path) -> Vehicle:
@@ -415,6 +458,10 @@ def load_vehicle(spec: str | Path | None = None) -> Vehicle:
             return read_vehicle_toml(Path(p))
     path = Path(spec)
     if path.suffix.lower() != ".toml" or not path.is_file():
-        raise InputError(text, "vehicle", text,
-                         f"a bundled vehicle ({', '.join(bundled_vehicle_names())}) or an existing vehicle .toml file")
+        raise InputError(
+            text,
+            "vehicle",
+            text,
+            f"a bundled vehicle ({', '.join(bundled_vehicle_names())}) or an existing vehicle .toml file",
+        )
     return read_vehicle_toml(path)

@@ -20,8 +20,21 @@ C1 = pd.DataFrame(
     {
         "speed_ratio": [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
         "torque_ratio": [2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
-        "capacity_factor_nm_s2": [3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3,
-                                  2.713e-3, 2.481e-3, 2.370e-3, 1.842e-3, 1.237e-3, 0.187e-3],
+        "capacity_factor_nm_s2": [
+            3.272e-3,
+            3.257e-3,
+            3.228e-3,
+            3.181e-3,
+            3.112e-3,
+            3.017e-3,
+            2.887e-3,
+            2.713e-3,
+            2.481e-3,
+            2.370e-3,
+            1.842e-3,
+            1.237e-3,
+            0.187e-3,
+        ],
     }
 )
 
@@ -80,9 +93,13 @@ def fit(out: Path, data: Path) -> Frames:
     C1.to_csv(target, index=False)
     _run("fit", "li-sunden-2016", "--target", target, "--out", out)
     fitted = tomllib.loads((out / "fitted.toml").read_text())
-    rows = [(f"{section}.{key}", float(value)) for section, table in sorted(fitted.items())
-            if isinstance(table, dict) for key, value in sorted(table.items())
-            if isinstance(value, (int, float)) and not isinstance(value, bool)]
+    rows = [
+        (f"{section}.{key}", float(value))
+        for section, table in sorted(fitted.items())
+        if isinstance(table, dict)
+        for key, value in sorted(table.items())
+        if isinstance(value, (int, float)) and not isinstance(value, bool)
+    ]
     return {"fitted.csv": pd.DataFrame(rows, columns=["parameter", "value"])}
 
 

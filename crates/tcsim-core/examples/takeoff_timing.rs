@@ -9,9 +9,16 @@ use tcsim_core::signal::Signal;
 use tcsim_core::transient::{simulate, Drive, InitialState, SolverOptions, TurbineLoad};
 
 fn main() {
-    let model = HtDynamics::new(HtGeometry::appendix_d(), Inertias::new(0.109, 0.056, 0.01).unwrap(), 0.2914, [-0.00569, 0.00134, 0.0009]).unwrap();
+    let model = HtDynamics::new(
+        HtGeometry::appendix_d(),
+        Inertias::new(0.109, 0.056, 0.01).unwrap(),
+        0.2914,
+        [-0.00569, 0.00134, 0.0009],
+    )
+    .unwrap();
     let drive = Drive::PumpTorqueLoad {
-        pump_torque_nm: Signal::new("pump_torque_nm", vec![0.0, 0.1, 0.3, 10.0], vec![40.0, 40.0, 250.0, 250.0], 0.0).unwrap(),
+        pump_torque_nm: Signal::new("pump_torque_nm", vec![0.0, 0.1, 0.3, 10.0], vec![40.0, 40.0, 250.0, 250.0], 0.0)
+            .unwrap(),
         load: TurbineLoad { torque_nm: Signal::constant(10.0), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 },
     };
     let t: Vec<f64> = (0..=1000).map(|i| i as f64 * 0.01).collect();

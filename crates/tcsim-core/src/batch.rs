@@ -22,7 +22,14 @@ pub struct HtSteadyColumns {
 impl HtSteadyColumns {
     fn with_capacity(n: usize) -> Self {
         let v = || Vec::with_capacity(n);
-        Self { flow_m3_s: v(), stator_speed_rad_s: v(), pump_torque_nm: v(), turbine_torque_nm: v(), stator_torque_nm: v(), stator_mode: Vec::with_capacity(n) }
+        Self {
+            flow_m3_s: v(),
+            stator_speed_rad_s: v(),
+            pump_torque_nm: v(),
+            turbine_torque_nm: v(),
+            stator_torque_nm: v(),
+            stator_mode: Vec::with_capacity(n),
+        }
     }
 }
 
@@ -43,7 +50,10 @@ pub fn ht_steady_states(
     strict: bool,
 ) -> Result<HtSteadyColumns, PointError> {
     let n = pump_speed_rad_s.len();
-    assert!(turbine_speed_rad_s.len() == n && (geometry.len() == 1 || geometry.len() == n), "batch shapes are checked by the caller");
+    assert!(
+        turbine_speed_rad_s.len() == n && (geometry.len() == 1 || geometry.len() == n),
+        "batch shapes are checked by the caller"
+    );
     let mut out = HtSteadyColumns::with_capacity(n);
     for i in 0..n {
         let g = &geometry[if geometry.len() == 1 { 0 } else { i }];
@@ -58,7 +68,13 @@ pub fn ht_steady_states(
             }
             Err(error) if strict => return Err(PointError { index: i, error }),
             Err(_) => {
-                for col in [&mut out.flow_m3_s, &mut out.stator_speed_rad_s, &mut out.pump_torque_nm, &mut out.turbine_torque_nm, &mut out.stator_torque_nm] {
+                for col in [
+                    &mut out.flow_m3_s,
+                    &mut out.stator_speed_rad_s,
+                    &mut out.pump_torque_nm,
+                    &mut out.turbine_torque_nm,
+                    &mut out.stator_torque_nm,
+                ] {
                     col.push(f64::NAN);
                 }
                 out.stator_mode.push(-1);
@@ -89,7 +105,8 @@ pub fn ht_ratio_gradients(
     for (i, &sr) in speed_ratio.iter().enumerate() {
         let wt = Dual::cst(sr * pump_speed_rad_s);
         // one forward pass per free parameter; without free parameters, one plain pass
-        let seeds: Vec<HtGeometry<Dual>> = if k == 0 { vec![geometry.to_dual()] } else { free.iter().map(|&p| geometry.seeded(p)).collect() };
+        let seeds: Vec<HtGeometry<Dual>> =
+            if k == 0 { vec![geometry.to_dual()] } else { free.iter().map(|&p| geometry.seeded(p)).collect() };
         for (j, g) in seeds.iter().enumerate() {
             let Ok(s) = steady_state(g, wp, wt) else { break };
             let (t, c) = (s.torque_ratio(), s.pump_torque_nm);
@@ -136,7 +153,13 @@ mod tests {
             let (tr2, cf2, _, _) = ht_ratio_gradients(&HtGeometry { values: v }, 209.4, &sr, &[]);
             for i in 0..sr.len() {
                 let (fd_tr, fd_cf) = ((tr2[i] - tr[i]) / h, (cf2[i] - cf[i]) / h);
-                assert!((dtr[i * 3 + j] - fd_tr).abs() < 1e-5 * (1.0 + fd_tr.abs()), "{} SR {}: {} vs {fd_tr}", p.key(), sr[i], dtr[i * 3 + j]);
+                assert!(
+                    (dtr[i * 3 + j] - fd_tr).abs() < 1e-5 * (1.0 + fd_tr.abs()),
+                    "{} SR {}: {} vs {fd_tr}",
+                    p.key(),
+                    sr[i],
+                    dtr[i * 3 + j]
+                );
                 assert!((dcf[i * 3 + j] - fd_cf).abs() < 1e-5 * (1e-3 + fd_cf.abs()), "{} SR {}", p.key(), sr[i]);
             }
         }
@@ -159,10 +182,20 @@ pub struct TransientJob {
 pub type RunOutput = (Vec<Vec<f64>>, Vec<crate::transient::Event>);
 
 /// Run `f`, turning a panic into a solver error instead of unwinding.
-pub fn catch_panic<T>(f: impl FnOnce() -> crate::transient::TransientResult<T>) -> crate::transient::TransientResult<T> {
+pub fn catch_panic<T>(
+    f: impl FnOnce() -> crate::transient::TransientResult<T>,
+) -> crate::transient::TransientResult<T> {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
-        let msg = payload.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| payload.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into());
-        Err(crate::transient::TransientError::Solver { time_s: f64::NAN, state: vec![], message: format!("internal error: {msg}") })
+        let msg = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(crate::transient::TransientError::Solver {
+            time_s: f64::NAN,
+            state: vec![],
+            message: format!("internal error: {msg}"),
+        })
     })
 }
 
@@ -178,7 +211,9 @@ pub fn run_transient_job(job: &TransientJob) -> crate::transient::TransientResul
 pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J) -> R + Sync) -> Vec<R> {
     use std::sync::atomic::{AtomicUsize, Ordering};
     use std::sync::Mutex;
-    let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }.min(jobs.len()).max(1);
+    let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }
+        .min(jobs.len())
+        .max(1);
     if threads == 1 {
         return jobs.iter().map(&f).collect();
     }

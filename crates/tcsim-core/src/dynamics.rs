@@ -92,7 +92,11 @@ pub struct Inertias {
 
 impl Inertias {
     pub fn new(pump_kg_m2: f64, turbine_kg_m2: f64, stator_kg_m2: f64) -> CoreResult<Self> {
-        for (name, v) in [("inertia.pump_kg_m2", pump_kg_m2), ("inertia.turbine_kg_m2", turbine_kg_m2), ("inertia.stator_kg_m2", stator_kg_m2)] {
+        for (name, v) in [
+            ("inertia.pump_kg_m2", pump_kg_m2),
+            ("inertia.turbine_kg_m2", turbine_kg_m2),
+            ("inertia.stator_kg_m2", stator_kg_m2),
+        ] {
             if !(v.is_finite() && v > 0.0) {
                 return Err(CoreError::new(name, v, "a finite, positive inertia in kg·m²"));
             }
@@ -109,7 +113,11 @@ pub fn sig(x: f64) -> String {
     let digits = 5 - x.abs().log10().floor() as i32;
     if (-5..=15).contains(&digits) {
         let s = format!("{:.*}", digits.max(0) as usize, x);
-        if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.').to_string() } else { s }
+        if s.contains('.') {
+            s.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            s
+        }
     } else {
         format!("{x:.5e}")
     }
@@ -147,8 +155,14 @@ fn table_torques(c: &Characteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [
     let w2 = signed_square(wp);
     let tp = l.capacity_factor_nm_s2 * w2;
     let tt = l.torque_ratio * tp;
-    let dtp = [l.d_capacity_factor * dsr_dwp * w2 + l.capacity_factor_nm_s2 * 2.0 * wp.abs(), l.d_capacity_factor * dsr_dwt * w2];
-    let dtt = [l.d_torque_ratio * dsr_dwp * tp + l.torque_ratio * dtp[0], l.d_torque_ratio * dsr_dwt * tp + l.torque_ratio * dtp[1]];
+    let dtp = [
+        l.d_capacity_factor * dsr_dwp * w2 + l.capacity_factor_nm_s2 * 2.0 * wp.abs(),
+        l.d_capacity_factor * dsr_dwt * w2,
+    ];
+    let dtt = [
+        l.d_torque_ratio * dsr_dwp * tp + l.torque_ratio * dtp[0],
+        l.d_torque_ratio * dsr_dwt * tp + l.torque_ratio * dtp[1],
+    ];
     (tp, tt, dtp, dtt)
 }
 
@@ -224,7 +238,10 @@ impl QuasiDynamics {
                 return Err(CoreError::new(name, v, expected));
             }
         }
-        for (name, v) in [("quasi_dynamic.pump_shape_effect_m2", self.pump_shape_effect_m2), ("quasi_dynamic.turbine_shape_effect_m2", self.turbine_shape_effect_m2)] {
+        for (name, v) in [
+            ("quasi_dynamic.pump_shape_effect_m2", self.pump_shape_effect_m2),
+            ("quasi_dynamic.turbine_shape_effect_m2", self.turbine_shape_effect_m2),
+        ] {
             if !v.is_finite() {
                 return Err(CoreError::new(name, v, "a finite shape effect in m²"));
             }
@@ -242,7 +259,10 @@ impl QuasiDynamics {
         let l = self.characteristic.lookup(sr);
         let k = self.flow_scale();
         let q = k * l.capacity_factor_nm_s2 * wp.abs();
-        let dq = [k * (l.d_capacity_factor * dsr_dwp * wp.abs() + l.capacity_factor_nm_s2 * wp.signum()), k * l.d_capacity_factor * dsr_dwt * wp.abs()];
+        let dq = [
+            k * (l.d_capacity_factor * dsr_dwp * wp.abs() + l.capacity_factor_nm_s2 * wp.signum()),
+            k * l.d_capacity_factor * dsr_dwt * wp.abs(),
+        ];
         (q, dq)
     }
 }
@@ -312,7 +332,8 @@ pub struct HtDynamics {
     k: HtConst,
 }
 
-const SHAPE_KEYS: [&str; 3] = ["geometry.pump_shape_effect_m2", "geometry.turbine_shape_effect_m2", "geometry.stator_shape_effect_m2"];
+const SHAPE_KEYS: [&str; 3] =
+    ["geometry.pump_shape_effect_m2", "geometry.turbine_shape_effect_m2", "geometry.stator_shape_effect_m2"];
 
 /// Constants of eqs 2.12–2.25 for fast evaluation.
 #[derive(Debug, Clone)]
@@ -332,9 +353,18 @@ struct HtConst {
 impl HtDynamics {
     /// Check the parameters and the positive definiteness of the mass matrix (physics notes §4).
     /// An inadmissible shape effect is refused with the largest admissible magnitude.
-    pub fn new(geometry: HtGeometry<f64>, inertia: Inertias, fluid_length_m: f64, shape_effect_m2: [f64; 3]) -> CoreResult<Self> {
+    pub fn new(
+        geometry: HtGeometry<f64>,
+        inertia: Inertias,
+        fluid_length_m: f64,
+        shape_effect_m2: [f64; 3],
+    ) -> CoreResult<Self> {
         if !(fluid_length_m.is_finite() && fluid_length_m > 0.0) {
-            return Err(CoreError::new("geometry.fluid_length_m", fluid_length_m, "a finite, positive fluid length in m"));
+            return Err(CoreError::new(
+                "geometry.fluid_length_m",
+                fluid_length_m,
+                "a finite, positive fluid length in m",
+            ));
         }
         for (k, s) in SHAPE_KEYS.iter().zip(shape_effect_m2) {
             if !s.is_finite() {
@@ -414,11 +444,7 @@ impl HtDynamics {
 
 /// Shock velocities of eqs 2.20–2.22 at speeds ω and q = Q/A.
 fn shock_velocities(k: &HtConst, w: &[f64; 3], q: f64) -> [f64; 3] {
-    [
-        k.r[2] * (w[2] - w[0]) + q * k.b[0],
-        k.r[0] * (w[0] - w[1]) + q * k.b[1],
-        k.r[1] * (w[1] - w[2]) + q * k.b[2],
-    ]
+    [k.r[2] * (w[2] - w[0]) + q * k.b[0], k.r[0] * (w[0] - w[1]) + q * k.b[1], k.r[1] * (w[1] - w[2]) + q * k.b[2]]
 }
 
 impl ConverterDynamics for HtDynamics {
@@ -457,7 +483,8 @@ impl ConverterDynamics for HtDynamics {
         let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
         let linear = q * (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]);
         let v = shock_velocities(k, &w, q);
-        let loss = sigma * 0.5 * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2] + k.friction * q * q);
+        let loss =
+            sigma * 0.5 * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2] + k.friction * q * q);
         [
             -k.rho * (h[0] - h[2]) * flow,
             -k.rho * (h[1] - h[0]) * flow,
@@ -498,7 +525,8 @@ impl ConverterDynamics for HtDynamics {
         for i in 0..3 {
             j[FLOW][i] = rho * (dhead[i] + q * a[i] - dloss[i]);
         }
-        let dloss_dq = sigma * (k.c[0] * v[0] * k.b[0] + k.c[1] * v[1] * k.b[1] + k.c[2] * v[2] * k.b[2] + k.friction * q);
+        let dloss_dq =
+            sigma * (k.c[0] * v[0] * k.b[0] + k.c[1] * v[1] * k.b[1] + k.c[2] * v[2] * k.b[2] + k.friction * q);
         j[FLOW][FLOW] = rho * ((w[0] * a[0] + w[1] * a[1] + w[2] * a[2]) - dloss_dq) / area;
         j
     }
@@ -524,7 +552,10 @@ mod tests {
         Characteristic::new(
             vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
             vec![2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
-            vec![3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3, 1.842e-3, 1.237e-3, 0.187e-3],
+            vec![
+                3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3,
+                1.842e-3, 1.237e-3, 0.187e-3,
+            ],
         )
         .unwrap()
     }
@@ -561,7 +592,11 @@ mod tests {
             for r in (0..4).filter(|&r| present[r]) {
                 let fd = (fp[r] - fm[r]) / (2.0 * h);
                 let scale = m.forces(&u, sigma).iter().map(|x| x.abs()).fold(1e-3, f64::max) / u[c].abs().max(1e-6);
-                assert!((fd - j[r][c]).abs() <= 1e-6 * scale + 1e-6 * fd.abs(), "row {r} col {c} sigma {sigma}: analytic {} fd {fd}", j[r][c]);
+                assert!(
+                    (fd - j[r][c]).abs() <= 1e-6 * scale + 1e-6 * fd.abs(),
+                    "row {r} col {c} sigma {sigma}: analytic {} fd {fd}",
+                    j[r][c]
+                );
             }
         }
     }
@@ -569,7 +604,9 @@ mod tests {
     #[test]
     fn analytic_jacobians_match_finite_differences() {
         let h = ht([-0.00569, 0.00134, 0.0009]);
-        for u in [[200.0, 0.0, 0.0, 0.12], [210.0, 150.0, 20.0, 0.05], [150.0, 170.0, 60.0, -0.03], [100.0, 40.0, 0.0, 0.0]] {
+        for u in
+            [[200.0, 0.0, 0.0, 0.12], [210.0, 150.0, 20.0, 0.05], [150.0, 170.0, 60.0, -0.03], [100.0, 40.0, 0.0, 0.0]]
+        {
             for sigma in [1.0, -1.0, 0.0] {
                 check_jacobian(&h, u, sigma);
             }
@@ -594,8 +631,10 @@ mod tests {
             let vt = g.get(PumpExitRadius) * (u[0] - u[1]) + q * (t(PumpExitAngle) - t(TurbineInletAngle));
             let vs = g.get(TurbineExitRadius) * (u[1] - u[2]) + q * (t(TurbineExitAngle) - t(StatorInletAngle));
             let rho = g.get(FluidDensity);
-            let vre2: f64 = [PumpExitAngle, TurbineExitAngle, StatorExitAngle].iter().map(|&a| q * q * (1.0 + t(a).powi(2))).sum();
-            let ploss = sigma * rho / 2.0 * (vp * vp + vt * vt + vs * vs) + sigma * rho * g.get(FrictionLoss) / 2.0 * vre2;
+            let vre2: f64 =
+                [PumpExitAngle, TurbineExitAngle, StatorExitAngle].iter().map(|&a| q * q * (1.0 + t(a).powi(2))).sum();
+            let ploss =
+                sigma * rho / 2.0 * (vp * vp + vt * vt + vs * vs) + sigma * rho * g.get(FrictionLoss) / 2.0 * vre2;
             let lp = h.loss_power_w(&u, &h.forces(&u, sigma));
             assert!((lp - u[3] * ploss).abs() <= 1e-10 * lp.abs(), "{lp} vs {}", u[3] * ploss);
             assert!(lp > 0.0);
@@ -658,7 +697,13 @@ pub fn build_model(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics
     let kind = spec.kind()?;
     let i = numbers(spec, "inertia_kg_m2", Some(3))?;
     let inertia = Inertias::new(i[0], i[1], i[2])?;
-    let table = || -> CoreResult<Characteristic> { Characteristic::new(numbers(spec, "speed_ratio", None)?, numbers(spec, "torque_ratio", None)?, numbers(spec, "capacity_factor_nm_s2", None)?) };
+    let table = || -> CoreResult<Characteristic> {
+        Characteristic::new(
+            numbers(spec, "speed_ratio", None)?,
+            numbers(spec, "torque_ratio", None)?,
+            numbers(spec, "capacity_factor_nm_s2", None)?,
+        )
+    };
     Ok(match kind.as_str() {
         "table" => Box::new(TableDynamics { characteristic: table()?, inertia }),
         "quasi-dynamic" => {
@@ -680,7 +725,12 @@ pub fn build_model(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics
             let mut values = [0.0; crate::hrovat_tobler::N_PARAMS];
             values.copy_from_slice(&g);
             let shape = numbers(spec, "shape_effect_m2", Some(3))?;
-            Box::new(HtDynamics::new(HtGeometry::new(values)?, inertia, number(spec, "fluid_length_m")?, [shape[0], shape[1], shape[2]])?)
+            Box::new(HtDynamics::new(
+                HtGeometry::new(values)?,
+                inertia,
+                number(spec, "fluid_length_m")?,
+                [shape[0], shape[1], shape[2]],
+            )?)
         }
         other => return Err(CoreError::new("kind", other, "table, quasi-dynamic or hrovat-tobler")),
     })

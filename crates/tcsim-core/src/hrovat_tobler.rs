@@ -120,7 +120,10 @@ impl HtGeometry<f64> {
             let v = values[p.index()];
             let ok = if p.is_angle() {
                 v.is_finite() && v.abs() < std::f64::consts::FRAC_PI_2
-            } else if matches!(p, HtParam::PumpShockLoss | HtParam::TurbineShockLoss | HtParam::StatorShockLoss | HtParam::FrictionLoss) {
+            } else if matches!(
+                p,
+                HtParam::PumpShockLoss | HtParam::TurbineShockLoss | HtParam::StatorShockLoss | HtParam::FrictionLoss
+            ) {
                 v.is_finite() && v >= 0.0
             } else {
                 v.is_finite() && v > 0.0
@@ -151,7 +154,24 @@ impl HtGeometry<f64> {
     /// Appendix D reference values (Li & Sundén 2016, Table D.1).
     pub fn appendix_d() -> Self {
         let d = |deg: f64| deg.to_radians();
-        Self::new([0.01, 840.0, 0.12, 0.065, 0.06, d(-20.0), d(-50.0), d(60.0), d(-50.0), d(55.0), d(15.0), 1.0, 1.0, 1.0, 0.2]).unwrap()
+        Self::new([
+            0.01,
+            840.0,
+            0.12,
+            0.065,
+            0.06,
+            d(-20.0),
+            d(-50.0),
+            d(60.0),
+            d(-50.0),
+            d(55.0),
+            d(15.0),
+            1.0,
+            1.0,
+            1.0,
+            0.2,
+        ])
+        .unwrap()
     }
 
     /// Seed parameter `p` for a derivative.
@@ -174,8 +194,12 @@ impl HtGeometry<f64> {
             t(HtParam::PumpExitAngle) - t(HtParam::TurbineInletAngle),
             t(HtParam::TurbineExitAngle) - t(HtParam::StatorInletAngle),
         ];
-        let c = [self.get(HtParam::PumpShockLoss), self.get(HtParam::TurbineShockLoss), self.get(HtParam::StatorShockLoss)];
-        let friction = 3.0 + t(HtParam::PumpExitAngle).powi(2) + t(HtParam::TurbineExitAngle).powi(2) + t(HtParam::StatorExitAngle).powi(2);
+        let c =
+            [self.get(HtParam::PumpShockLoss), self.get(HtParam::TurbineShockLoss), self.get(HtParam::StatorShockLoss)];
+        let friction = 3.0
+            + t(HtParam::PumpExitAngle).powi(2)
+            + t(HtParam::TurbineExitAngle).powi(2)
+            + t(HtParam::StatorExitAngle).powi(2);
         c.iter().zip(b).map(|(c, b)| c * b * b).sum::<f64>() + self.get(HtParam::FrictionLoss) * friction
     }
 }
@@ -279,7 +303,8 @@ struct Balance<T> {
 
 fn tangents<T: Scalar>(g: &HtGeometry<T>) -> [T; 6] {
     use HtParam::*;
-    [PumpExitAngle, TurbineExitAngle, StatorExitAngle, PumpInletAngle, TurbineInletAngle, StatorInletAngle].map(|p| g.get(p).tan())
+    [PumpExitAngle, TurbineExitAngle, StatorExitAngle, PumpInletAngle, TurbineInletAngle, StatorInletAngle]
+        .map(|p| g.get(p).tan())
 }
 
 fn balance<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
@@ -293,9 +318,8 @@ fn balance<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, stator_speed: Quad<T>) ->
     let head0 = Quad::cst(rp * rp * wp * wp + rt * rt * wt * wt - rp * rp * wt * wp)
         .add(ws.mul_affine(ws).times(rs * rs))
         .sub(ws.times(rs * rs * wp + rt * rt * wt));
-    let head1 = q.mul_affine(
-        Quad::cst(wp * (rp * tp - rs * ts) + wt * (rt * tt - rp * tp)).add(ws.times(rs * ts - rt * tt)),
-    );
+    let head1 =
+        q.mul_affine(Quad::cst(wp * (rp * tp - rs * ts) + wt * (rt * tt - rp * tp)).add(ws.times(rs * ts - rt * tt)));
     // shock velocities, eqs 2.20–2.22
     let sh_p = ws.sub(cwp).times(rs).add(q.times(ts - tpp));
     let sh_t = cwp.sub(cwt).times(rp).add(q.times(tp - ttt));
@@ -357,7 +381,11 @@ fn solve_mode<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, mode: StatorMode) -> O
 }
 
 /// Steady state with the stator held (ω_s = 0), whatever the sign of the holding torque.
-pub fn locked_steady_state<T: Scalar>(g: &HtGeometry<T>, pump_speed_rad_s: T, turbine_speed_rad_s: T) -> Option<HtSteadyState<T>> {
+pub fn locked_steady_state<T: Scalar>(
+    g: &HtGeometry<T>,
+    pump_speed_rad_s: T,
+    turbine_speed_rad_s: T,
+) -> Option<HtSteadyState<T>> {
     solve_mode(g, pump_speed_rad_s, turbine_speed_rad_s, StatorMode::Locked)
 }
 
@@ -378,7 +406,11 @@ fn check_operating_point(wp: f64, wt: f64) -> CoreResult<()> {
 
 /// Steady state with the one-way clutch: locked while it holds (T_s ≥ 0), free-wheeling past the
 /// coupling point, no flow where the free-wheeling quadratic has no positive root.
-pub fn steady_state<T: Scalar>(g: &HtGeometry<T>, pump_speed_rad_s: T, turbine_speed_rad_s: T) -> CoreResult<HtSteadyState<T>> {
+pub fn steady_state<T: Scalar>(
+    g: &HtGeometry<T>,
+    pump_speed_rad_s: T,
+    turbine_speed_rad_s: T,
+) -> CoreResult<HtSteadyState<T>> {
     let (wp, wt) = (pump_speed_rad_s, turbine_speed_rad_s);
     check_operating_point(wp.re(), wt.re())?;
     let locked = locked_steady_state(g, wp, wt).ok_or_else(|| {
@@ -454,14 +486,19 @@ mod tests {
         let (rp, rt, rs) = (v(PumpExitRadius), v(TurbineExitRadius), v(StatorExitRadius));
         let (tp, tt, ts) = (v(PumpExitAngle).tan(), v(TurbineExitAngle).tan(), v(StatorExitAngle).tan());
         let (tpp, ttt, tss) = (v(PumpInletAngle).tan(), v(TurbineInletAngle).tan(), v(StatorInletAngle).tan());
-        let head = rho * (rp * rp * wp * wp + rt * rt * wt * wt + rs * rs * ws * ws - rs * rs * wp * ws - rp * rp * wt * wp - rt * rt * ws * wt)
+        let head = rho
+            * (rp * rp * wp * wp + rt * rt * wt * wt + rs * rs * ws * ws
+                - rs * rs * wp * ws
+                - rp * rp * wt * wp
+                - rt * rt * ws * wt)
             + wp * rho * (rp * tp - rs * ts) * q
             + wt * rho * (rt * tt - rp * tp) * q
             + ws * rho * (rs * ts - rt * tt) * q;
         let vsh = [rs * (ws - wp) + q * (ts - tpp), rp * (wp - wt) + q * (tp - ttt), rt * (wt - ws) + q * (tt - tss)];
         let c = [v(PumpShockLoss), v(TurbineShockLoss), v(StatorShockLoss)];
         let vre2: f64 = [tp, tt, ts].iter().map(|t| q * q * (1.0 + t * t)).sum();
-        let ploss = rho / 2.0 * (0..3).map(|i| c[i] * vsh[i] * vsh[i]).sum::<f64>() + rho * v(FrictionLoss) / 2.0 * vre2;
+        let ploss =
+            rho / 2.0 * (0..3).map(|i| c[i] * vsh[i] * vsh[i]).sum::<f64>() + rho * v(FrictionLoss) / 2.0 * vre2;
         head - ploss
     }
 
@@ -523,7 +560,8 @@ mod tests {
             assert!(s.stator_speed_rad_s > 0.0 && s.flow_m3_s > 0.0);
         }
         // the free-wheeling branch starts from the locked solution: continuous flow and torque
-        let (l, f) = (locked_steady_state(&g, WP, sr_c * WP).unwrap(), steady_state(&g, WP, (sr_c + 1e-9) * WP).unwrap());
+        let (l, f) =
+            (locked_steady_state(&g, WP, sr_c * WP).unwrap(), steady_state(&g, WP, (sr_c + 1e-9) * WP).unwrap());
         assert!((l.flow_m3_s - f.flow_m3_s).abs() < 1e-7 && f.stator_speed_rad_s.abs() < 1e-4);
     }
 
@@ -575,8 +613,12 @@ mod tests {
     #[test]
     fn analytic_derivatives_match_finite_differences() {
         let g = HtGeometry::appendix_d();
-        let outputs = |s: &HtSteadyState<Dual>| [s.flow_m3_s, s.pump_torque_nm, s.turbine_torque_nm, s.stator_torque_nm, s.stator_speed_rad_s];
-        let outputs_f = |s: &HtSteadyState<f64>| [s.flow_m3_s, s.pump_torque_nm, s.turbine_torque_nm, s.stator_torque_nm, s.stator_speed_rad_s];
+        let outputs = |s: &HtSteadyState<Dual>| {
+            [s.flow_m3_s, s.pump_torque_nm, s.turbine_torque_nm, s.stator_torque_nm, s.stator_speed_rad_s]
+        };
+        let outputs_f = |s: &HtSteadyState<f64>| {
+            [s.flow_m3_s, s.pump_torque_nm, s.turbine_torque_nm, s.stator_torque_nm, s.stator_speed_rad_s]
+        };
         for sr in [0.0, 0.3, 0.75, 0.95] {
             let wt = sr * WP;
             for p in HtParam::ALL {
@@ -590,7 +632,9 @@ mod tests {
                 };
                 let (a, b) = (eval(-h), eval(h));
                 assert_eq!(a.mode, b.mode);
-                for (k, (o, (fa, fb))) in outputs(&ad).iter().zip(outputs_f(&a).iter().zip(outputs_f(&b).iter())).enumerate() {
+                for (k, (o, (fa, fb))) in
+                    outputs(&ad).iter().zip(outputs_f(&a).iter().zip(outputs_f(&b).iter())).enumerate()
+                {
                     let fd = (fb - fa) / (2.0 * h);
                     let tol = 1e-6 * (fd.abs() + o.v.abs() / x.abs().max(1e-2));
                     assert!((o.d - fd).abs() <= tol, "SR {sr}, {}, output {k}: {} vs {fd}", p.key(), o.d);
@@ -600,14 +644,24 @@ mod tests {
                 let (dp, dt) = if which == 0 { (Dual::var(WP), Dual::cst(wt)) } else { (Dual::cst(WP), Dual::var(wt)) };
                 let ad = steady_state(&g.to_dual(), dp, dt).unwrap();
                 let h = 1e-4;
-                let eval = |d: f64| if which == 0 { steady_state(&g, WP + d, wt).unwrap() } else { steady_state(&g, WP, wt + d).unwrap() };
+                let eval = |d: f64| {
+                    if which == 0 {
+                        steady_state(&g, WP + d, wt).unwrap()
+                    } else {
+                        steady_state(&g, WP, wt + d).unwrap()
+                    }
+                };
                 if sr == 0.0 && which == 1 {
                     continue; // SR < 0 is out of range: one-sided at stall, checked below
                 }
                 let (a, b) = (eval(-h), eval(h));
                 for (o, (fa, fb)) in outputs(&ad).iter().zip(outputs_f(&a).iter().zip(outputs_f(&b).iter())) {
                     let fd = (fb - fa) / (2.0 * h);
-                    assert!((o.d - fd).abs() <= 1e-6 * (fd.abs() + o.v.abs() / WP), "SR {sr}, speed {which}: {} vs {fd}", o.d);
+                    assert!(
+                        (o.d - fd).abs() <= 1e-6 * (fd.abs() + o.v.abs() / WP),
+                        "SR {sr}, speed {which}: {} vs {fd}",
+                        o.d
+                    );
                 }
             }
         }

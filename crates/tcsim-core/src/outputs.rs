@@ -85,7 +85,15 @@ pub fn row(model: &dyn ConverterDynamics, s: &Sample) -> [f64; 27] {
         s.torque[2],
         ratio(u[TURBINE], u[PUMP]),
         ratio(turbine, pump),
-        if model.has_stator_clutch() { if s.mode.stator_locked { 0.0 } else { 1.0 } } else { f64::NAN },
+        if model.has_stator_clutch() {
+            if s.mode.stator_locked {
+                0.0
+            } else {
+                1.0
+            }
+        } else {
+            f64::NAN
+        },
         if model.has_flow_sign() { s.mode.flow_sign } else { f64::NAN },
         inertia_p,
         fluid_p,

@@ -44,7 +44,11 @@ pub fn run_segment<S: SmoothSegment>(
     steps: &mut usize,
 ) -> TransientResult<SegmentEnd<S::Root>> {
     let n = seg.n_states();
-    let fail = |t: f64, x: &[f64], e: &dyn std::fmt::Display| TransientError::Solver { time_s: t, state: if x.is_empty() { vec![] } else { seg.coordinates(x, t) }, message: e.to_string() };
+    let fail = |t: f64, x: &[f64], e: &dyn std::fmt::Display| TransientError::Solver {
+        time_s: t,
+        state: if x.is_empty() { vec![] } else { seg.coordinates(x, t) },
+        message: e.to_string(),
+    };
     while samples.len() < times_s.len() && times_s[samples.len()] <= t0 {
         samples.push(seg.sample(&x0, times_s[samples.len()]));
     }

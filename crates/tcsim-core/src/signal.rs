@@ -30,7 +30,11 @@ impl Signal {
     /// increasing, values finite; at least one sample.
     pub fn new(name: &str, time_s: Vec<f64>, value: Vec<f64>, derivative_window_s: f64) -> CoreResult<Self> {
         if time_s.is_empty() || time_s.len() != value.len() {
-            return Err(CoreError::new(name, format!("{} times, {} values", time_s.len(), value.len()), "as many values as times, at least one"));
+            return Err(CoreError::new(
+                name,
+                format!("{} times, {} values", time_s.len(), value.len()),
+                "as many values as times, at least one",
+            ));
         }
         if let Some(i) = time_s.iter().position(|t| !t.is_finite()) {
             return Err(CoreError::new(format!("{name}.time_s[{i}]"), time_s[i], "a finite time"));
@@ -42,7 +46,11 @@ impl Signal {
             return Err(CoreError::new(format!("{name}.time_s[{i}]"), time_s[i], "strictly increasing times"));
         }
         if !(derivative_window_s.is_finite() && derivative_window_s >= 0.0) {
-            return Err(CoreError::new("derivative_window_s", derivative_window_s, "a finite window of zero or more seconds"));
+            return Err(CoreError::new(
+                "derivative_window_s",
+                derivative_window_s,
+                "a finite window of zero or more seconds",
+            ));
         }
         let rate = smoothed_rate(&time_s, &value, derivative_window_s);
         Ok(Self { time_s, value, rate })
@@ -119,7 +127,8 @@ fn least_squares_slope(t: &[f64], y: &[f64]) -> f64 {
     let m = t.len() as f64;
     let tm = t.iter().sum::<f64>() / m;
     let ym = y.iter().sum::<f64>() / m;
-    let (num, den) = t.iter().zip(y).fold((0.0, 0.0), |(n, d), (&ti, &yi)| (n + (ti - tm) * (yi - ym), d + (ti - tm) * (ti - tm)));
+    let (num, den) =
+        t.iter().zip(y).fold((0.0, 0.0), |(n, d), (&ti, &yi)| (n + (ti - tm) * (yi - ym), d + (ti - tm) * (ti - tm)));
     num / den
 }
 
@@ -147,7 +156,8 @@ mod tests {
         }
         // ±0.5 rad/s alternating noise on a ramp: the raw difference is off by 1000 rad/s², the
         // smoothed derivative by less than 1 %
-        let noisy: Vec<f64> = t.iter().enumerate().map(|(i, t)| 40.0 * t + if i % 2 == 0 { 0.5 } else { -0.5 }).collect();
+        let noisy: Vec<f64> =
+            t.iter().enumerate().map(|(i, t)| 40.0 * t + if i % 2 == 0 { 0.5 } else { -0.5 }).collect();
         let s = Signal::new("w", t.clone(), noisy, DEFAULT_DERIVATIVE_WINDOW_S).unwrap();
         assert!((s.rate(0.5) - 40.0).abs() < 0.4, "{}", s.rate(0.5));
         // symmetric windows at every inner sample, so the slope of a parabola is exact there

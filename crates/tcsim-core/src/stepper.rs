@@ -9,7 +9,9 @@
 
 use crate::dynamics::{ConverterDynamics, Vec4};
 use crate::signal::Signal;
-use crate::transient::{initial_mode, initial_state, simulate_from, Drive, InitialState, Mode, Sample, SolverOptions, TransientResult};
+use crate::transient::{
+    initial_mode, initial_state, simulate_from, Drive, InitialState, Mode, Sample, SolverOptions, TransientResult,
+};
 
 /// Which quantities the host gives and which come back.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -34,14 +36,29 @@ pub struct Stepper<M: ConverterDynamics> {
 
 impl<M: ConverterDynamics> Stepper<M> {
     pub fn new(model: M, causality: Causality, options: SolverOptions) -> Self {
-        Self { model, causality, options, time_s: 0.0, inputs: [0.0; 2], u: [0.0; 4], mode: Mode { stator_locked: false, flow_sign: 1.0 }, last: None }
+        Self {
+            model,
+            causality,
+            options,
+            time_s: 0.0,
+            inputs: [0.0; 2],
+            u: [0.0; 4],
+            mode: Mode { stator_locked: false, flow_sign: 1.0 },
+            last: None,
+        }
     }
 
     fn drive(&self, t: [f64; 2], a: [f64; 2], b: [f64; 2]) -> TransientResult<Drive> {
         let sig = |name: &str, i: usize| Signal::new(name, t.to_vec(), vec![a[i], b[i]], 0.0);
         Ok(match self.causality {
-            Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed { pump_torque_nm: sig("pump_torque_nm", 0)?, turbine_speed_rad_s: sig("turbine_speed_rad_s", 1)? },
-            Causality::Speeds => Drive::Speeds { pump_speed_rad_s: sig("pump_speed_rad_s", 0)?, turbine_speed_rad_s: sig("turbine_speed_rad_s", 1)? },
+            Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
+                pump_torque_nm: sig("pump_torque_nm", 0)?,
+                turbine_speed_rad_s: sig("turbine_speed_rad_s", 1)?,
+            },
+            Causality::Speeds => Drive::Speeds {
+                pump_speed_rad_s: sig("pump_speed_rad_s", 0)?,
+                turbine_speed_rad_s: sig("turbine_speed_rad_s", 1)?,
+            },
         })
     }
 
@@ -49,7 +66,13 @@ impl<M: ConverterDynamics> Stepper<M> {
     /// consistent with them unless `init` gives values.
     /// `rates` are the inputs' rates at `t0` (zero if unknown): they enter the outputs at the start
     /// (the inertia and shape-effect terms), not the steady state.
-    pub fn initialize(&mut self, t0: f64, inputs: [f64; 2], rates: [f64; 2], init: &InitialState) -> TransientResult<Sample> {
+    pub fn initialize(
+        &mut self,
+        t0: f64,
+        inputs: [f64; 2],
+        rates: [f64; 2],
+        init: &InitialState,
+    ) -> TransientResult<Sample> {
         let drive = self.drive([t0, t0 + 1.0], inputs, [inputs[0] + rates[0], inputs[1] + rates[1]])?;
         let u = initial_state(&self.model, &drive, t0, init)?;
         let mode = initial_mode(&self.model, &drive, &u, t0);

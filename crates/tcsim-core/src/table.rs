@@ -62,7 +62,11 @@ impl Characteristic {
         }
         for (name, v) in [("torque_ratio", &torque_ratio), ("capacity_factor_nm_s2", &capacity_factor_nm_s2)] {
             if v.len() != n {
-                return Err(CoreError::new(name, format!("{} points", v.len()), format!("{n} points, as many as speed_ratio")));
+                return Err(CoreError::new(
+                    name,
+                    format!("{} points", v.len()),
+                    format!("{n} points, as many as speed_ratio"),
+                ));
             }
         }
         for (name, v) in [
@@ -106,7 +110,13 @@ impl Characteristic {
             extrapolated: true,
         };
         if sr.is_nan() {
-            return Lookup { torque_ratio: f64::NAN, capacity_factor_nm_s2: f64::NAN, d_torque_ratio: f64::NAN, d_capacity_factor: f64::NAN, extrapolated: true };
+            return Lookup {
+                torque_ratio: f64::NAN,
+                capacity_factor_nm_s2: f64::NAN,
+                d_torque_ratio: f64::NAN,
+                d_capacity_factor: f64::NAN,
+                extrapolated: true,
+            };
         }
         if sr < x[0] {
             return held(0);
@@ -122,7 +132,13 @@ impl Characteristic {
         let lerp = |y: &[f64]| ((1.0 - w) * y[i - 1] + w * y[i], (y[i] - y[i - 1]) / h);
         let (tr, dtr) = lerp(&self.torque_ratio);
         let (cf, dcf) = lerp(&self.capacity_factor_nm_s2);
-        Lookup { torque_ratio: tr, capacity_factor_nm_s2: cf, d_torque_ratio: dtr, d_capacity_factor: dcf, extrapolated: false }
+        Lookup {
+            torque_ratio: tr,
+            capacity_factor_nm_s2: cf,
+            d_torque_ratio: dtr,
+            d_capacity_factor: dcf,
+            extrapolated: false,
+        }
     }
 
     /// Steady state at pump and turbine speeds in rad/s (eqs 2.8–2.9, no inertia terms).
@@ -159,7 +175,9 @@ mod tests {
         Characteristic::new(
             vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
             vec![2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
-            [3.272, 3.257, 3.228, 3.181, 3.112, 3.017, 2.887, 2.713, 2.481, 2.370, 1.842, 1.237, 0.187].map(|v| v * 1e-3).to_vec(),
+            [3.272, 3.257, 3.228, 3.181, 3.112, 3.017, 2.887, 2.713, 2.481, 2.370, 1.842, 1.237, 0.187]
+                .map(|v| v * 1e-3)
+                .to_vec(),
         )
         .unwrap()
     }
@@ -186,9 +204,17 @@ mod tests {
     fn holds_end_values_outside_the_table() {
         let t = c1();
         let below = t.lookup(-0.2);
-        assert!(below.extrapolated && below.torque_ratio == 2.14 && below.capacity_factor_nm_s2 == t.capacity_factor_nm_s2()[0]);
+        assert!(
+            below.extrapolated
+                && below.torque_ratio == 2.14
+                && below.capacity_factor_nm_s2 == t.capacity_factor_nm_s2()[0]
+        );
         let above = t.lookup(1.3);
-        assert!(above.extrapolated && above.torque_ratio == 1.0 && above.capacity_factor_nm_s2 == t.capacity_factor_nm_s2()[12]);
+        assert!(
+            above.extrapolated
+                && above.torque_ratio == 1.0
+                && above.capacity_factor_nm_s2 == t.capacity_factor_nm_s2()[12]
+        );
         assert_eq!(above.d_capacity_factor, 0.0);
     }
 
@@ -196,7 +222,8 @@ mod tests {
     fn overrun_rows_reverse_the_pump_torque() {
         // JAMBE/TRAMI 9AT excerpt: negative capacity above SR = 1 (turbine drives the pump).
         let c = |v: f64| v * (60.0 / (2.0 * std::f64::consts::PI)).powi(2);
-        let t = Characteristic::new(vec![0.9, 1.0, 1.1, 1.2], vec![1.0; 4], vec![c(30e-6), 0.0, c(-5e-6), c(-10e-6)]).unwrap();
+        let t = Characteristic::new(vec![0.9, 1.0, 1.1, 1.2], vec![1.0; 4], vec![c(30e-6), 0.0, c(-5e-6), c(-10e-6)])
+            .unwrap();
         let op = t.operating_point(200.0, 230.0).unwrap();
         assert!(!op.extrapolated);
         assert!(op.pump_torque_nm < 0.0 && op.turbine_torque_nm < 0.0, "{op:?}");
@@ -225,7 +252,9 @@ mod tests {
             let (a, b) = (t.lookup(sr - h), t.lookup(sr + h));
             let l = t.lookup(sr);
             assert!((l.d_torque_ratio - (b.torque_ratio - a.torque_ratio) / (2.0 * h)).abs() < 1e-6);
-            assert!((l.d_capacity_factor - (b.capacity_factor_nm_s2 - a.capacity_factor_nm_s2) / (2.0 * h)).abs() < 1e-9);
+            assert!(
+                (l.d_capacity_factor - (b.capacity_factor_nm_s2 - a.capacity_factor_nm_s2) / (2.0 * h)).abs() < 1e-9
+            );
         }
     }
 

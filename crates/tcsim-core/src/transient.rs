@@ -36,7 +36,6 @@
 //! side is smooth and the energy identity holds exactly (the held flow does no work). This is the
 //! same state the closed-form steady state calls `no-flow` near SR = 1.
 
-
 use crate::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::error::CoreError;
 use crate::segment::SmoothSegment;
@@ -75,7 +74,9 @@ impl Drive {
 
     fn pump_torque(&self) -> Option<&Signal> {
         match self {
-            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, .. } | Drive::PumpTorqueLoad { pump_torque_nm, .. } => Some(pump_torque_nm),
+            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, .. } | Drive::PumpTorqueLoad { pump_torque_nm, .. } => {
+                Some(pump_torque_nm)
+            }
             Drive::Speeds { .. } => None,
         }
     }
@@ -90,7 +91,9 @@ impl Drive {
     /// Earliest time at which every signal has a sample.
     pub fn start_time(&self) -> f64 {
         let signals: Vec<&Signal> = match self {
-            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, turbine_speed_rad_s } => vec![pump_torque_nm, turbine_speed_rad_s],
+            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, turbine_speed_rad_s } => {
+                vec![pump_torque_nm, turbine_speed_rad_s]
+            }
             Drive::Speeds { pump_speed_rad_s, turbine_speed_rad_s } => vec![pump_speed_rad_s, turbine_speed_rad_s],
             Drive::PumpTorqueLoad { pump_torque_nm, load } => vec![pump_torque_nm, &load.torque_nm],
         };
@@ -178,7 +181,11 @@ impl std::fmt::Display for TransientError {
             TransientError::Input(e) => write!(f, "{e}"),
             TransientError::Solver { time_s, state, message } => {
                 let names = ["ω_p", "ω_t", "ω_s", "Q", "ω_o", "ω_f", "ω_r", "v", "θ_f", "θ_r", "T_fast", "T_boost"];
-                let shown: Vec<String> = state.iter().enumerate().map(|(i, v)| format!("{} = {v:.6}", names.get(i).copied().unwrap_or("x"))).collect();
+                let shown: Vec<String> = state
+                    .iter()
+                    .enumerate()
+                    .map(|(i, v)| format!("{} = {v:.6}", names.get(i).copied().unwrap_or("x")))
+                    .collect();
                 write!(f, "solver failed at t = {time_s:.6} s ({}): {message}", shown.join(", "))
             }
         }
@@ -271,7 +278,9 @@ impl<'a> Segment<'a> {
                 Role::Absent
             } else if drive.given(c).is_some() {
                 Role::Given
-            } else if (c == STATOR && mode.stator_locked) || (c == FLOW && model.has_flow_sign() && mode.flow_sign == 0.0) {
+            } else if (c == STATOR && mode.stator_locked)
+                || (c == FLOW && model.has_flow_sign() && mode.flow_sign == 0.0)
+            {
                 Role::Held
             } else {
                 Role::Free
@@ -332,7 +341,13 @@ impl<'a> Segment<'a> {
     }
 
     fn given_rates(&self, t: f64) -> Vec4 {
-        std::array::from_fn(|c| if self.role[c] == Role::Given { self.drive.given(c).map_or(0.0, |s| s.rate(t)) } else { 0.0 })
+        std::array::from_fn(|c| {
+            if self.role[c] == Role::Given {
+                self.drive.given(c).map_or(0.0, |s| s.rate(t))
+            } else {
+                0.0
+            }
+        })
     }
 
     /// External torques acting on the free coordinates, and their derivative with respect to ω_t.
@@ -379,7 +394,12 @@ impl<'a> Segment<'a> {
         let j = self.model.force_jacobian(&u, self.mode.flow_sign);
         let (_, de_dwt) = self.external(&u, t);
         for (i, &r) in self.free.iter().enumerate() {
-            out[i] = self.free.iter().enumerate().map(|(k, &c)| (j[r][c] + if r == TURBINE && c == TURBINE { de_dwt } else { 0.0 }) * v[k]).sum();
+            out[i] = self
+                .free
+                .iter()
+                .enumerate()
+                .map(|(k, &c)| (j[r][c] + if r == TURBINE && c == TURBINE { de_dwt } else { 0.0 }) * v[k])
+                .sum();
         }
     }
 
@@ -452,8 +472,21 @@ impl<'a> Segment<'a> {
             // the reaction that balances the transferred torques
             torque[2] = transferred.1 - transferred.0;
         }
-        let loss = if self.mode.flow_sign == 0.0 && self.model.has_flow_sign() { 0.0 } else { self.model.loss_power_w(&u, &f) };
-        Sample { time_s: t, u, u_dot: ud, torque, transferred, mode: self.mode, loss_power_w: loss, stored_energy_j: stored }
+        let loss = if self.mode.flow_sign == 0.0 && self.model.has_flow_sign() {
+            0.0
+        } else {
+            self.model.loss_power_w(&u, &f)
+        };
+        Sample {
+            time_s: t,
+            u,
+            u_dot: ud,
+            torque,
+            transferred,
+            mode: self.mode,
+            loss_power_w: loss,
+            stored_energy_j: stored,
+        }
     }
 
     fn atol(&self, o: &SolverOptions) -> Vec<f64> {
@@ -480,7 +513,16 @@ fn invert(n: usize, a: &Mat4) -> Option<Mat4> {
 /// The mode a state starts in: the stator locked if it stands and the clutch would hold; the flow
 /// sign from Q, or from the held-flow balance when Q = 0.
 pub fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64) -> Mode {
-    let mut mode = Mode { stator_locked: false, flow_sign: if u[FLOW] > 0.0 { 1.0 } else if u[FLOW] < 0.0 { -1.0 } else { 0.0 } };
+    let mut mode = Mode {
+        stator_locked: false,
+        flow_sign: if u[FLOW] > 0.0 {
+            1.0
+        } else if u[FLOW] < 0.0 {
+            -1.0
+        } else {
+            0.0
+        },
+    };
     if model.has_flow_sign() && u[FLOW] == 0.0 {
         mode.flow_sign = flow_sign_at_zero(model, drive, u, t, mode.stator_locked || u[STATOR] <= 0.0);
     }
@@ -519,7 +561,12 @@ fn flow_sign_at_zero(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: 
 /// * drive (c): the same with the turbine speed from `init` (default 0, a vehicle at rest).
 ///
 /// Values in `init` override the steady state.
-pub fn initial_state(model: &dyn ConverterDynamics, drive: &Drive, t0: f64, init: &InitialState) -> TransientResult<Vec4> {
+pub fn initial_state(
+    model: &dyn ConverterDynamics,
+    drive: &Drive,
+    t0: f64,
+    init: &InitialState,
+) -> TransientResult<Vec4> {
     let given_wt = drive.given(TURBINE).map(|s| s.value(t0));
     let given_wp = drive.given(PUMP).map(|s| s.value(t0));
     let wt = given_wt.or(init.turbine_speed_rad_s).unwrap_or(0.0);
@@ -533,7 +580,16 @@ pub fn initial_state(model: &dyn ConverterDynamics, drive: &Drive, t0: f64, init
     let mut u = if init.flow_m3_s.is_some() && init.stator_speed_rad_s.is_some() {
         [wp, wt, 0.0, 0.0]
     } else {
-        model.steady_point(wp, wt).map_err(|e| CoreError::new(format!("initial state: {}", e.field), e.value, format!("{}; give the initial state explicitly", e.expected)))?.u
+        model
+            .steady_point(wp, wt)
+            .map_err(|e| {
+                CoreError::new(
+                    format!("initial state: {}", e.field),
+                    e.value,
+                    format!("{}; give the initial state explicitly", e.expected),
+                )
+            })?
+            .u
     };
     u[PUMP] = wp;
     u[TURBINE] = wt;
@@ -549,13 +605,23 @@ pub fn initial_state(model: &dyn ConverterDynamics, drive: &Drive, t0: f64, init
             u[c] = 0.0;
         }
     }
-    for (name, v) in [("initial pump_speed_rad_s", u[0]), ("initial turbine_speed_rad_s", u[1]), ("initial stator_speed_rad_s", u[2]), ("initial flow_m3_s", u[3])] {
+    for (name, v) in [
+        ("initial pump_speed_rad_s", u[0]),
+        ("initial turbine_speed_rad_s", u[1]),
+        ("initial stator_speed_rad_s", u[2]),
+        ("initial flow_m3_s", u[3]),
+    ] {
         if !v.is_finite() {
             return Err(CoreError::new(name, v, "a finite value").into());
         }
     }
     if model.has_stator_clutch() && u[STATOR] < 0.0 {
-        return Err(CoreError::new("initial stator_speed_rad_s", u[STATOR], "zero or more: the one-way clutch stops backward rotation").into());
+        return Err(CoreError::new(
+            "initial stator_speed_rad_s",
+            u[STATOR],
+            "zero or more: the one-way clutch stops backward rotation",
+        )
+        .into());
     }
     Ok(u)
 }
@@ -563,9 +629,13 @@ pub fn initial_state(model: &dyn ConverterDynamics, drive: &Drive, t0: f64, init
 /// The pump speed at which the steady-state pump torque equals `pump_torque_nm` at turbine
 /// speed `wt` ≥ 0.
 fn steady_pump_speed(model: &dyn ConverterDynamics, pump_torque_nm: f64, wt: f64) -> TransientResult<f64> {
-    let bad = |expected: &str| TransientError::Input(CoreError::new("initial pump_torque_nm", pump_torque_nm, expected.to_string()));
+    let bad = |expected: &str| {
+        TransientError::Input(CoreError::new("initial pump_torque_nm", pump_torque_nm, expected.to_string()))
+    };
     if pump_torque_nm.is_nan() || pump_torque_nm <= 0.0 {
-        return Err(bad("a positive pump torque at the start for a steady initial state; give the initial pump speed explicitly"));
+        return Err(bad(
+            "a positive pump torque at the start for a steady initial state; give the initial pump speed explicitly",
+        ));
     }
     if wt.is_nan() || wt < 0.0 {
         return Err(bad("a turbine speed of zero or more at the start for a steady initial state; give the initial pump speed explicitly"));
@@ -599,7 +669,13 @@ fn steady_pump_speed(model: &dyn ConverterDynamics, pump_torque_nm: f64, wt: f64
 }
 
 /// Run `model` under `drive`, sampled at `times_s` (sorted, the first is the start time).
-pub fn simulate(model: &dyn ConverterDynamics, drive: &Drive, times_s: &[f64], init: &InitialState, options: &SolverOptions) -> TransientResult<Trajectory> {
+pub fn simulate(
+    model: &dyn ConverterDynamics,
+    drive: &Drive,
+    times_s: &[f64],
+    init: &InitialState,
+    options: &SolverOptions,
+) -> TransientResult<Trajectory> {
     check_times(times_s)?;
     let t0 = times_s[0];
     let u0 = initial_state(model, drive, t0, init)?;
@@ -621,7 +697,14 @@ fn check_times(times_s: &[f64]) -> TransientResult<()> {
 }
 
 /// Run from a given state and mode.
-pub fn simulate_from(model: &dyn ConverterDynamics, drive: &Drive, times_s: &[f64], u0: Vec4, mode0: Mode, options: &SolverOptions) -> TransientResult<Trajectory> {
+pub fn simulate_from(
+    model: &dyn ConverterDynamics,
+    drive: &Drive,
+    times_s: &[f64],
+    u0: Vec4,
+    mode0: Mode,
+    options: &SolverOptions,
+) -> TransientResult<Trajectory> {
     check_times(times_s)?;
     let t_end = *times_s.last().unwrap_or(&0.0);
     let mut traj = Trajectory { samples: Vec::with_capacity(times_s.len()), ..Default::default() };
@@ -642,9 +725,15 @@ pub fn simulate_from(model: &dyn ConverterDynamics, drive: &Drive, times_s: &[f6
                 let mut next = seg.full(&x_root, t_root);
                 let (kind, new_mode) = switch(&seg, root, &mut next, t_root);
                 traj.events.push(Event { time_s: t_root, kind, mode: new_mode });
-                if std::env::var("TCSIM_DEBUG").is_ok() { eprintln!("event {t_root} {kind:?} {new_mode:?} u={next:?}"); }
+                if std::env::var("TCSIM_DEBUG").is_ok() {
+                    eprintln!("event {t_root} {kind:?} {new_mode:?} u={next:?}");
+                }
                 if traj.events.len() > options.max_events {
-                    return Err(TransientError::Solver { time_s: t_root, state: next.to_vec(), message: format!("more than {} events: the clutch or flow events chatter", options.max_events) });
+                    return Err(TransientError::Solver {
+                        time_s: t_root,
+                        state: next.to_vec(),
+                        message: format!("more than {} events: the clutch or flow events chatter", options.max_events),
+                    });
                 }
                 t = t_root;
                 u = next;
@@ -718,7 +807,15 @@ impl SmoothSegment for Segment<'_> {
 }
 
 /// Integrate one segment (see [`crate::segment::run_segment`]).
-fn run_segment(seg: &Segment, u0: &Vec4, t0: f64, t_end: f64, times_s: &[f64], o: &SolverOptions, traj: &mut Traj) -> TransientResult<Option<(f64, Root, Vec<f64>)>> {
+fn run_segment(
+    seg: &Segment,
+    u0: &Vec4,
+    t0: f64,
+    t_end: f64,
+    times_s: &[f64],
+    o: &SolverOptions,
+    traj: &mut Traj,
+) -> TransientResult<Option<(f64, Root, Vec<f64>)>> {
     crate::segment::run_segment(seg, seg.state(u0), t0, t_end, times_s, o, &mut traj.samples, &mut traj.steps)
 }
 

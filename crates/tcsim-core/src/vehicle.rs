@@ -26,7 +26,9 @@ use crate::error::{CoreError, CoreResult};
 use crate::linalg::invert;
 use crate::segment::{run_segment, SmoothSegment};
 use crate::signal::Signal;
-use crate::transient::{Hysteresis, Mode as ConverterMode, Sample as ConverterSample, SolverOptions, TransientError, TransientResult};
+use crate::transient::{
+    Hysteresis, Mode as ConverterMode, Sample as ConverterSample, SolverOptions, TransientError, TransientResult,
+};
 
 pub const N: usize = 12;
 pub const GEARBOX_OUT: usize = 4;
@@ -50,7 +52,11 @@ pub struct Curve {
 impl Curve {
     pub fn new(name: &str, x: Vec<f64>, y: Vec<f64>) -> CoreResult<Self> {
         if x.len() < 2 || x.len() != y.len() {
-            return Err(CoreError::new(name, format!("{} and {} points", x.len(), y.len()), "two or more points, as many values as speeds"));
+            return Err(CoreError::new(
+                name,
+                format!("{} and {} points", x.len(), y.len()),
+                "two or more points, as many values as speeds",
+            ));
         }
         if let Some(i) = (1..x.len()).find(|&i| x[i].partial_cmp(&x[i - 1]) != Some(std::cmp::Ordering::Greater)) {
             return Err(CoreError::new(format!("{name}[{i}]"), x[i], "strictly increasing"));
@@ -166,7 +172,9 @@ impl Gearbox {
         if n == 0 {
             return Err(CoreError::new("gearbox.ratios", "[]", "at least one gear"));
         }
-        for (name, v) in [("gearbox.efficiencies", &self.efficiencies), ("gearbox.input_inertia_kg_m2", &self.input_inertia_kg_m2)] {
+        for (name, v) in
+            [("gearbox.efficiencies", &self.efficiencies), ("gearbox.input_inertia_kg_m2", &self.input_inertia_kg_m2)]
+        {
             if v.len() != n {
                 return Err(CoreError::new(name, format!("{} values", v.len()), format!("{n} values, one per gear")));
             }
@@ -178,7 +186,11 @@ impl Gearbox {
             ("gearbox.downshift_speed_full_pedal_m_s", &self.downshift_speed_full_pedal_m_s),
         ] {
             if v.len() != n - 1 {
-                return Err(CoreError::new(name, format!("{} values", v.len()), format!("{} values, one per shift", n - 1)));
+                return Err(CoreError::new(
+                    name,
+                    format!("{} values", v.len()),
+                    format!("{} values, one per shift", n - 1),
+                ));
             }
             for (i, &x) in v.iter().enumerate() {
                 positive(&format!("{name}[{i}]"), x)?;
@@ -194,11 +206,23 @@ impl Gearbox {
         }
         for i in 0..n - 1 {
             for (lo, hi, name) in [
-                (self.downshift_speed_zero_pedal_m_s[i], self.upshift_speed_zero_pedal_m_s[i], "gearbox.downshift_speed_zero_pedal_m_s"),
-                (self.downshift_speed_full_pedal_m_s[i], self.upshift_speed_full_pedal_m_s[i], "gearbox.downshift_speed_full_pedal_m_s"),
+                (
+                    self.downshift_speed_zero_pedal_m_s[i],
+                    self.upshift_speed_zero_pedal_m_s[i],
+                    "gearbox.downshift_speed_zero_pedal_m_s",
+                ),
+                (
+                    self.downshift_speed_full_pedal_m_s[i],
+                    self.upshift_speed_full_pedal_m_s[i],
+                    "gearbox.downshift_speed_full_pedal_m_s",
+                ),
             ] {
                 if lo >= hi {
-                    return Err(CoreError::new(format!("{name}[{i}]"), lo, format!("below the upshift speed {hi} m/s (hysteresis)")));
+                    return Err(CoreError::new(
+                        format!("{name}[{i}]"),
+                        lo,
+                        format!("below the upshift speed {hi} m/s (hysteresis)"),
+                    ));
                 }
             }
         }
@@ -248,7 +272,8 @@ impl Lockup {
         Ok(())
     }
     pub fn engage_speed(&self, p: f64) -> f64 {
-        self.engage_speed_zero_pedal_m_s + p.clamp(0.0, 1.0) * (self.engage_speed_full_pedal_m_s - self.engage_speed_zero_pedal_m_s)
+        self.engage_speed_zero_pedal_m_s
+            + p.clamp(0.0, 1.0) * (self.engage_speed_full_pedal_m_s - self.engage_speed_zero_pedal_m_s)
     }
 }
 
@@ -376,7 +401,11 @@ pub enum LockupState {
     /// Capacity ramping in since `since_s` (full once `ramped`), slipping. An `armed` clutch locks
     /// when the slip falls below the sync threshold; one that broke away from locked is armed after
     /// slipping for `REARM_DELAY_S`.
-    Engaging { since_s: f64, ramped: bool, armed: bool },
+    Engaging {
+        since_s: f64,
+        ramped: bool,
+        armed: bool,
+    },
     Locked,
 }
 
@@ -474,7 +503,13 @@ struct Powers {
 }
 
 impl<'a> Plant<'a> {
-    fn new(model: &'a dyn ConverterDynamics, v: &'a Vehicle, sc: &'a Scenario, mode: VehicleMode, sync_sign: f64) -> Self {
+    fn new(
+        model: &'a dyn ConverterDynamics,
+        v: &'a Vehicle,
+        sc: &'a Scenario,
+        mode: VehicleMode,
+        sync_sign: f64,
+    ) -> Self {
         let present = model.coordinates();
         let conv_mass = model.mass();
         let mut mass = [[0.0; N]; N];
@@ -535,7 +570,8 @@ impl<'a> Plant<'a> {
                 }
             }
         }
-        let reduced_inv = invert(&reduced_mass).expect("the reduced mass matrix of a positive-definite M is invertible");
+        let reduced_inv =
+            invert(&reduced_mass).expect("the reduced mass matrix of a positive-definite M is invertible");
         let mut roots = Vec::new();
         if model.has_stator_clutch() {
             roots.push(if mode.converter.stator_locked { Root::StatorTorque } else { Root::StatorSpeed });
@@ -560,7 +596,9 @@ impl<'a> Plant<'a> {
             }
         }
         match mode.lockup {
-            LockupState::Open if mode.gear + 1 >= v.lockup.min_gear && mode.shift.is_none() => roots.push(Root::LockupEngage),
+            LockupState::Open if mode.gear + 1 >= v.lockup.min_gear && mode.shift.is_none() => {
+                roots.push(Root::LockupEngage)
+            }
             LockupState::Engaging { ramped: false, .. } => roots.push(Root::LockupRamped),
             LockupState::Engaging { armed: false, .. } => roots.push(Root::LockupArm),
             LockupState::Engaging { .. } => roots.push(Root::LockupLock),
@@ -593,7 +631,9 @@ impl<'a> Plant<'a> {
 
     fn lockup_capacity(&self, t: f64) -> f64 {
         match self.mode.lockup {
-            LockupState::Engaging { since_s, .. } => self.v.lockup.capacity_nm * ((t - since_s) / self.v.lockup.engage_time_s).clamp(0.0, 1.0),
+            LockupState::Engaging { since_s, .. } => {
+                self.v.lockup.capacity_nm * ((t - since_s) / self.v.lockup.engage_time_s).clamp(0.0, 1.0)
+            }
             _ => 0.0,
         }
     }
@@ -672,7 +712,10 @@ impl<'a> Plant<'a> {
         let weight = v.body.mass_kg * G * cos_g;
         let brake = self.sc.brake_pedal.value(t).clamp(0.0, 1.0) * v.brake.capacity_nm;
         let vs = u[SPEED];
-        for (axle, load, share) in [(FRONT, ty.front_load_fraction, v.brake.front_fraction), (REAR, 1.0 - ty.front_load_fraction, 1.0 - v.brake.front_fraction)] {
+        for (axle, load, share) in [
+            (FRONT, ty.front_load_fraction, v.brake.front_fraction),
+            (REAR, 1.0 - ty.front_load_fraction, 1.0 - v.brake.front_fraction),
+        ] {
             let slip_speed = ty.rolling_radius_m * u[axle] - vs;
             let kappa = slip_speed / (vs * vs + SLIP_SPEED_M_S * SLIP_SPEED_M_S).sqrt();
             let mu = ty.friction_coefficient;
@@ -722,7 +765,8 @@ impl<'a> Plant<'a> {
     /// Front and rear shaft torques.
     fn shaft_torques(&self, u: &[f64; N], f: &[f64; N]) -> [f64; 2] {
         let d = &self.v.driveline;
-        [(TWIST_F, 0), (TWIST_R, 1)].map(|(tw, i)| d.shaft_stiffness_nm_per_rad[i] * u[tw] + d.shaft_damping_nm_s_per_rad[i] * f[tw])
+        [(TWIST_F, 0), (TWIST_R, 1)]
+            .map(|(tw, i)| d.shaft_stiffness_nm_per_rad[i] * u[tw] + d.shaft_damping_nm_s_per_rad[i] * f[tw])
     }
 
     /// Brake capacity left on the weaker held axle (negative: the brake cannot hold).
@@ -739,7 +783,6 @@ impl<'a> Plant<'a> {
         (head - inertial, shock)
     }
 }
-
 
 /// One sampled instant of a launch.
 #[derive(Debug, Clone, Copy)]
@@ -834,13 +877,16 @@ impl SmoothSegment for Plant<'_> {
                     let (share, fd) = (self.v.brake.front_fraction, self.v.driveline.final_drive_ratio);
                     let shaft = self.shaft_torques(&u, &f);
                     // with a 20 % margin, so that a brake that just let go does not grab again
-                    let short = (fd * shaft[0].abs() - 0.8 * cap * share).max(fd * shaft[1].abs() - 0.8 * cap * (1.0 - share));
+                    let short =
+                        (fd * shaft[0].abs() - 0.8 * cap * share).max(fd * shaft[1].abs() - 0.8 * cap * (1.0 - share));
                     spin.max(short)
                 }
                 Root::Upshift => gb.upshift_speed(self.mode.gear, p) - u[SPEED],
                 Root::Downshift => u[SPEED] - gb.downshift_speed(self.mode.gear, p),
                 Root::ShiftHandover => self.mode.shift.map_or(1.0, |s| s.since_s + gb.shift_handover_s - t),
-                Root::ShiftSync => self.mode.shift.map_or(1.0, |s| self.sync_sign * (u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT]) - SYNC_SLIP_RAD_S),
+                Root::ShiftSync => self.mode.shift.map_or(1.0, |s| {
+                    self.sync_sign * (u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT]) - SYNC_SLIP_RAD_S
+                }),
                 Root::LockupEngage => self.v.lockup.engage_speed(p) - u[SPEED],
                 Root::LockupRamped => match self.mode.lockup {
                     LockupState::Engaging { since_s, .. } => since_s + self.v.lockup.engage_time_s - t,
@@ -886,15 +932,24 @@ impl SmoothSegment for Plant<'_> {
             stored_energy_j: 0.5 * (0..4).map(|r| uc[r] * (0..4).map(|c| cm[r][c] * uc[c]).sum::<f64>()).sum::<f64>(),
         };
         let d = &self.v.driveline;
-        let kinetic: f64 = 0.5 * (0..=SPEED).map(|r| u[r] * (0..=SPEED).map(|c| self.mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
-        let spring = 0.5 * (d.shaft_stiffness_nm_per_rad[0] * u[TWIST_F].powi(2) + d.shaft_stiffness_nm_per_rad[1] * u[TWIST_R].powi(2));
+        let kinetic: f64 =
+            0.5 * (0..=SPEED).map(|r| u[r] * (0..=SPEED).map(|c| self.mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
+        let spring = 0.5
+            * (d.shaft_stiffness_nm_per_rad[0] * u[TWIST_F].powi(2)
+                + d.shaft_stiffness_nm_per_rad[1] * u[TWIST_R].powi(2));
         let shaft = self.shaft_torques(&u, &f);
         let ty = &self.v.tyres;
         let tyre = [FRONT, REAR].map(|a| {
             let load = if a == FRONT { ty.front_load_fraction } else { 1.0 - ty.front_load_fraction };
             let (_, cos_g) = self.v.grade();
-            let kappa = (ty.rolling_radius_m * u[a] - u[SPEED]) / (u[SPEED] * u[SPEED] + SLIP_SPEED_M_S * SLIP_SPEED_M_S).sqrt();
-            ty.friction_coefficient * load * self.v.body.mass_kg * G * cos_g * (ty.slip_stiffness * kappa / ty.friction_coefficient).tanh()
+            let kappa = (ty.rolling_radius_m * u[a] - u[SPEED])
+                / (u[SPEED] * u[SPEED] + SLIP_SPEED_M_S * SLIP_SPEED_M_S).sqrt();
+            ty.friction_coefficient
+                * load
+                * self.v.body.mass_kg
+                * G
+                * cos_g
+                * (ty.slip_stiffness * kappa / ty.friction_coefficient).tanh()
         });
         LaunchSample {
             time_s: t,
@@ -1050,7 +1105,8 @@ fn switch(plant: &Plant, root: Root, u: &mut [f64; N], t: f64) -> (VehicleMode, 
             if slip.abs() <= SYNC_SLIP_RAD_S {
                 m.lockup = LockupState::Locked;
             } else {
-                m.lockup = LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: true };
+                m.lockup =
+                    LockupState::Engaging { since_s: t - plant.v.lockup.engage_time_s, ramped: true, armed: true };
                 sync = slip.signum();
             }
         }
@@ -1095,7 +1151,9 @@ fn due(plant: &Plant, u: &[f64; N], t: f64) -> Option<Root> {
             return Some(Root::BrakeRelease);
         }
     }
-    if m.lockup != LockupState::Open && (m.gear + 1 < plant.v.lockup.min_gear || u[SPEED] < LOCKUP_RELEASE_FRACTION * plant.v.lockup.engage_speed(p)) {
+    if m.lockup != LockupState::Open
+        && (m.gear + 1 < plant.v.lockup.min_gear || u[SPEED] < LOCKUP_RELEASE_FRACTION * plant.v.lockup.engage_speed(p))
+    {
         return Some(Root::LockupRelease);
     }
     if m.shift.is_none() && !m.wheels_held {
@@ -1105,7 +1163,10 @@ fn due(plant: &Plant, u: &[f64; N], t: f64) -> Option<Root> {
         if m.gear > 0 && u[SPEED] < gb.downshift_speed(m.gear, p) {
             return Some(Root::Downshift);
         }
-        if m.lockup == LockupState::Open && m.gear + 1 >= plant.v.lockup.min_gear && u[SPEED] > plant.v.lockup.engage_speed(p) {
+        if m.lockup == LockupState::Open
+            && m.gear + 1 >= plant.v.lockup.min_gear
+            && u[SPEED] > plant.v.lockup.engage_speed(p)
+        {
             return Some(Root::LockupEngage);
         }
     }
@@ -1119,7 +1180,13 @@ fn kinetic_energy(plant: &Plant, u: &[f64; N]) -> f64 {
 
 /// Run a launch from the braked standstill ([`initial_state`]), sampled every `output_step_s`
 /// until the stop speed or the end time.
-pub fn simulate_launch(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario, output_step_s: f64, options: &SolverOptions) -> TransientResult<LaunchTrajectory> {
+pub fn simulate_launch(
+    model: &dyn ConverterDynamics,
+    v: &Vehicle,
+    sc: &Scenario,
+    output_step_s: f64,
+    options: &SolverOptions,
+) -> TransientResult<LaunchTrajectory> {
     v.validate()?;
     if !(sc.end_time_s.is_finite() && sc.end_time_s > 0.0) {
         return Err(CoreError::new("end_time_s", sc.end_time_s, "a finite, positive end time").into());
@@ -1132,7 +1199,10 @@ pub fn simulate_launch(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario
     let u0 = initial_state(model, v, sc)?;
     let held = sc.brake_pedal.value(0.0) > 0.0;
     let mut mode = VehicleMode {
-        converter: ConverterMode { stator_locked: model.has_stator_clutch(), flow_sign: if model.has_flow_sign() { 1.0 } else { 0.0 } },
+        converter: ConverterMode {
+            stator_locked: model.has_stator_clutch(),
+            flow_sign: if model.has_flow_sign() { 1.0 } else { 0.0 },
+        },
         gear: 0,
         shift: None,
         lockup: LockupState::Open,
@@ -1174,7 +1244,11 @@ pub fn simulate_launch(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario
                 };
                 traj.events.push(VehicleEvent { time_s: t_root, kind, gear: new_mode.gear + 1 });
                 if traj.events.len() > options.max_events {
-                    return Err(TransientError::Solver { time_s: t_root, state: next.to_vec(), message: format!("more than {} events: events chatter", options.max_events) });
+                    return Err(TransientError::Solver {
+                        time_s: t_root,
+                        state: next.to_vec(),
+                        message: format!("more than {} events: events chatter", options.max_events),
+                    });
                 }
                 t = t_root;
                 u = next;
@@ -1214,7 +1288,12 @@ pub const LAUNCH_COLUMNS: [&str; 18] = [
 /// All columns of a launch: the converter's, then [`LAUNCH_COLUMNS`], then
 /// `event_energy_loss_j` (cumulative energy booked at switching events).
 pub fn launch_column_names() -> Vec<&'static str> {
-    crate::outputs::COLUMNS.iter().chain(LAUNCH_COLUMNS.iter()).chain(std::iter::once(&"event_energy_loss_j")).copied().collect()
+    crate::outputs::COLUMNS
+        .iter()
+        .chain(LAUNCH_COLUMNS.iter())
+        .chain(std::iter::once(&"event_energy_loss_j"))
+        .copied()
+        .collect()
 }
 
 /// The run as columns in the order of [`launch_column_names`]. `gear` is 1-based (the off-going
@@ -1270,7 +1349,8 @@ mod tests {
         Engine {
             inertia_kg_m2: 0.2,
             idle_speed_rad_s: 78.5,
-            full_load: Curve::new("full_load", vec![60.0, 230.0, 500.0, 700.0], vec![150.0, 400.0, 400.0, 280.0]).unwrap(),
+            full_load: Curve::new("full_load", vec![60.0, 230.0, 500.0, 700.0], vec![150.0, 400.0, 400.0, 280.0])
+                .unwrap(),
             drag_torque_nm: 15.0,
             drag_nm_s_per_rad: 0.05,
             fast_time_constant_s: 0.06,
@@ -1334,7 +1414,14 @@ mod tests {
 
     #[test]
     fn lockup_engage_speed_and_validation() {
-        let l = Lockup { capacity_nm: 600.0, static_to_kinetic: 1.2, engage_time_s: 0.5, min_gear: 3, engage_speed_zero_pedal_m_s: 12.0, engage_speed_full_pedal_m_s: 25.0 };
+        let l = Lockup {
+            capacity_nm: 600.0,
+            static_to_kinetic: 1.2,
+            engage_time_s: 0.5,
+            min_gear: 3,
+            engage_speed_zero_pedal_m_s: 12.0,
+            engage_speed_full_pedal_m_s: 25.0,
+        };
         assert_eq!(l.engage_speed(0.0), 12.0);
         assert_eq!(l.engage_speed(2.0), 25.0);
         let bad = Lockup { static_to_kinetic: 0.9, ..l };

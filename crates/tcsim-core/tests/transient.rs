@@ -31,7 +31,14 @@ fn energy_residual(cols: &[Vec<f64>]) -> (f64, f64) {
     let input = col(cols, "converter_input_power_w");
     let loss = col(cols, "fluid_loss_power_w");
     let net: Vec<f64> = input.iter().zip(loss).map(|(i, l)| i - l).collect();
-    let passed = trapezoid(t, &col(cols, "pump_torque_nm").iter().zip(col(cols, "pump_speed_rad_s")).map(|(a, b)| (a * b).abs()).collect::<Vec<_>>());
+    let passed = trapezoid(
+        t,
+        &col(cols, "pump_torque_nm")
+            .iter()
+            .zip(col(cols, "pump_speed_rad_s"))
+            .map(|(a, b)| (a * b).abs())
+            .collect::<Vec<_>>(),
+    );
     let residual = (stored[stored.len() - 1] - stored[0]) - trapezoid(t, &net);
     (residual / passed, passed)
 }
@@ -43,7 +50,10 @@ fn energy_identity_holds_through_clutch_and_flow_events() {
         let (traj, cols) = run(&ht(SHAPE), &takeoff(tip_out), &t, InitialState::default());
         assert!(traj.events.iter().any(|e| e.kind == EventKind::StatorRelease), "{:?}", traj.events);
         let (rel, passed) = energy_residual(&cols);
-        println!("tip_out={tip_out}: energy through the pump {passed:.0} J, residual {rel:.2e}, events {}", traj.events.len());
+        println!(
+            "tip_out={tip_out}: energy through the pump {passed:.0} J, residual {rel:.2e}, events {}",
+            traj.events.len()
+        );
         assert!(rel.abs() < 1e-3, "energy residual {rel:e}");
         // the losses dissipate
         assert!(col(&cols, "fluid_loss_power_w").iter().all(|&p| p >= -1e-9));
@@ -65,19 +75,32 @@ fn agrees_with_the_scipy_reference_take_off() {
         assert!((a - b).abs() < 5e-5, "event at {a} vs {b}");
     }
     let last = |name| *col(&cols, name).last().unwrap();
-    for (name, reference) in [("pump_speed_rad_s", -126.98775), ("turbine_speed_rad_s", 21.33480), ("flow_m3_s", 0.01775067), ("stator_torque_nm", 3.4574)] {
+    for (name, reference) in [
+        ("pump_speed_rad_s", -126.98775),
+        ("turbine_speed_rad_s", 21.33480),
+        ("flow_m3_s", 0.01775067),
+        ("stator_torque_nm", 3.4574),
+    ] {
         assert!((last(name) - reference).abs() <= 2e-4 * reference.abs(), "{name}: {} vs {reference}", last(name));
     }
     let (_, cols) = run(&ht(SHAPE), &takeoff(false), &t, InitialState::default());
     let last = |name| *col(&cols, name).last().unwrap();
-    for (name, reference) in [("pump_speed_rad_s", 375.57147), ("turbine_speed_rad_s", 346.39751), ("stator_speed_rad_s", 48.21712), ("flow_m3_s", 0.07111556)] {
+    for (name, reference) in [
+        ("pump_speed_rad_s", 375.57147),
+        ("turbine_speed_rad_s", 346.39751),
+        ("stator_speed_rad_s", 48.21712),
+        ("flow_m3_s", 0.07111556),
+    ] {
         assert!((last(name) - reference).abs() <= 1e-5 * reference.abs(), "{name}: {} vs {reference}", last(name));
     }
 }
 
 /// Drive (b) at constant speeds.
 fn held(wp: f64, wt: f64, until: f64) -> Drive {
-    Drive::Speeds { pump_speed_rad_s: signal("pump_speed_rad_s", &[(0.0, wp), (until, wp)]), turbine_speed_rad_s: signal("turbine_speed_rad_s", &[(0.0, wt), (until, wt)]) }
+    Drive::Speeds {
+        pump_speed_rad_s: signal("pump_speed_rad_s", &[(0.0, wp), (until, wp)]),
+        turbine_speed_rad_s: signal("turbine_speed_rad_s", &[(0.0, wt), (until, wt)]),
+    }
 }
 
 #[test]
@@ -90,11 +113,21 @@ fn held_speeds_settle_on_the_closed_form_steady_state() {
     // undetermined: it keeps whatever speed it had when the flow stopped.)
     for sr in [0.0, 0.5, 0.95, 0.995] {
         let ss = steady_state(&g, wp, sr * wp).unwrap();
-        let init = InitialState { flow_m3_s: Some(0.5 * ss.flow_m3_s.max(0.02)), stator_speed_rad_s: Some(0.0), ..Default::default() };
+        let init = InitialState {
+            flow_m3_s: Some(0.5 * ss.flow_m3_s.max(0.02)),
+            stator_speed_rad_s: Some(0.0),
+            ..Default::default()
+        };
         let (traj, cols) = run(&ht(SHAPE), &held(wp, sr * wp, 10.0), &t, init);
         let last = |name| *col(&cols, name).last().unwrap();
         let rel = |a: f64, b: f64| (a - b).abs() / b.abs().max(1e-3 * ss.pump_torque_nm.abs().max(1.0));
-        println!("SR {sr}: mode {:?}, Q {} vs {}, events {:?}", ss.mode, last("flow_m3_s"), ss.flow_m3_s, traj.events.len());
+        println!(
+            "SR {sr}: mode {:?}, Q {} vs {}, events {:?}",
+            ss.mode,
+            last("flow_m3_s"),
+            ss.flow_m3_s,
+            traj.events.len()
+        );
         match ss.mode {
             StatorMode::NoFlow => {
                 assert_eq!(last("flow_m3_s"), 0.0);
@@ -105,7 +138,10 @@ fn held_speeds_settle_on_the_closed_form_steady_state() {
                 assert!(rel(last("flow_m3_s"), ss.flow_m3_s) < 1e-4, "Q {} vs {}", last("flow_m3_s"), ss.flow_m3_s);
                 assert!(rel(last("pump_torque_nm"), ss.pump_torque_nm) < 1e-4);
                 assert!(rel(last("turbine_torque_nm"), ss.turbine_torque_nm) < 1e-4);
-                assert!(rel(last("stator_torque_nm"), ss.stator_torque_nm) < 1e-4 || (ss.stator_torque_nm == 0.0 && last("stator_torque_nm").abs() < 1e-6));
+                assert!(
+                    rel(last("stator_torque_nm"), ss.stator_torque_nm) < 1e-4
+                        || (ss.stator_torque_nm == 0.0 && last("stator_torque_nm").abs() < 1e-6)
+                );
                 assert!((last("stator_speed_rad_s") - ss.stator_speed_rad_s).abs() < 1e-4 * wp);
                 assert_eq!(last("stator_mode"), if ss.mode == StatorMode::Locked { 0.0 } else { 1.0 });
             }
@@ -142,7 +178,11 @@ fn tip_out_reverses_the_flow_and_finishes() {
     let t = grid(0.0, 10.0, 2001);
     let (traj, cols) = run(&ht(SHAPE), &takeoff(true), &t, InitialState::default());
     assert_eq!(*col(&cols, "time_s").last().unwrap(), 10.0);
-    assert!(traj.events.iter().any(|e| e.kind == EventKind::FlowStart && e.mode.flow_sign == -1.0), "{:?}", traj.events);
+    assert!(
+        traj.events.iter().any(|e| e.kind == EventKind::FlowStart && e.mode.flow_sign == -1.0),
+        "{:?}",
+        traj.events
+    );
     assert!(col(&cols, "flow_m3_s").iter().any(|&q| q < 0.0));
     assert!(traj.events.iter().any(|e| e.kind == EventKind::StatorLock));
 }
@@ -152,7 +192,8 @@ fn quasi_dynamic_properties() {
     let t = grid(0.0, 3.0, 3001);
     // (2) at steady state the tables hold exactly, whatever the shape effects
     for s in [0.0, 0.2, 0.5] {
-        let (_, cols) = run(&qd(s, s), &held(209.44, 104.72, 3.0), &t, InitialState { flow_m3_s: Some(0.0), ..Default::default() });
+        let (_, cols) =
+            run(&qd(s, s), &held(209.44, 104.72, 3.0), &t, InitialState { flow_m3_s: Some(0.0), ..Default::default() });
         let op = c1().operating_point(209.44, 104.72).unwrap();
         let last = |name| *col(&cols, name).last().unwrap();
         assert!((last("pump_torque_nm") - op.pump_torque_nm).abs() < 1e-9 * op.pump_torque_nm, "S {s}");
@@ -172,7 +213,12 @@ fn quasi_dynamic_properties() {
     let (_, s_cols) = run(&qd(0.1, 0.1), &takeoff(false), &t, InitialState::default());
     let table_tr: Vec<f64> = col(&s_cols, "speed_ratio").iter().map(|&sr| c1().lookup(sr).torque_ratio).collect();
     let e1 = col(&s_cols, "effective_torque_ratio");
-    let deficit = |from: f64, to: f64| (0..t.len()).filter(|&i| t[i] >= from && t[i] <= to).map(|i| table_tr[i] - e1[i]).fold(f64::NEG_INFINITY, f64::max);
+    let deficit = |from: f64, to: f64| {
+        (0..t.len())
+            .filter(|&i| t[i] >= from && t[i] <= to)
+            .map(|i| table_tr[i] - e1[i])
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
     let late = (0..t.len()).filter(|&i| t[i] >= 1.3).map(|i| (table_tr[i] - e1[i]).abs()).fold(0.0f64, f64::max);
     println!("quasi-dynamic S = 0.1: largest deficit in effective TR {:.3}, after 1.3 s {late:.4}", deficit(0.0, 0.5));
     assert!(deficit(0.0, 0.5) > 0.2);
@@ -240,25 +286,45 @@ fn the_three_drives_agree_on_one_take_off() {
     let (_, c) = run(&model, &takeoff(false), &t, InitialState::default());
     let turbine = Signal::new("turbine_speed_rad_s", t.clone(), col(&c, "turbine_speed_rad_s").to_vec(), 0.0).unwrap();
     let pump = Signal::new("pump_speed_rad_s", t.clone(), col(&c, "pump_speed_rad_s").to_vec(), 0.0).unwrap();
-    let (_, a) = run(&model, &Drive::PumpTorqueTurbineSpeed { pump_torque_nm: takeoff_torque(false), turbine_speed_rad_s: turbine.clone() }, &t, InitialState::default());
-    let (_, b) = run(&model, &Drive::Speeds { pump_speed_rad_s: pump, turbine_speed_rad_s: turbine }, &t, InitialState::default());
+    let (_, a) = run(
+        &model,
+        &Drive::PumpTorqueTurbineSpeed { pump_torque_nm: takeoff_torque(false), turbine_speed_rad_s: turbine.clone() },
+        &t,
+        InitialState::default(),
+    );
+    let (_, b) = run(
+        &model,
+        &Drive::Speeds { pump_speed_rad_s: pump, turbine_speed_rad_s: turbine },
+        &t,
+        InitialState::default(),
+    );
     let max_err = |x: &[f64], y: &[f64]| x.iter().zip(y).skip(1).fold(0.0f64, |m, (p, q)| m.max((p - q).abs()));
     let ep = max_err(col(&c, "pump_speed_rad_s"), col(&a, "pump_speed_rad_s"));
     let et = max_err(col(&c, "turbine_torque_nm"), col(&a, "turbine_torque_nm"));
     let eb = max_err(col(&c, "pump_torque_nm"), col(&b, "pump_torque_nm"));
-    println!("drive (a) vs (c): pump speed {ep:.2e} rad/s, turbine torque {et:.2e} N·m; drive (b): pump torque {eb:.2e} N·m");
+    println!(
+        "drive (a) vs (c): pump speed {ep:.2e} rad/s, turbine torque {et:.2e} N·m; drive (b): pump torque {eb:.2e} N·m"
+    );
     assert!(ep < 0.05 && et < 1.0 && eb < 2.0);
 }
 
 #[test]
 fn bad_runs_are_input_errors() {
     let t = grid(0.0, 1.0, 11);
-    let drive = Drive::PumpTorqueTurbineSpeed { pump_torque_nm: Signal::constant(-10.0), turbine_speed_rad_s: Signal::constant(0.0) };
+    let drive = Drive::PumpTorqueTurbineSpeed {
+        pump_torque_nm: Signal::constant(-10.0),
+        turbine_speed_rad_s: Signal::constant(0.0),
+    };
     match simulate(&ht(SHAPE), &drive, &t, &InitialState::default(), &SolverOptions::default()) {
         Err(tcsim_core::transient::TransientError::Input(e)) => assert_eq!(e.field, "initial pump_torque_nm"),
         other => panic!("{other:?}"),
     }
-    let init = InitialState { pump_speed_rad_s: Some(100.0), stator_speed_rad_s: Some(-1.0), flow_m3_s: Some(0.01), ..Default::default() };
+    let init = InitialState {
+        pump_speed_rad_s: Some(100.0),
+        stator_speed_rad_s: Some(-1.0),
+        flow_m3_s: Some(0.01),
+        ..Default::default()
+    };
     assert!(simulate(&ht(SHAPE), &drive, &t, &init, &SolverOptions::default()).is_err());
     assert!(simulate(&ht(SHAPE), &drive, &[0.0, 0.0], &InitialState::default(), &SolverOptions::default()).is_err());
 }
@@ -267,7 +333,15 @@ fn bad_runs_are_input_errors() {
 fn a_run_stepped_interval_by_interval_follows_the_single_run() {
     // the co-simulation engine: inputs piecewise linear on the communication grid
     use tcsim_core::stepper::{Causality, Stepper};
-    let tp = |t: f64| if t < 0.1 { 40.0 } else if t < 0.3 { 40.0 + (t - 0.1) / 0.2 * 210.0 } else { 250.0 };
+    let tp = |t: f64| {
+        if t < 0.1 {
+            40.0
+        } else if t < 0.3 {
+            40.0 + (t - 0.1) / 0.2 * 210.0
+        } else {
+            250.0
+        }
+    };
     let wt = |t: f64| 32.0 * t; // passes the coupling point
     let t_end = 10.0;
     let drive = Drive::PumpTorqueTurbineSpeed {
@@ -289,7 +363,10 @@ fn a_run_stepped_interval_by_interval_follows_the_single_run() {
             worst = worst.max((s.u[0] - col(&cols, "pump_speed_rad_s")[i]).abs() / col(&cols, "pump_speed_rad_s")[i]);
             worst = worst.max((-s.torque[1] - col(&cols, "turbine_torque_nm")[i]).abs() / 250.0);
         }
-        println!("h = {h}: largest difference from the single run {worst:.2e}; single-run events {:?}", single.events.iter().map(|e| e.kind).collect::<Vec<_>>());
+        println!(
+            "h = {h}: largest difference from the single run {worst:.2e}; single-run events {:?}",
+            single.events.iter().map(|e| e.kind).collect::<Vec<_>>()
+        );
         assert!(worst < 1e-4, "h = {h}: {worst}");
         // both released the stator at the coupling point
         assert!(!stepper.sample().unwrap().mode.stator_locked && !single.samples.last().unwrap().mode.stator_locked);

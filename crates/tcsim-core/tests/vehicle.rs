@@ -14,7 +14,12 @@ fn sedan() -> Vehicle {
         engine: Engine {
             inertia_kg_m2: 0.20,
             idle_speed_rad_s: 750.0 * rpm,
-            full_load: Curve::new("engine.full_load", [600.0, 1000.0, 1500.0, 2200.0, 4800.0, 5700.0, 6500.0].map(|r| r * rpm).to_vec(), vec![120.0, 200.0, 300.0, 400.0, 400.0, 350.0, 280.0]).unwrap(),
+            full_load: Curve::new(
+                "engine.full_load",
+                [600.0, 1000.0, 1500.0, 2200.0, 4800.0, 5700.0, 6500.0].map(|r| r * rpm).to_vec(),
+                vec![120.0, 200.0, 300.0, 400.0, 400.0, 350.0, 280.0],
+            )
+            .unwrap(),
             drag_torque_nm: 15.0,
             drag_nm_s_per_rad: 0.05,
             fast_time_constant_s: 0.06,
@@ -34,10 +39,33 @@ fn sedan() -> Vehicle {
             downshift_speed_zero_pedal_m_s: vec![2.0, 4.5, 7.0, 10.0, 13.0, 16.0, 19.0],
             downshift_speed_full_pedal_m_s: vec![9.0, 16.0, 26.0, 37.0, 47.0, 57.0, 66.0],
         },
-        lockup: Lockup { capacity_nm: 600.0, static_to_kinetic: 1.2, engage_time_s: 0.5, min_gear: 3, engage_speed_zero_pedal_m_s: 12.0, engage_speed_full_pedal_m_s: 25.0 },
-        driveline: Driveline { final_drive_ratio: 3.33, shaft_stiffness_nm_per_rad: [6000.0, 9000.0], shaft_damping_nm_s_per_rad: [30.0, 40.0], axle_inertia_kg_m2: [2.2, 2.2] },
-        tyres: Tyres { rolling_radius_m: 0.345, friction_coefficient: 1.0, slip_stiffness: 15.0, front_load_fraction: 0.57 },
-        body: Body { mass_kg: 2050.0, drag_area_m2: 0.70, rolling_resistance: 0.010, air_density_kg_m3: 1.2, grade_percent: 0.0 },
+        lockup: Lockup {
+            capacity_nm: 600.0,
+            static_to_kinetic: 1.2,
+            engage_time_s: 0.5,
+            min_gear: 3,
+            engage_speed_zero_pedal_m_s: 12.0,
+            engage_speed_full_pedal_m_s: 25.0,
+        },
+        driveline: Driveline {
+            final_drive_ratio: 3.33,
+            shaft_stiffness_nm_per_rad: [6000.0, 9000.0],
+            shaft_damping_nm_s_per_rad: [30.0, 40.0],
+            axle_inertia_kg_m2: [2.2, 2.2],
+        },
+        tyres: Tyres {
+            rolling_radius_m: 0.345,
+            friction_coefficient: 1.0,
+            slip_stiffness: 15.0,
+            front_load_fraction: 0.57,
+        },
+        body: Body {
+            mass_kg: 2050.0,
+            drag_area_m2: 0.70,
+            rolling_resistance: 0.010,
+            air_density_kg_m3: 1.2,
+            grade_percent: 0.0,
+        },
         brake: Brake { capacity_nm: 6000.0, front_fraction: 0.6 },
     }
 }
@@ -60,7 +88,11 @@ fn run(model: &dyn ConverterDynamics, sc: &Scenario) -> LaunchTrajectory {
 fn models() -> Vec<(&'static str, Box<dyn ConverterDynamics>)> {
     // the bundled converter: quasi-dynamic with the magnitudes of the torus shape effects, and
     // Hrovat & Tobler fitted to the same table (as the thesis matched it, §3.2.1)
-    vec![("table", Box::new(table())), ("quasi-dynamic", Box::new(qd(0.00569, 0.00134))), ("hrovat-tobler", Box::new(ht_fitted(SHAPE)))]
+    vec![
+        ("table", Box::new(table())),
+        ("quasi-dynamic", Box::new(qd(0.00569, 0.00134))),
+        ("hrovat-tobler", Box::new(ht_fitted(SHAPE))),
+    ]
 }
 
 fn mean_accel(r: &LaunchTrajectory, from: f64, to: f64) -> f64 {
@@ -84,7 +116,13 @@ fn braked_vehicle_stands_still_and_table_and_quasi_dynamic_agree_at_stall() {
     // figure 3.5: the table and quasi-dynamic models share the tables, so they are identical at stall
     for (a, b) in runs[0].samples.iter().zip(&runs[1].samples).filter(|(a, _)| a.time_s < 5.0) {
         for c in [0, 1] {
-            assert!((a.u[c] - b.u[c]).abs() <= 1e-6 * a.u[0], "t {} coordinate {c}: {} vs {}", a.time_s, a.u[c], b.u[c]);
+            assert!(
+                (a.u[c] - b.u[c]).abs() <= 1e-6 * a.u[0],
+                "t {} coordinate {c}: {} vs {}",
+                a.time_s,
+                a.u[c],
+                b.u[c]
+            );
         }
     }
     // at stall the engine idles against the converter: its speed stays within 10 % of idle
@@ -168,7 +206,12 @@ fn braked_driveline_winds_up_by_the_stall_torque_and_tyres_limit_the_acceleratio
         // the shafts carry the stalled turbine torque through first gear (thesis §4.3.1)
         let turbine = -s.converter.torque[1];
         let shafts = s.shaft_torque_nm[0] + s.shaft_torque_nm[1];
-        assert!((shafts - turbine * v.gearbox.ratios[0]).abs() < 1e-3 * shafts, "t {}: {shafts} vs {}", s.time_s, turbine * v.gearbox.ratios[0]);
+        assert!(
+            (shafts - turbine * v.gearbox.ratios[0]).abs() < 1e-3 * shafts,
+            "t {}: {shafts} vs {}",
+            s.time_s,
+            turbine * v.gearbox.ratios[0]
+        );
         // split by stiffness, and no tyre force while the axles are held
         let split = s.shaft_torque_nm[0] / shafts;
         assert!((split - 6000.0 / 15000.0).abs() < 1e-6);
@@ -185,7 +228,13 @@ fn coasting_slows_down_and_the_brake_stops_and_holds_the_vehicle() {
     // then brings it to rest
     let t = vec![0.0, 5.0, 5.05, 8.0, 8.05, 20.0, 20.5, 40.0];
     let sc = Scenario {
-        accelerator_pedal: Signal::new("accelerator_pedal", t.clone(), vec![0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0], 0.0).unwrap(),
+        accelerator_pedal: Signal::new(
+            "accelerator_pedal",
+            t.clone(),
+            vec![0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+            0.0,
+        )
+        .unwrap(),
         brake_pedal: Signal::new("brake_pedal", t, vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0, 0.6, 0.6], 0.0).unwrap(),
         end_time_s: 40.0,
         stop_speed_m_s: None,
@@ -208,7 +257,13 @@ fn coasting_slows_down_and_the_brake_stops_and_holds_the_vehicle() {
 fn coast_and_brake(brake: f64) -> Scenario {
     let t = vec![0.0, 5.0, 5.05, 8.0, 8.05, 20.0, 20.5, 40.0];
     Scenario {
-        accelerator_pedal: Signal::new("accelerator_pedal", t.clone(), vec![0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0], 0.0).unwrap(),
+        accelerator_pedal: Signal::new(
+            "accelerator_pedal",
+            t.clone(),
+            vec![0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0, 0.0],
+            0.0,
+        )
+        .unwrap(),
         brake_pedal: Signal::new("brake_pedal", t, vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0, brake, brake], 0.0).unwrap(),
         end_time_s: 40.0,
         stop_speed_m_s: None,
@@ -221,7 +276,11 @@ fn a_light_brake_also_holds_the_stopped_vehicle() {
     // the brake's regularised creep speed stays below the hold threshold up to 95 % load
     for brake in [0.15, 0.25, 0.35] {
         let r = run(&table(), &coast_and_brake(brake));
-        assert!(r.events.iter().any(|e| e.kind == "brake-hold" && e.time_s > 20.0), "brake {brake}: {:?}", r.events.iter().map(|e| e.kind).collect::<Vec<_>>());
+        assert!(
+            r.events.iter().any(|e| e.kind == "brake-hold" && e.time_s > 20.0),
+            "brake {brake}: {:?}",
+            r.events.iter().map(|e| e.kind).collect::<Vec<_>>()
+        );
         assert!(r.samples.last().unwrap().u[SPEED].abs() < 1e-9);
     }
 }
@@ -233,7 +292,8 @@ fn a_lockup_clutch_that_breaks_away_locks_again() {
     v.lockup.capacity_nm = 350.0;
     let t = vec![0.0, 5.0, 5.05, 26.0, 26.05, 40.0];
     let sc = Scenario {
-        accelerator_pedal: Signal::new("accelerator_pedal", t.clone(), vec![0.0, 0.0, 0.3, 0.3, 0.6, 0.6], 0.0).unwrap(),
+        accelerator_pedal: Signal::new("accelerator_pedal", t.clone(), vec![0.0, 0.0, 0.3, 0.3, 0.6, 0.6], 0.0)
+            .unwrap(),
         brake_pedal: Signal::new("brake_pedal", t, vec![1.0, 1.0, 0.0, 0.0, 0.0, 0.0], 0.0).unwrap(),
         end_time_s: 40.0,
         stop_speed_m_s: None,
@@ -264,5 +324,8 @@ fn a_logged_engine_torque_replaces_the_engine_model() {
     let r2 = simulate_launch(&model, &sedan(), &replay, 0.01, &SolverOptions::default()).unwrap();
     let (a, b) = (r.samples.last().unwrap().time_s, r2.samples.last().unwrap().time_s);
     assert!((a - b).abs() < 0.02, "100 km/h at {a} vs {b} s");
-    assert_eq!(r.events.iter().map(|e| e.kind).collect::<Vec<_>>(), r2.events.iter().map(|e| e.kind).collect::<Vec<_>>());
+    assert_eq!(
+        r.events.iter().map(|e| e.kind).collect::<Vec<_>>(),
+        r2.events.iter().map(|e| e.kind).collect::<Vec<_>>()
+    );
 }

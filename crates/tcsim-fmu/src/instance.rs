@@ -2,12 +2,14 @@
 //! co-simulation stepper of the core. Safe Rust; the C boundary is in `lib.rs`.
 
 use serde_json::{Map, Value};
+use tcsim_core::dynamics::FLOW;
 use tcsim_core::dynamics::{build_model, ConverterDynamics, ModelSpec};
 use tcsim_core::outputs::{row, COLUMNS};
-use tcsim_core::stepper::{Causality, Stepper};
-use tcsim_core::dynamics::FLOW;
 use tcsim_core::signal::Signal;
-use tcsim_core::transient::{initial_mode, initial_state, Drive, InitialState, Mode, ModeView, Sample, SolverOptions, EVENT_INDICATORS};
+use tcsim_core::stepper::{Causality, Stepper};
+use tcsim_core::transient::{
+    initial_mode, initial_state, Drive, InitialState, Mode, ModeView, Sample, SolverOptions, EVENT_INDICATORS,
+};
 use tcsim_core::CoreResult;
 
 /// Value references of the signals, fixed whatever the causality; 12 and 13 are the rates of the
@@ -74,9 +76,14 @@ impl Configuration {
         let model = doc.get("model").and_then(Value::as_object).cloned().ok_or("model.json: no \"model\" object")?;
         let mut parameters = Vec::new();
         for (i, p) in doc.get("parameters").and_then(Value::as_array).cloned().unwrap_or_default().iter().enumerate() {
-            let key = p.get("key").and_then(Value::as_str).ok_or(format!("model.json: parameters[{i}] has no key"))?.to_string();
+            let key = p
+                .get("key")
+                .and_then(Value::as_str)
+                .ok_or(format!("model.json: parameters[{i}] has no key"))?
+                .to_string();
             let index = p.get("index").and_then(Value::as_u64).unwrap_or(0) as usize;
-            let start = spec_value(&model, &key, index).ok_or(format!("model.json: parameters[{i}] = {key}[{index}] is not a number of the model"))?;
+            let start = spec_value(&model, &key, index)
+                .ok_or(format!("model.json: parameters[{i}] = {key}[{index}] is not a number of the model"))?;
             parameters.push(Parameter { key, index, start, value: start });
         }
         Ok(Self { causality, model, parameters })
@@ -91,7 +98,11 @@ struct Spec<'a> {
 
 impl ModelSpec for Spec<'_> {
     fn kind(&self) -> CoreResult<String> {
-        self.model.get("kind").and_then(Value::as_str).map(str::to_string).ok_or_else(|| tcsim_core::CoreError::new("kind", "missing", "a model kind"))
+        self.model
+            .get("kind")
+            .and_then(Value::as_str)
+            .map(str::to_string)
+            .ok_or_else(|| tcsim_core::CoreError::new("kind", "missing", "a model kind"))
     }
     fn numbers(&self, key: &str) -> Option<Vec<f64>> {
         let mut v: Vec<f64> = match self.model.get(key)? {
@@ -220,7 +231,11 @@ impl Instance {
             self.signals[vr as usize] = value;
             return Ok(());
         }
-        let i = vr.checked_sub(FIRST_PARAMETER).map(|i| i as usize).filter(|&i| i < self.config.parameters.len()).ok_or(format!("no variable with value reference {vr}"))?;
+        let i = vr
+            .checked_sub(FIRST_PARAMETER)
+            .map(|i| i as usize)
+            .filter(|&i| i < self.config.parameters.len())
+            .ok_or(format!("no variable with value reference {vr}"))?;
         self.config.parameters[i].value = value;
         if self.stepper.is_some() {
             // tunable: check the new parameters now, apply them at the next step
@@ -228,14 +243,17 @@ impl Instance {
             self.rebuild = true;
         }
         if let Some(me) = self.me.as_mut() {
-            me.model = build_model(&Spec { model: &self.config.model, parameters: &self.config.parameters }).map_err(|e| e.to_string())?;
+            me.model = build_model(&Spec { model: &self.config.model, parameters: &self.config.parameters })
+                .map_err(|e| e.to_string())?;
         }
         Ok(())
     }
 
     pub fn set_rate(&mut self, vr: u32, order: i32, value: f64) -> Result<(), String> {
         if order != 1 || !self.input_refs().contains(&(vr as usize)) {
-            return Err(format!("input derivatives of order 1 of the inputs only (value reference {vr}, order {order})"));
+            return Err(format!(
+                "input derivatives of order 1 of the inputs only (value reference {vr}, order {order})"
+            ));
         }
         self.rates[vr as usize] = Some(value);
         Ok(())
@@ -263,7 +281,8 @@ impl Instance {
         let mut stepper = Stepper::new(model, self.config.causality, self.options);
         let refs = self.input_refs();
         let rates = [self.rates[refs[0]].unwrap_or(0.0), self.rates[refs[1]].unwrap_or(0.0)];
-        let sample = stepper.initialize(self.start_time, self.inputs(), rates, &self.initial()).map_err(|e| e.to_string())?;
+        let sample =
+            stepper.initialize(self.start_time, self.inputs(), rates, &self.initial()).map_err(|e| e.to_string())?;
         self.stepper = Some(stepper);
         self.previous = Some((self.start_time, self.inputs()));
         self.publish(&sample);
@@ -289,7 +308,10 @@ impl Instance {
         let end = [0, 1].map(|k| start[k] + h * self.rates[refs[k]].unwrap_or(estimated[k]));
         let stepper = self.stepper.as_mut().ok_or("fmi2DoStep before initialisation")?;
         if (stepper.time_s() - t).abs() > 1e-9 * t.abs().max(1.0) {
-            return Err(format!("communication point {t} s: expected the end of the last step, {} s", stepper.time_s()));
+            return Err(format!(
+                "communication point {t} s: expected the end of the last step, {} s",
+                stepper.time_s()
+            ));
         }
         let sample = stepper.do_step(h, start, end).map_err(|e| e.to_string())?;
         self.previous = Some((t, start));
@@ -356,7 +378,9 @@ mod tests {
     #[test]
     fn bad_configurations_and_parameters_are_errors() {
         assert!(Configuration::parse("{").is_err());
-        assert!(Configuration::parse(r#"{"model": {}, "parameters": [{"key": "x"}]}"#).unwrap_err().contains("parameters[0]"));
+        assert!(Configuration::parse(r#"{"model": {}, "parameters": [{"key": "x"}]}"#)
+            .unwrap_err()
+            .contains("parameters[0]"));
         let mut inst = Instance::new(Configuration::parse(CONFIG).unwrap());
         inst.set(100, -1.0).unwrap();
         assert!(inst.initialize().unwrap_err().contains("inertia.pump_kg_m2"));
@@ -380,16 +404,29 @@ impl Instance {
             return InitialState::default();
         }
         let pump = if self.config.causality == Causality::PumpTorqueTurbineSpeed { Some(self.start[1]) } else { None };
-        InitialState { pump_speed_rad_s: pump, turbine_speed_rad_s: None, stator_speed_rad_s: Some(self.start[2]), flow_m3_s: Some(self.start[3]) }
+        InitialState {
+            pump_speed_rad_s: pump,
+            turbine_speed_rad_s: None,
+            stator_speed_rad_s: Some(self.start[2]),
+            flow_m3_s: Some(self.start[3]),
+        }
     }
 
     /// The drive of the current inputs and their rates (linear about the current time).
     fn me_drive(&self, t: f64) -> Result<Drive, String> {
-        let line = |name: &str, value: f64, rate: f64| Signal::new(name, vec![t, t + 1.0], vec![value, value + rate], 0.0).map_err(|e| e.to_string());
+        let line = |name: &str, value: f64, rate: f64| {
+            Signal::new(name, vec![t, t + 1.0], vec![value, value + rate], 0.0).map_err(|e| e.to_string())
+        };
         let s = &self.signals;
         Ok(match self.config.causality {
-            Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed { pump_torque_nm: Signal::constant(s[0]), turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])? },
-            Causality::Speeds => Drive::Speeds { pump_speed_rad_s: line("pump_speed_rad_s", s[1], s[12])?, turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])? },
+            Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
+                pump_torque_nm: Signal::constant(s[0]),
+                turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])?,
+            },
+            Causality::Speeds => Drive::Speeds {
+                pump_speed_rad_s: line("pump_speed_rad_s", s[1], s[12])?,
+                turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])?,
+            },
         })
     }
 
@@ -495,7 +532,9 @@ impl Instance {
         let me = self.me.as_ref()?;
         if (FIRST_DERIVATIVE..FIRST_DERIVATIVE + 4).contains(&vr) {
             let drive = self.me_drive(me.time_s).ok()?;
-            return Some(ModeView::new(&me.model, &drive, me.mode).rates(&me.u, me.time_s)[(vr - FIRST_DERIVATIVE) as usize]);
+            return Some(
+                ModeView::new(&me.model, &drive, me.mode).rates(&me.u, me.time_s)[(vr - FIRST_DERIVATIVE) as usize],
+            );
         }
         if (vr as usize) < SIGNALS.len() {
             if self.settable(vr as usize) {

@@ -56,7 +56,11 @@ impl Component {
 }
 
 fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
-    payload.downcast_ref::<&str>().map(|s| s.to_string()).or_else(|| payload.downcast_ref::<String>().cloned()).unwrap_or_else(|| "unknown panic".into())
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "unknown panic".into())
 }
 
 /// Run `f` on the component; an error or a panic is logged and becomes `fmi2Error`.
@@ -102,7 +106,8 @@ unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], String> {
 fn resources_path(location: &str) -> String {
     let path = location.strip_prefix("file://").unwrap_or(location);
     // file:///C:/... on Windows; percent-encoded spaces
-    let path = if path.len() > 2 && path.as_bytes()[0] == b'/' && path.as_bytes()[2] == b':' { &path[1..] } else { path };
+    let path =
+        if path.len() > 2 && path.as_bytes()[0] == b'/' && path.as_bytes()[2] == b':' { &path[1..] } else { path };
     path.replace("%20", " ").trim_end_matches('/').to_string()
 }
 
@@ -117,7 +122,12 @@ pub extern "C" fn fmi2GetVersion() -> *const c_char {
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2SetDebugLogging(c: *mut c_void, _on: c_int, _n: usize, _categories: *const *const c_char) -> Status {
+pub unsafe extern "C" fn fmi2SetDebugLogging(
+    c: *mut c_void,
+    _on: c_int,
+    _n: usize,
+    _categories: *const *const c_char,
+) -> Status {
     unsafe { with(c, |_| Ok(())) }
 }
 
@@ -135,7 +145,15 @@ pub unsafe extern "C" fn fmi2Instantiate(
         let name = if name.is_null() { CString::default() } else { unsafe { CStr::from_ptr(name) }.to_owned() };
         let callbacks = if callbacks.is_null() { None } else { Some(unsafe { *callbacks }) };
         let fail = |msg: String| {
-            let comp = Component { name: name.clone(), callbacks, instance: Instance::new(Configuration { causality: tcsim_core::stepper::Causality::Speeds, model: Default::default(), parameters: vec![] }) };
+            let comp = Component {
+                name: name.clone(),
+                callbacks,
+                instance: Instance::new(Configuration {
+                    causality: tcsim_core::stepper::Causality::Speeds,
+                    model: Default::default(),
+                    parameters: vec![],
+                }),
+            };
             comp.log(ERROR, &msg);
             std::ptr::null_mut()
         };
@@ -170,7 +188,14 @@ pub unsafe extern "C" fn fmi2FreeInstance(c: *mut c_void) {
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2SetupExperiment(c: *mut c_void, tolerance_defined: c_int, tolerance: f64, start: f64, _stop_defined: c_int, _stop: f64) -> Status {
+pub unsafe extern "C" fn fmi2SetupExperiment(
+    c: *mut c_void,
+    tolerance_defined: c_int,
+    tolerance: f64,
+    start: f64,
+    _stop_defined: c_int,
+    _stop: f64,
+) -> Status {
     unsafe {
         with(c, |comp| {
             if tolerance_defined != 0 && tolerance.is_finite() && tolerance > 0.0 {
@@ -308,17 +333,36 @@ pub unsafe extern "C" fn fmi2SerializeFMUstate(c: *mut c_void, _s: *mut c_void, 
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2DeSerializeFMUstate(c: *mut c_void, _b: *const c_char, _n: usize, _s: *mut *mut c_void) -> Status {
+pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
+    c: *mut c_void,
+    _b: *const c_char,
+    _n: usize,
+    _s: *mut *mut c_void,
+) -> Status {
     unsafe { unsupported(c, "fmi2DeSerializeFMUstate") }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetDirectionalDerivative(c: *mut c_void, _u: *const u32, _nu: usize, _z: *const u32, _nz: usize, _dv: *const f64, _dz: *mut f64) -> Status {
+pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
+    c: *mut c_void,
+    _u: *const u32,
+    _nu: usize,
+    _z: *const u32,
+    _nz: usize,
+    _dv: *const f64,
+    _dz: *mut f64,
+) -> Status {
     unsafe { unsupported(c, "fmi2GetDirectionalDerivative") }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2SetRealInputDerivatives(c: *mut c_void, vr: *const u32, n: usize, order: *const c_int, values: *const f64) -> Status {
+pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
+    c: *mut c_void,
+    vr: *const u32,
+    n: usize,
+    order: *const c_int,
+    values: *const f64,
+) -> Status {
     unsafe {
         with(c, |comp| {
             for ((r, o), v) in slice(vr, n)?.iter().zip(slice(order, n)?).zip(slice(values, n)?) {
@@ -330,7 +374,13 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(c: *mut c_void, vr: *const 
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(c: *mut c_void, _vr: *const u32, _n: usize, _o: *const c_int, _v: *mut f64) -> Status {
+pub unsafe extern "C" fn fmi2GetRealOutputDerivatives(
+    c: *mut c_void,
+    _vr: *const u32,
+    _n: usize,
+    _o: *const c_int,
+    _v: *mut f64,
+) -> Status {
     unsafe { unsupported(c, "fmi2GetRealOutputDerivatives") }
 }
 
@@ -414,7 +464,12 @@ pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: *mut c_void) -> Status {
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2CompletedIntegratorStep(c: *mut c_void, _no_prior: c_int, enter_event_mode: *mut c_int, terminate: *mut c_int) -> Status {
+pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
+    c: *mut c_void,
+    _no_prior: c_int,
+    enter_event_mode: *mut c_int,
+    terminate: *mut c_int,
+) -> Status {
     unsafe {
         with(c, |_| {
             if !enter_event_mode.is_null() {

@@ -11,17 +11,28 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 
-use tcsim_core::batch::{ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs, TransientJob};
-use tcsim_core::dynamics::ConverterDynamics;
-use tcsim_core::signal::Signal;
-use tcsim_core::transient::{Drive, EventKind, InitialState, SolverOptions, TransientError, TurbineLoad};
-use tcsim_core::vehicle::{launch_column_names, simulate_launch, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres, Vehicle};
+use tcsim_core::batch::{
+    ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs,
+    TransientJob,
+};
 use tcsim_core::capacity::CapacityConvention;
+use tcsim_core::dynamics::ConverterDynamics;
 use tcsim_core::hrovat_tobler::{coupling_point, HtGeometry, HtParam, N_PARAMS};
+use tcsim_core::signal::Signal;
 use tcsim_core::table::Characteristic;
+use tcsim_core::transient::{Drive, EventKind, InitialState, SolverOptions, TransientError, TurbineLoad};
+use tcsim_core::vehicle::{
+    launch_column_names, simulate_launch, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres,
+    Vehicle,
+};
 use tcsim_core::CoreError;
 
-pyo3::create_exception!(_core, CoreInputError, PyValueError, "Bad input to the tcsim core: args are (message, field, value, expected).");
+pyo3::create_exception!(
+    _core,
+    CoreInputError,
+    PyValueError,
+    "Bad input to the tcsim core: args are (message, field, value, expected)."
+);
 
 fn input_error(e: CoreError) -> PyErr {
     CoreInputError::new_err((e.to_string(), e.field, e.value, e.expected))
@@ -66,7 +77,10 @@ fn geometry_rows(geometry: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<HtGeometr
 }
 
 fn param(key: &str) -> PyResult<HtParam> {
-    HtParam::ALL.into_iter().find(|p| p.key() == key).ok_or_else(|| PyValueError::new_err(format!("unknown Hrovat & Tobler parameter {key:?}")))
+    HtParam::ALL
+        .into_iter()
+        .find(|p| p.key() == key)
+        .ok_or_else(|| PyValueError::new_err(format!("unknown Hrovat & Tobler parameter {key:?}")))
 }
 
 /// Names of the capacity conventions.
@@ -77,7 +91,11 @@ fn capacity_conventions() -> Vec<&'static str> {
 
 /// Convert values in `convention` to capacity factor in N·m/(rad/s)².
 #[pyfunction]
-fn capacity_to_cf<'py>(py: Python<'py>, convention_key: &str, values: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn capacity_to_cf<'py>(
+    py: Python<'py>,
+    convention_key: &str,
+    values: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let c = convention(convention_key)?;
         Ok(slice(&values, "values")?.iter().map(|&v| c.to_capacity_factor(v)).collect::<Vec<_>>().into_pyarray(py))
@@ -86,7 +104,11 @@ fn capacity_to_cf<'py>(py: Python<'py>, convention_key: &str, values: PyReadonly
 
 /// Convert capacity factors in N·m/(rad/s)² to `convention`.
 #[pyfunction]
-fn cf_to_capacity<'py>(py: Python<'py>, convention_key: &str, cf: PyReadonlyArray1<'py, f64>) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn cf_to_capacity<'py>(
+    py: Python<'py>,
+    convention_key: &str,
+    cf: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let c = convention(convention_key)?;
         Ok(slice(&cf, "cf")?.iter().map(|&v| c.from_capacity_factor(v)).collect::<Vec<_>>().into_pyarray(py))
@@ -105,7 +127,8 @@ fn ht_parameter_names() -> Vec<&'static str> {
 fn ht_check_geometry(geometry: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
     guard(|| {
         let v = slice(&geometry, "geometry")?;
-        let arr: [f64; N_PARAMS] = v.try_into().map_err(|_| PyValueError::new_err(format!("geometry must have {N_PARAMS} values")))?;
+        let arr: [f64; N_PARAMS] =
+            v.try_into().map_err(|_| PyValueError::new_err(format!("geometry must have {N_PARAMS} values")))?;
         HtGeometry::new(arr).map(|_| ()).map_err(input_error)
     })
 }
@@ -124,13 +147,16 @@ fn ht_steady_states<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let g = geometry_rows(&geometry)?;
-        let (wp, wt) = (slice(&pump_speed_rad_s, "pump_speed_rad_s")?, slice(&turbine_speed_rad_s, "turbine_speed_rad_s")?);
+        let (wp, wt) =
+            (slice(&pump_speed_rad_s, "pump_speed_rad_s")?, slice(&turbine_speed_rad_s, "turbine_speed_rad_s")?);
         if wp.len() != wt.len() || (g.len() != 1 && g.len() != wp.len()) {
-            return Err(PyValueError::new_err("pump and turbine speeds need equal lengths, and geometry one row or one row per point"));
+            return Err(PyValueError::new_err(
+                "pump and turbine speeds need equal lengths, and geometry one row or one row per point",
+            ));
         }
-        let cols = py
-            .detach(|| core_steady_states(&g, wp, wt, strict))
-            .map_err(|e| input_error(CoreError { field: format!("{} (point {})", e.error.field, e.index), ..e.error }))?;
+        let cols = py.detach(|| core_steady_states(&g, wp, wt, strict)).map_err(|e| {
+            input_error(CoreError { field: format!("{} (point {})", e.error.field, e.index), ..e.error })
+        })?;
         let d = PyDict::new(py);
         d.set_item("flow_m3_s", cols.flow_m3_s.into_pyarray(py))?;
         d.set_item("stator_speed_rad_s", cols.stator_speed_rad_s.into_pyarray(py))?;
@@ -161,7 +187,12 @@ fn ht_ratio_gradients<'py>(
     pump_speed_rad_s: f64,
     speed_ratio: PyReadonlyArray1<'py, f64>,
     free: Vec<String>,
-) -> PyResult<(Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>)> {
+) -> PyResult<(
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray1<f64>>,
+    Bound<'py, PyArray2<f64>>,
+    Bound<'py, PyArray2<f64>>,
+)> {
     guard(|| {
         let g = geometry_rows(&geometry)?;
         let g = *g.first().ok_or_else(|| PyValueError::new_err("geometry has no row"))?;
@@ -175,14 +206,26 @@ fn ht_ratio_gradients<'py>(
     })
 }
 
-fn characteristic(sr: &PyReadonlyArray1<'_, f64>, tr: &PyReadonlyArray1<'_, f64>, cf: &PyReadonlyArray1<'_, f64>) -> PyResult<Characteristic> {
-    Characteristic::new(slice(sr, "speed_ratio")?.to_vec(), slice(tr, "torque_ratio")?.to_vec(), slice(cf, "capacity_factor_nm_s2")?.to_vec())
-        .map_err(input_error)
+fn characteristic(
+    sr: &PyReadonlyArray1<'_, f64>,
+    tr: &PyReadonlyArray1<'_, f64>,
+    cf: &PyReadonlyArray1<'_, f64>,
+) -> PyResult<Characteristic> {
+    Characteristic::new(
+        slice(sr, "speed_ratio")?.to_vec(),
+        slice(tr, "torque_ratio")?.to_vec(),
+        slice(cf, "capacity_factor_nm_s2")?.to_vec(),
+    )
+    .map_err(input_error)
 }
 
 /// Validate a characteristic table (finite, strictly increasing SR, equal lengths).
 #[pyfunction]
-fn table_check(speed_ratio: PyReadonlyArray1<'_, f64>, torque_ratio: PyReadonlyArray1<'_, f64>, capacity_factor_nm_s2: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+fn table_check(
+    speed_ratio: PyReadonlyArray1<'_, f64>,
+    torque_ratio: PyReadonlyArray1<'_, f64>,
+    capacity_factor_nm_s2: PyReadonlyArray1<'_, f64>,
+) -> PyResult<()> {
     guard(|| characteristic(&speed_ratio, &torque_ratio, &capacity_factor_nm_s2).map(|_| ()))
 }
 
@@ -199,14 +242,23 @@ fn table_steady_states<'py>(
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let t = characteristic(&speed_ratio, &torque_ratio, &capacity_factor_nm_s2)?;
-        let (wp, wt) = (slice(&pump_speed_rad_s, "pump_speed_rad_s")?, slice(&turbine_speed_rad_s, "turbine_speed_rad_s")?);
+        let (wp, wt) =
+            (slice(&pump_speed_rad_s, "pump_speed_rad_s")?, slice(&turbine_speed_rad_s, "turbine_speed_rad_s")?);
         if wp.len() != wt.len() {
             return Err(PyValueError::new_err("pump and turbine speeds need equal lengths"));
         }
         let points = py
-            .detach(|| wp.iter().zip(wt).enumerate().map(|(i, (&p, &t_))| t.operating_point(p, t_).map_err(|e| (i, e))).collect::<Result<Vec<_>, _>>())
+            .detach(|| {
+                wp.iter()
+                    .zip(wt)
+                    .enumerate()
+                    .map(|(i, (&p, &t_))| t.operating_point(p, t_).map_err(|e| (i, e)))
+                    .collect::<Result<Vec<_>, _>>()
+            })
             .map_err(|(i, e)| input_error(CoreError { field: format!("{} (point {i})", e.field), ..e }))?;
-        let col = |f: fn(&tcsim_core::table::TableOperatingPoint) -> f64| points.iter().map(f).collect::<Vec<_>>().into_pyarray(py);
+        let col = |f: fn(&tcsim_core::table::TableOperatingPoint) -> f64| {
+            points.iter().map(f).collect::<Vec<_>>().into_pyarray(py)
+        };
         let d = PyDict::new(py);
         d.set_item("speed_ratio", col(|p| p.speed_ratio))?;
         d.set_item("torque_ratio", col(|p| p.torque_ratio))?;
@@ -233,7 +285,9 @@ fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -
     match d.get_item(key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
-        Some(v) => v.extract::<T>().map(Some).map_err(|e| PyValueError::new_err(format!("{key}: {}", Into::<PyErr>::into(e)))),
+        Some(v) => {
+            v.extract::<T>().map(Some).map_err(|e| PyValueError::new_err(format!("{key}: {}", Into::<PyErr>::into(e))))
+        }
     }
 }
 
@@ -274,7 +328,10 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
             pump_torque_nm: signal_from(d, "pump_torque_nm", window)?,
             turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)?,
         },
-        "speeds" => Drive::Speeds { pump_speed_rad_s: signal_from(d, "pump_speed_rad_s", window)?, turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)? },
+        "speeds" => Drive::Speeds {
+            pump_speed_rad_s: signal_from(d, "pump_speed_rad_s", window)?,
+            turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)?,
+        },
         "pump-torque-load" => {
             let load = TurbineLoad {
                 torque_nm: signal_from(d, "load_torque_nm", window)?,
@@ -282,10 +339,18 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
                 drag_nm_s2: opt_item(d, "load_drag_nm_s2")?.unwrap_or(0.0),
             };
             if !(load.inertia_kg_m2.is_finite() && load.inertia_kg_m2 >= 0.0) {
-                return Err(input_error(CoreError::new("load_inertia_kg_m2", load.inertia_kg_m2, "a finite inertia of zero or more in kg·m²")));
+                return Err(input_error(CoreError::new(
+                    "load_inertia_kg_m2",
+                    load.inertia_kg_m2,
+                    "a finite inertia of zero or more in kg·m²",
+                )));
             }
             if !(load.drag_nm_s2.is_finite() && load.drag_nm_s2 >= 0.0) {
-                return Err(input_error(CoreError::new("load_drag_nm_s2", load.drag_nm_s2, "a finite drag coefficient of zero or more")));
+                return Err(input_error(CoreError::new(
+                    "load_drag_nm_s2",
+                    load.drag_nm_s2,
+                    "a finite drag coefficient of zero or more",
+                )));
             }
             Drive::PumpTorqueLoad { pump_torque_nm: signal_from(d, "pump_torque_nm", window)?, load }
         }
@@ -313,7 +378,12 @@ fn options_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<SolverOptions> {
         o.first_step_s = opt_item(d, "first_step_s")?.unwrap_or(o.first_step_s);
         o.max_events = opt_item(d, "max_events")?.unwrap_or(o.max_events);
     }
-    for (k, v) in [("rtol", o.rtol), ("speed_atol_rad_s", o.speed_atol_rad_s), ("flow_atol_m3_s", o.flow_atol_m3_s), ("first_step_s", o.first_step_s)] {
+    for (k, v) in [
+        ("rtol", o.rtol),
+        ("speed_atol_rad_s", o.speed_atol_rad_s),
+        ("flow_atol_m3_s", o.flow_atol_m3_s),
+        ("first_step_s", o.first_step_s),
+    ] {
         if !(v.is_finite() && v > 0.0) {
             return Err(input_error(CoreError::new(k, v, "a finite, positive tolerance")));
         }
@@ -333,7 +403,12 @@ fn event_name(k: EventKind) -> &'static str {
 /// The smoothed derivative the transient engine uses for given speeds (local least-squares slope
 /// over ±window/2, tcsim_core::signal), at the sample times.
 #[pyfunction]
-fn smoothed_rate<'py>(py: Python<'py>, time_s: PyReadonlyArray1<'py, f64>, values: PyReadonlyArray1<'py, f64>, window_s: f64) -> PyResult<Bound<'py, PyArray1<f64>>> {
+fn smoothed_rate<'py>(
+    py: Python<'py>,
+    time_s: PyReadonlyArray1<'py, f64>,
+    values: PyReadonlyArray1<'py, f64>,
+    window_s: f64,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let t = slice(&time_s, "time_s")?.to_vec();
         let s = Signal::new("values", t.clone(), slice(&values, "values")?.to_vec(), window_s).map_err(input_error)?;
@@ -363,7 +438,11 @@ fn transient_runs<'py>(
 ) -> PyResult<Vec<Py<PyAny>>> {
     guard(|| {
         let n = models.len().max(drives.len());
-        if models.is_empty() || drives.is_empty() || (models.len() != n && models.len() != 1) || (drives.len() != n && drives.len() != 1) {
+        if models.is_empty()
+            || drives.is_empty()
+            || (models.len() != n && models.len() != 1)
+            || (drives.len() != n && drives.len() != 1)
+        {
             return Err(PyValueError::new_err("models and drives must have equal lengths, or one of them length one"));
         }
         let init = init_from(init.as_ref())?;
@@ -372,7 +451,13 @@ fn transient_runs<'py>(
         let jobs = (0..n)
             .map(|i| {
                 let (drive, times) = &parsed_drives[if parsed_drives.len() == 1 { 0 } else { i }];
-                Ok(TransientJob { model: model_from(&models[if models.len() == 1 { 0 } else { i }])?, drive: drive.clone(), times_s: times.clone(), init, options })
+                Ok(TransientJob {
+                    model: model_from(&models[if models.len() == 1 { 0 } else { i }])?,
+                    drive: drive.clone(),
+                    times_s: times.clone(),
+                    init,
+                    options,
+                })
             })
             .collect::<PyResult<Vec<_>>>()?;
         let results = py.detach(|| run_transient_jobs(&jobs, threads));
@@ -385,11 +470,18 @@ fn transient_runs<'py>(
                         for (name, col) in tcsim_core::outputs::COLUMNS.iter().zip(cols) {
                             d.set_item(*name, col.into_pyarray(py))?;
                         }
-                        let ev: Vec<(f64, &str, bool, f64)> = events.iter().map(|e| (e.time_s, event_name(e.kind), e.mode.stator_locked, e.mode.flow_sign)).collect();
+                        let ev: Vec<(f64, &str, bool, f64)> = events
+                            .iter()
+                            .map(|e| (e.time_s, event_name(e.kind), e.mode.stator_locked, e.mode.flow_sign))
+                            .collect();
                         ("ok", d, ev).into_pyobject(py)?.into_any().unbind()
                     }
-                    Err(TransientError::Input(e)) => ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind(),
-                    Err(e @ TransientError::Solver { .. }) => ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind(),
+                    Err(TransientError::Input(e)) => {
+                        ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind()
+                    }
+                    Err(e @ TransientError::Solver { .. }) => {
+                        ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind()
+                    }
                 })
             })
             .collect()
@@ -418,7 +510,12 @@ fn vehicle_from(d: &Bound<'_, PyDict>) -> PyResult<Vehicle> {
         engine: Engine {
             inertia_kg_m2: item(&e, "inertia_kg_m2")?,
             idle_speed_rad_s: item(&e, "idle_speed_rad_s")?,
-            full_load: Curve::new("engine.full_load_speed_rad_s", item(&e, "full_load_speed_rad_s")?, item(&e, "full_load_torque_nm")?).map_err(input_error)?,
+            full_load: Curve::new(
+                "engine.full_load_speed_rad_s",
+                item(&e, "full_load_speed_rad_s")?,
+                item(&e, "full_load_torque_nm")?,
+            )
+            .map_err(input_error)?,
             drag_torque_nm: item(&e, "drag_torque_nm")?,
             drag_nm_s_per_rad: item(&e, "drag_nm_s_per_rad")?,
             fast_time_constant_s: item(&e, "fast_time_constant_s")?,
@@ -448,8 +545,14 @@ fn vehicle_from(d: &Bound<'_, PyDict>) -> PyResult<Vehicle> {
         },
         driveline: Driveline {
             final_drive_ratio: item(&dl, "final_drive_ratio")?,
-            shaft_stiffness_nm_per_rad: [item(&dl, "front_shaft_stiffness_nm_per_rad")?, item(&dl, "rear_shaft_stiffness_nm_per_rad")?],
-            shaft_damping_nm_s_per_rad: [item(&dl, "front_shaft_damping_nm_s_per_rad")?, item(&dl, "rear_shaft_damping_nm_s_per_rad")?],
+            shaft_stiffness_nm_per_rad: [
+                item(&dl, "front_shaft_stiffness_nm_per_rad")?,
+                item(&dl, "rear_shaft_stiffness_nm_per_rad")?,
+            ],
+            shaft_damping_nm_s_per_rad: [
+                item(&dl, "front_shaft_damping_nm_s_per_rad")?,
+                item(&dl, "rear_shaft_damping_nm_s_per_rad")?,
+            ],
             axle_inertia_kg_m2: [item(&dl, "front_axle_inertia_kg_m2")?, item(&dl, "rear_axle_inertia_kg_m2")?],
         },
         tyres: Tyres {
@@ -471,7 +574,8 @@ fn vehicle_from(d: &Bound<'_, PyDict>) -> PyResult<Vehicle> {
 
 fn scenario_from(d: &Bound<'_, PyDict>) -> PyResult<Scenario> {
     let t: Vec<f64> = item(d, "time_s")?;
-    let signal = |key: &str| -> PyResult<Signal> { Signal::new(key, t.clone(), item(d, key)?, 0.0).map_err(input_error) };
+    let signal =
+        |key: &str| -> PyResult<Signal> { Signal::new(key, t.clone(), item(d, key)?, 0.0).map_err(input_error) };
     Ok(Scenario {
         accelerator_pedal: signal("accelerator_pedal")?,
         brake_pedal: signal("brake_pedal")?,
@@ -535,8 +639,12 @@ fn launch_runs<'py>(
                         let ev: Vec<(f64, &str, usize)> = events.iter().map(|e| (e.time_s, e.kind, e.gear)).collect();
                         ("ok", d, ev).into_pyobject(py)?.into_any().unbind()
                     }
-                    Err(TransientError::Input(e)) => ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind(),
-                    Err(e @ TransientError::Solver { .. }) => ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind(),
+                    Err(TransientError::Input(e)) => {
+                        ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind()
+                    }
+                    Err(e @ TransientError::Solver { .. }) => {
+                        ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind()
+                    }
                 })
             })
             .collect()
