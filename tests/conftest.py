@@ -2,13 +2,18 @@
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import subprocess
 import sys
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+
+from tcsim.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_CONVERTERS = REPO.parent / "shared" / "data" / "converters"
@@ -41,17 +46,36 @@ class Run:
 
 
 def run_cli(*args: str, cwd: Path | None = None) -> Run:
-    """Run ``python -m tcsim`` in a subprocess, as a user would."""
+    """Run ``python -m tcsim`` in a subprocess, as a user would (for the few smoke tests)."""
     env = dict(os.environ, COLUMNS="200")
     p = subprocess.run(
-        [sys.executable, "-m", "tcsim", *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=300
+        [sys.executable, "-m", "tcsim", *map(str, args)], capture_output=True, text=True, cwd=cwd, env=env, timeout=600
     )
     return Run(p.returncode, p.stdout, p.stderr)
 
 
+def run_cli_in_process(*args: str, cwd: Path | None = None) -> Run:
+    """Run ``tcsim.cli.main`` in this process, with its own stdout, stderr, warning filters and
+    working directory, and a 200-column terminal; an exception that escapes ``main`` fails the test."""
+    out, err = io.StringIO(), io.StringIO()
+    here = os.getcwd()
+    with contextlib.ExitStack() as stack:
+        stack.enter_context(contextlib.redirect_stdout(out))
+        stack.enter_context(contextlib.redirect_stderr(err))
+        stack.enter_context(warnings.catch_warnings())
+        stack.enter_context(pytest.MonkeyPatch.context()).setenv("COLUMNS", "200")
+        warnings.simplefilter("default")
+        if cwd is not None:
+            os.chdir(cwd)
+            stack.callback(os.chdir, here)
+        code = main([str(a) for a in args])
+    return Run(code, out.getvalue(), err.getvalue())
+
+
 @pytest.fixture
 def cli():
-    return run_cli
+    """The command line, in-process (``run_cli`` is the subprocess form for smoke tests)."""
+    return run_cli_in_process
 
 
 @pytest.fixture
