@@ -66,28 +66,29 @@ def test_batch_equals_single_runs_and_broadcasts():
 
 
 def test_batch_releases_the_gil():
-    """A Python thread keeps running while the core integrates a batch."""
+    """A Python thread keeps running while the core integrates a batch (no clock involved: the
+    other thread counts how often it ran Python code while the batch call was in progress)."""
     base = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
     models = [base.with_shape_effects(0.01 * (i % 3), 0.0) for i in range(400)]
-    ticks = 0
+    in_call = threading.Event()
     done = threading.Event()
+    ticks = 0
 
     def count():
         nonlocal ticks
+        in_call.wait()
         while not done.is_set():
             ticks += 1
             time.sleep(0.001)
 
     th = threading.Thread(target=count)
     th.start()
-    t0 = time.perf_counter()
+    in_call.set()
     tr.simulate_batch(models, [tr.isolated_takeoff()], times_s=np.linspace(0, 10, 11), threads=1)
-    elapsed = time.perf_counter() - t0
     done.set()
     th.join()
-    # with the GIL held the counter could not move at all during the call
-    assert elapsed > 0.02
-    assert ticks >= 5, (ticks, elapsed)
+    # with the GIL held for the call the counter could move at most once or twice (switch interval)
+    assert ticks >= 5, ticks
 
 
 def test_inadmissible_shape_effect_names_the_bound():
