@@ -16,7 +16,7 @@ import pytest
 from tcsim.cli import main
 
 REPO = Path(__file__).resolve().parents[1]
-SHARED_CONVERTERS = REPO.parent / "shared" / "data" / "converters"
+CONVERTER_DATA = REPO / "tests" / "data" / "converters"  # published tables (tests/data/README.md)
 
 # Li & Sundén (2016) Table C.1 with CF in N·m/(rad/s)²
 C1_SR = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0]

@@ -9,7 +9,7 @@ import pandas as pd
 import pytest
 
 import tcsim
-from conftest import C1_CF, C1_SR, C1_TR, SHARED_CONVERTERS
+from conftest import C1_CF, C1_SR, C1_TR, CONVERTER_DATA
 from tcsim import _core
 from tcsim.converter import load_converter
 from tcsim.steady import characterise, coupling_point
@@ -44,9 +44,8 @@ def test_table_model_holds_end_values_outside_the_table(ls):
     np.testing.assert_allclose(df["capacity_factor_nm_s2"], [3.272e-3, 0.187e-3], rtol=1e-15)
 
 
-@pytest.mark.skipif(not SHARED_CONVERTERS.exists(), reason="shared converter tables not present")
 def test_overrun_rows_of_jambe_trami_table_reverse_the_torque():
-    conv = load_converter(SHARED_CONVERTERS / "jambe_trami_9at.csv")
+    conv = load_converter(CONVERTER_DATA / "jambe_trami_9at.csv")
     df = characterise(conv, "table")
     assert df["speed_ratio"].min() == pytest.approx(-0.1) and df["speed_ratio"].max() == pytest.approx(2.1)
     over = df[df["speed_ratio"] > 1.0]

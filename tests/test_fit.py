@@ -21,7 +21,7 @@ from tcsim.converter import Characteristic, load_converter
 from tcsim.errors import InputError, TcsimWarning
 from tcsim.fitting import DEFAULT_FREE, LOSSES, PUMP_SPEED_RAD_S, RADII, fit_hrovat_tobler, target_table
 
-SHARED_TABLES = Path(__file__).resolve().parents[2] / "shared" / "data" / "converters"
+SHARED_TABLES = Path(__file__).resolve().parent / "data" / "converters"
 
 
 @pytest.fixture(scope="module")
@@ -227,10 +227,9 @@ def test_api_raises_input_errors(bundled):
 
 
 def shared_tables() -> list[Path]:
-    return sorted(SHARED_TABLES.glob("*.csv")) if SHARED_TABLES.is_dir() else []
+    return sorted(SHARED_TABLES.glob("*.csv"))
 
 
-@pytest.mark.skipif(not SHARED_TABLES.is_dir(), reason=f"{SHARED_TABLES} does not exist")
 @pytest.mark.parametrize("path", shared_tables(), ids=lambda p: p.stem)
 def test_fit_runs_on_every_shared_table(path, bundled):
     with warnings.catch_warnings():
