@@ -3,8 +3,8 @@
 //! These loops are what the Python API calls (with the GIL released) for characteristics, the
 //! parameter study and the fit.
 
+use crate::converter::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode};
 use crate::error::CoreError;
-use crate::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode};
 use crate::scalar::{Dual, Scalar};
 
 /// Column-wise steady states of the Hrovat & Tobler model.
@@ -171,27 +171,27 @@ mod tests {
 
 /// One transient run of a batch.
 pub struct TransientJob {
-    pub model: Box<dyn crate::dynamics::ConverterDynamics + Send>,
-    pub drive: crate::transient::Drive,
+    pub model: Box<dyn crate::converter::dynamics::ConverterDynamics + Send>,
+    pub drive: crate::engine::isolated::Drive,
     pub times_s: Vec<f64>,
-    pub init: crate::transient::InitialState,
-    pub options: crate::transient::SolverOptions,
+    pub init: crate::engine::isolated::InitialState,
+    pub options: crate::engine::options::SolverOptions,
 }
 
-/// Columns of a run (see [`crate::outputs::COLUMNS`]) and its events.
-pub type RunOutput = (Vec<Vec<f64>>, Vec<crate::transient::Event>);
+/// Columns of a run (see [`crate::engine::outputs::COLUMNS`]) and its events.
+pub type RunOutput = (Vec<Vec<f64>>, Vec<crate::engine::isolated::Event>);
 
 /// Run `f`, turning a panic into a solver error instead of unwinding.
 pub fn catch_panic<T>(
-    f: impl FnOnce() -> crate::transient::TransientResult<T>,
-) -> crate::transient::TransientResult<T> {
+    f: impl FnOnce() -> crate::engine::options::TransientResult<T>,
+) -> crate::engine::options::TransientResult<T> {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
         let msg = payload
             .downcast_ref::<&str>()
             .map(|s| s.to_string())
             .or_else(|| payload.downcast_ref::<String>().cloned())
             .unwrap_or_else(|| "unknown panic".into());
-        Err(crate::transient::TransientError::Solver {
+        Err(crate::engine::options::TransientError::Solver {
             time_s: f64::NAN,
             state: vec![],
             message: format!("internal error: {msg}"),
@@ -200,10 +200,11 @@ pub fn catch_panic<T>(
 }
 
 /// Run one job.
-pub fn run_transient_job(job: &TransientJob) -> crate::transient::TransientResult<RunOutput> {
+pub fn run_transient_job(job: &TransientJob) -> crate::engine::options::TransientResult<RunOutput> {
     catch_panic(|| {
-        let traj = crate::transient::simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
-        Ok((crate::outputs::columns(job.model.as_ref(), &traj), traj.events))
+        let traj =
+            crate::engine::isolated::simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
+        Ok((crate::engine::outputs::columns(job.model.as_ref(), &traj), traj.events))
     })
 }
 
@@ -237,6 +238,9 @@ pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J)
 }
 
 /// Run all jobs on `threads` worker threads (0: one per core). Results are in job order.
-pub fn run_transient_jobs(jobs: &[TransientJob], threads: usize) -> Vec<crate::transient::TransientResult<RunOutput>> {
+pub fn run_transient_jobs(
+    jobs: &[TransientJob],
+    threads: usize,
+) -> Vec<crate::engine::options::TransientResult<RunOutput>> {
     parallel_map(jobs, threads, run_transient_job)
 }

@@ -3,11 +3,13 @@
 mod common;
 
 use common::*;
-use tcsim_core::dynamics::ConverterDynamics;
-use tcsim_core::hrovat_tobler::{coupling_point, steady_state, HtGeometry, StatorMode};
-use tcsim_core::outputs::{columns, COLUMNS};
-use tcsim_core::signal::Signal;
-use tcsim_core::transient::{simulate, Drive, EventKind, InitialState, SolverOptions, Trajectory};
+use tcsim_core::converter::dynamics::ConverterDynamics;
+use tcsim_core::converter::hrovat_tobler::{coupling_point, steady_state, HtGeometry, StatorMode};
+use tcsim_core::engine::converter_events::EventKind;
+use tcsim_core::engine::isolated::{simulate, Drive, InitialState, Trajectory};
+use tcsim_core::engine::options::SolverOptions;
+use tcsim_core::engine::outputs::{columns, COLUMNS};
+use tcsim_core::engine::signal::Signal;
 
 fn col<'a>(cols: &'a [Vec<f64>], name: &str) -> &'a [f64] {
     &cols[COLUMNS.iter().position(|c| *c == name).unwrap_or_else(|| panic!("no column {name}"))]
@@ -316,7 +318,7 @@ fn bad_runs_are_input_errors() {
         turbine_speed_rad_s: Signal::constant(0.0),
     };
     match simulate(&ht(SHAPE), &drive, &t, &InitialState::default(), &SolverOptions::default()) {
-        Err(tcsim_core::transient::TransientError::Input(e)) => assert_eq!(e.field, "initial pump_torque_nm"),
+        Err(tcsim_core::engine::options::TransientError::Input(e)) => assert_eq!(e.field, "initial pump_torque_nm"),
         other => panic!("{other:?}"),
     }
     let init = InitialState {
@@ -332,7 +334,7 @@ fn bad_runs_are_input_errors() {
 #[test]
 fn a_run_stepped_interval_by_interval_follows_the_single_run() {
     // the co-simulation engine: inputs piecewise linear on the communication grid
-    use tcsim_core::stepper::{Causality, Stepper};
+    use tcsim_core::engine::stepper::{Causality, Stepper};
     let tp = |t: f64| {
         if t < 0.1 {
             40.0

@@ -15,15 +15,18 @@ use tcsim_core::batch::{
     ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs,
     TransientJob,
 };
-use tcsim_core::capacity::CapacityConvention;
-use tcsim_core::dynamics::ConverterDynamics;
-use tcsim_core::hrovat_tobler::{coupling_point, HtGeometry, HtParam, N_PARAMS};
-use tcsim_core::signal::Signal;
-use tcsim_core::table::Characteristic;
-use tcsim_core::transient::{Drive, EventKind, InitialState, SolverOptions, TransientError, TurbineLoad};
-use tcsim_core::vehicle::{
-    launch_column_names, simulate_launch, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres,
-    Vehicle,
+use tcsim_core::converter::capacity::CapacityConvention;
+use tcsim_core::converter::dynamics::ConverterDynamics;
+use tcsim_core::converter::hrovat_tobler::{coupling_point, HtGeometry, HtParam, N_PARAMS};
+use tcsim_core::converter::table::Characteristic;
+use tcsim_core::engine::converter_events::EventKind;
+use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
+use tcsim_core::engine::options::{SolverOptions, TransientError};
+use tcsim_core::engine::signal::Signal;
+use tcsim_core::vehicle::launch::simulate_launch;
+use tcsim_core::vehicle::outputs::launch_column_names;
+use tcsim_core::vehicle::parameters::{
+    Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres, Vehicle,
 };
 use tcsim_core::CoreError;
 
@@ -256,7 +259,7 @@ fn table_steady_states<'py>(
                     .collect::<Result<Vec<_>, _>>()
             })
             .map_err(|(i, e)| input_error(CoreError { field: format!("{} (point {i})", e.field), ..e }))?;
-        let col = |f: fn(&tcsim_core::table::TableOperatingPoint) -> f64| {
+        let col = |f: fn(&tcsim_core::converter::table::TableOperatingPoint) -> f64| {
             points.iter().map(f).collect::<Vec<_>>().into_pyarray(py)
         };
         let d = PyDict::new(py);
@@ -294,7 +297,7 @@ fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -
 /// A Python dict as a core model specification.
 struct DictSpec<'a, 'py>(&'a Bound<'py, PyDict>);
 
-impl tcsim_core::dynamics::ModelSpec for DictSpec<'_, '_> {
+impl tcsim_core::converter::spec::ModelSpec for DictSpec<'_, '_> {
     fn kind(&self) -> tcsim_core::CoreResult<String> {
         item::<String>(self.0, "kind").map_err(|e| CoreError::new("kind", e, "a model kind"))
     }
@@ -305,7 +308,7 @@ impl tcsim_core::dynamics::ModelSpec for DictSpec<'_, '_> {
 }
 
 fn model_from(d: &Bound<'_, PyDict>) -> PyResult<Box<dyn ConverterDynamics + Send>> {
-    tcsim_core::dynamics::build_model(&DictSpec(d)).map_err(input_error)
+    tcsim_core::converter::spec::build_model(&DictSpec(d)).map_err(input_error)
 }
 
 fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal> {
@@ -318,7 +321,8 @@ fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal
 
 fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
     let kind: String = item(d, "kind")?;
-    let window: f64 = opt_item(d, "derivative_window_s")?.unwrap_or(tcsim_core::signal::DEFAULT_DERIVATIVE_WINDOW_S);
+    let window: f64 =
+        opt_item(d, "derivative_window_s")?.unwrap_or(tcsim_core::engine::signal::DEFAULT_DERIVATIVE_WINDOW_S);
     let out: Vec<f64> = match opt_item(d, "output_time_s")? {
         Some(t) => t,
         None => item(d, "time_s")?,
@@ -392,12 +396,7 @@ fn options_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<SolverOptions> {
 }
 
 fn event_name(k: EventKind) -> &'static str {
-    match k {
-        EventKind::StatorRelease => "stator-release",
-        EventKind::StatorLock => "stator-lock",
-        EventKind::FlowZero => "flow-zero",
-        EventKind::FlowStart => "flow-start",
-    }
+    k.name()
 }
 
 /// The smoothed derivative the transient engine uses for given speeds (local least-squares slope
@@ -419,7 +418,7 @@ fn smoothed_rate<'py>(
 /// Output column names of a transient run.
 #[pyfunction]
 fn transient_columns() -> Vec<&'static str> {
-    tcsim_core::outputs::COLUMNS.to_vec()
+    tcsim_core::engine::outputs::COLUMNS.to_vec()
 }
 
 /// Run transient jobs: `models[i]` under `drives[i]` (a list of length one is broadcast), with
@@ -467,7 +466,7 @@ fn transient_runs<'py>(
                 Ok(match r {
                     Ok((cols, events)) => {
                         let d = PyDict::new(py);
-                        for (name, col) in tcsim_core::outputs::COLUMNS.iter().zip(cols) {
+                        for (name, col) in tcsim_core::engine::outputs::COLUMNS.iter().zip(cols) {
                             d.set_item(*name, col.into_pyarray(py))?;
                         }
                         let ev: Vec<(f64, &str, bool, f64)> = events
@@ -622,7 +621,7 @@ fn launch_runs<'py>(
             tcsim_core::batch::parallel_map(&parsed, threads, |m| {
                 tcsim_core::batch::catch_panic(|| {
                     let traj = simulate_launch(m.as_ref(), &v, &sc, step, &solver)?;
-                    Ok((tcsim_core::vehicle::launch_columns(m.as_ref(), &sc, &traj), traj.events))
+                    Ok((tcsim_core::vehicle::outputs::launch_columns(m.as_ref(), &sc, &traj), traj.events))
                 })
             })
         });

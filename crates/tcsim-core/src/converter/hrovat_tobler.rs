@@ -475,7 +475,7 @@ pub fn coupling_point(g: &HtGeometry<f64>) -> Option<f64> {
 mod tests {
     use super::*;
 
-    const WP: f64 = 2000.0 * std::f64::consts::PI / 30.0;
+    const WP: f64 = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
 
     fn eq_2_15_rhs(g: &HtGeometry<f64>, wp: f64, wt: f64, ws: f64, flow: f64) -> f64 {
         // Direct transcription of the right-hand side of eq 2.15 with eqs 2.19–2.25, Q > 0.

@@ -3,7 +3,7 @@
 
 use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
 
-use crate::transient::{Hysteresis, SolverOptions, TransientError, TransientResult};
+use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
 
 type Matrix = NalgebraMat<f64>;
 type Lu = NalgebraLU<f64>;

@@ -14,6 +14,7 @@
 //! steady-state sweeps therefore stay inside the table, and overrun needs a table that has it.
 
 use crate::error::{CoreError, CoreResult};
+use crate::interp;
 
 /// A torque-converter characteristic: TR and CF against SR.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,12 +125,9 @@ impl Characteristic {
         if sr > x[n - 1] {
             return held(n - 1);
         }
-        // first index with x[i] > sr, clamped so that [i-1, i] is a segment
-        let i = x.partition_point(|&xi| xi <= sr).clamp(1, n - 1);
+        let (i, w) = interp::segment(x, sr);
         let h = x[i] - x[i - 1];
-        let w = (sr - x[i - 1]) / h;
-        // (1 − w)·y0 + w·y1 returns the table values exactly at the nodes
-        let lerp = |y: &[f64]| ((1.0 - w) * y[i - 1] + w * y[i], (y[i] - y[i - 1]) / h);
+        let lerp = |y: &[f64]| (interp::mix(y, i, w), (y[i] - y[i - 1]) / h);
         let (tr, dtr) = lerp(&self.torque_ratio);
         let (cf, dcf) = lerp(&self.capacity_factor_nm_s2);
         Lookup {
