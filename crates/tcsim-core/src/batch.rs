@@ -3,7 +3,7 @@
 //! These loops are what the Python API calls (with the GIL released) for characteristics, the
 //! parameter study and the fit.
 
-use crate::converter::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode};
+use crate::converter::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE};
 use crate::error::CoreError;
 use crate::scalar::{Dual, Scalar};
 
@@ -64,7 +64,7 @@ pub fn ht_steady_states(
                 out.pump_torque_nm.push(s.pump_torque_nm);
                 out.turbine_torque_nm.push(s.turbine_torque_nm);
                 out.stator_torque_nm.push(s.stator_torque_nm);
-                out.stator_mode.push(s.mode as i8);
+                out.stator_mode.push(s.mode.code());
             }
             Err(error) if strict => return Err(PointError { index: i, error }),
             Err(_) => {
@@ -77,7 +77,7 @@ pub fn ht_steady_states(
                 ] {
                     col.push(f64::NAN);
                 }
-                out.stator_mode.push(-1);
+                out.stator_mode.push(NO_STEADY_STATE);
             }
         }
     }

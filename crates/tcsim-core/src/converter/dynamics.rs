@@ -272,42 +272,36 @@ impl HtDynamics {
 
     /// `ρ L_f / A`, the fluid's own inertance.
     pub fn fluid_inertance(&self) -> f64 {
-        self.geometry.get(HtParam::FluidDensity) * self.fluid_length_m / self.geometry.get(HtParam::FlowArea)
+        self.mass_matrix_bound().inertance_kg_m4
     }
 
-    /// Largest admissible magnitude of each shape effect with the others as given: M is positive
-    /// definite iff `ρL_f/A > Σ ρ² S_x² / I_x` (the Schur complement of the diagonal inertias).
+    /// The admissibility of the mass matrix with these parameters.
+    pub fn mass_matrix_bound(&self) -> MassMatrixBound {
+        MassMatrixBound::new(&self.geometry, &self.inertia, self.fluid_length_m, self.shape_effect_m2)
+    }
+
+    /// Largest admissible magnitude of each shape effect with the others as given (see
+    /// [`MassMatrixBound::shape_effect_bounds`]).
     pub fn shape_effect_bounds(&self) -> [f64; 3] {
-        let rho = self.geometry.get(HtParam::FluidDensity);
-        let inertia = self.inertia_array();
-        let terms: [f64; 3] = std::array::from_fn(|i| rho * rho * self.shape_effect_m2[i].powi(2) / inertia[i]);
-        std::array::from_fn(|i| {
-            let room = self.fluid_inertance() - (terms.iter().sum::<f64>() - terms[i]);
-            if room <= 0.0 {
-                0.0
-            } else {
-                (room * inertia[i]).sqrt() / rho
-            }
-        })
+        self.mass_matrix_bound().shape_effect_bounds()
     }
 
     fn check_mass_matrix(&self) -> CoreResult<()> {
-        let rho = self.geometry.get(HtParam::FluidDensity);
-        let inertia = self.inertia_array();
-        let terms: [f64; 3] = std::array::from_fn(|i| rho * rho * self.shape_effect_m2[i].powi(2) / inertia[i]);
-        if self.fluid_inertance() - terms.iter().sum::<f64>() > 0.0 {
+        let b = self.mass_matrix_bound();
+        if b.margin_kg_m4() > 0.0 {
             return Ok(());
         }
         // blame the largest contribution
+        let terms = b.shape_terms_kg_m4;
         let i = (0..3).max_by(|&a, &b| terms[a].total_cmp(&terms[b])).unwrap_or(0);
-        let bound = self.shape_effect_bounds()[i];
+        let bound = b.shape_effect_bounds()[i];
         Err(CoreError::new(
             SHAPE_KEYS[i],
             self.shape_effect_m2[i],
             format!(
                 "|S| < {} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
                 sig(bound),
-                sig(self.fluid_inertance()),
+                sig(b.inertance_kg_m4),
                 sig(terms.iter().sum::<f64>())
             ),
         ))
@@ -329,6 +323,53 @@ impl HtDynamics {
             friction: g.get(FrictionLoss) * (3.0 + t[0] * t[0] + t[1] * t[1] + t[2] * t[2]),
             r,
         }
+    }
+}
+
+/// The admissibility bound of the Hrovat & Tobler mass matrix on the shape effects (physics notes
+/// §4): `M` is positive definite iff `ρL_f/A > Σ ρ²S_x²/I_x` (the Schur complement of the diagonal
+/// inertias). Computed for any parameters, admissible or not.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MassMatrixBound {
+    /// Fluid density ρ, kg/m³.
+    pub density_kg_m3: f64,
+    /// Pump, turbine and stator inertias `I_x`, kg·m².
+    pub inertia_kg_m2: [f64; 3],
+    /// `ρ L_f / A`, the fluid's own inertance, kg/m⁴.
+    pub inertance_kg_m4: f64,
+    /// `ρ² S_x² / I_x` for pump, turbine and stator, kg/m⁴.
+    pub shape_terms_kg_m4: [f64; 3],
+}
+
+impl MassMatrixBound {
+    pub fn new(geometry: &HtGeometry<f64>, inertia: &Inertias, fluid_length_m: f64, shape_effect_m2: [f64; 3]) -> Self {
+        let rho = geometry.get(HtParam::FluidDensity);
+        let inertia = [inertia.pump_kg_m2, inertia.turbine_kg_m2, inertia.stator_kg_m2];
+        MassMatrixBound {
+            density_kg_m3: rho,
+            inertia_kg_m2: inertia,
+            inertance_kg_m4: rho * fluid_length_m / geometry.get(HtParam::FlowArea),
+            shape_terms_kg_m4: std::array::from_fn(|i| rho * rho * shape_effect_m2[i].powi(2) / inertia[i]),
+        }
+    }
+
+    /// `ρL_f/A − Σ ρ²S_x²/I_x`, kg/m⁴: the mass matrix is admissible iff this is positive.
+    pub fn margin_kg_m4(&self) -> f64 {
+        self.inertance_kg_m4 - self.shape_terms_kg_m4.iter().sum::<f64>()
+    }
+
+    /// Largest admissible magnitude of each shape effect with the others as given, m² (0 when the
+    /// others already use up the inertance).
+    pub fn shape_effect_bounds(&self) -> [f64; 3] {
+        let (rho, inertia, terms) = (self.density_kg_m3, self.inertia_kg_m2, self.shape_terms_kg_m4);
+        std::array::from_fn(|i| {
+            let room = self.inertance_kg_m4 - (terms.iter().sum::<f64>() - terms[i]);
+            if room <= 0.0 {
+                0.0
+            } else {
+                (room * inertia[i]).sqrt() / rho
+            }
+        })
     }
 }
 
@@ -540,6 +581,19 @@ mod tests {
         let f = h.forces(&p.u, 1.0);
         assert!(f[FLOW].abs() < 1e-9 * 840.0 * 0.0144 * 209.4f64.powi(2));
         assert!((-f[PUMP] - p.pump_torque_nm).abs() < 1e-10 * p.pump_torque_nm);
+    }
+
+    #[test]
+    fn mass_matrix_bound_is_the_models_check() {
+        let shape = [0.004, -0.003, 0.001];
+        let m = ht(shape);
+        let b = MassMatrixBound::new(&m.geometry, &m.inertia, m.fluid_length_m, shape);
+        assert_eq!(b.inertance_kg_m4, m.fluid_inertance());
+        assert_eq!(b.shape_effect_bounds(), m.shape_effect_bounds());
+        assert!(b.margin_kg_m4() > 0.0);
+        let too_big = MassMatrixBound::new(&m.geometry, &m.inertia, m.fluid_length_m, [1.0, 0.0, 0.0]);
+        assert!(too_big.margin_kg_m4() <= 0.0);
+        assert!(HtDynamics::new(m.geometry, m.inertia, m.fluid_length_m, [1.0, 0.0, 0.0]).is_err());
     }
 
     #[test]

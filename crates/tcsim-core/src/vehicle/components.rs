@@ -16,6 +16,13 @@ pub const BRAKE_SPEED_RAD_S: f64 = 0.002;
 /// Scale of the regularised rolling-resistance sign, m/s.
 pub const ROLL_SPEED_M_S: f64 = 0.01;
 
+/// The engine's friction and pumping drag at speed `w` (rad/s), N·m, opposing rotation: a
+/// constant part `drag_torque_nm` with its sign regularised over 1 rad/s (tanh) and a viscous part
+/// `drag_nm_s_per_rad·w`. This is the drag of the vehicle plant ([`Engine::drag`]).
+pub fn engine_drag_nm(w: f64, drag_torque_nm: f64, drag_nm_s_per_rad: f64) -> f64 {
+    drag_torque_nm * (w / 1.0).tanh() + drag_nm_s_per_rad * w
+}
+
 impl Curve {
     /// The value at `x`: linear between points, ends held.
     pub fn at(&self, x: f64) -> f64 {
@@ -32,7 +39,7 @@ impl Engine {
     }
     /// Friction and pumping drag, opposing rotation.
     pub fn drag(&self, w: f64) -> f64 {
-        self.drag_torque_nm * (w / 1.0).tanh() + self.drag_nm_s_per_rad * w
+        engine_drag_nm(w, self.drag_torque_nm, self.drag_nm_s_per_rad)
     }
     /// Targets of the aspirated and boost torque parts for pedal `p` at speed `w`.
     pub fn targets(&self, p: f64, w: f64) -> (f64, f64) {
@@ -172,5 +179,13 @@ mod tests {
         assert_eq!(l.engage_speed(2.0), 25.0);
         let bad = Lockup { static_to_kinetic: 0.9, ..l };
         assert_eq!(bad.validate().unwrap_err().field, "lockup.static_to_kinetic");
+    }
+
+    #[test]
+    fn engine_drag_is_the_plant_drag() {
+        let e = engine();
+        for w in [-50.0, 0.0, 0.3, 80.0, 600.0] {
+            assert_eq!(engine_drag_nm(w, e.drag_torque_nm, e.drag_nm_s_per_rad), e.drag(w));
+        }
     }
 }
