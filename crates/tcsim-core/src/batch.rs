@@ -121,51 +121,6 @@ pub fn ht_ratio_gradients(
     (tr, cf, dtr, dcf)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn batch_matches_pointwise_and_reports_failures() {
-        let g = HtGeometry::appendix_d();
-        let wp = [200.0, 200.0, 200.0];
-        let wt = [0.0, 100.0, 260.0];
-        let lenient = ht_steady_states(&[g], &wp, &wt, false).unwrap();
-        let one = steady_state(&g, 200.0, 100.0).unwrap();
-        assert_eq!(lenient.pump_torque_nm[1], one.pump_torque_nm);
-        assert_eq!(lenient.stator_mode[2], -1);
-        assert!(lenient.flow_m3_s[2].is_nan());
-        let strict = ht_steady_states(&[g], &wp, &wt, true).unwrap_err();
-        assert_eq!(strict.index, 2);
-        assert_eq!(strict.error.field, "speed_ratio");
-    }
-
-    #[test]
-    fn ratio_gradients_match_finite_differences() {
-        let g = HtGeometry::appendix_d();
-        let sr = [0.0, 0.4, 0.8, 0.95];
-        let free = [HtParam::PumpExitAngle, HtParam::FrictionLoss, HtParam::PumpExitRadius];
-        let (tr, cf, dtr, dcf) = ht_ratio_gradients(&g, 209.4, &sr, &free);
-        for (j, p) in free.iter().enumerate() {
-            let h = 1e-7;
-            let mut v = g.values;
-            v[p.index()] += h;
-            let (tr2, cf2, _, _) = ht_ratio_gradients(&HtGeometry { values: v }, 209.4, &sr, &[]);
-            for i in 0..sr.len() {
-                let (fd_tr, fd_cf) = ((tr2[i] - tr[i]) / h, (cf2[i] - cf[i]) / h);
-                assert!(
-                    (dtr[i * 3 + j] - fd_tr).abs() < 1e-5 * (1.0 + fd_tr.abs()),
-                    "{} SR {}: {} vs {fd_tr}",
-                    p.key(),
-                    sr[i],
-                    dtr[i * 3 + j]
-                );
-                assert!((dcf[i * 3 + j] - fd_cf).abs() < 1e-5 * (1e-3 + fd_cf.abs()), "{} SR {}", p.key(), sr[i]);
-            }
-        }
-    }
-}
-
 // ---------------------------------------------------------------------------------------------
 // Transient runs
 
@@ -243,4 +198,49 @@ pub fn run_transient_jobs(
     threads: usize,
 ) -> Vec<crate::engine::options::TransientResult<RunOutput>> {
     parallel_map(jobs, threads, run_transient_job)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn batch_matches_pointwise_and_reports_failures() {
+        let g = HtGeometry::appendix_d();
+        let wp = [200.0, 200.0, 200.0];
+        let wt = [0.0, 100.0, 260.0];
+        let lenient = ht_steady_states(&[g], &wp, &wt, false).unwrap();
+        let one = steady_state(&g, 200.0, 100.0).unwrap();
+        assert_eq!(lenient.pump_torque_nm[1], one.pump_torque_nm);
+        assert_eq!(lenient.stator_mode[2], -1);
+        assert!(lenient.flow_m3_s[2].is_nan());
+        let strict = ht_steady_states(&[g], &wp, &wt, true).unwrap_err();
+        assert_eq!(strict.index, 2);
+        assert_eq!(strict.error.field, "speed_ratio");
+    }
+
+    #[test]
+    fn ratio_gradients_match_finite_differences() {
+        let g = HtGeometry::appendix_d();
+        let sr = [0.0, 0.4, 0.8, 0.95];
+        let free = [HtParam::PumpExitAngle, HtParam::FrictionLoss, HtParam::PumpExitRadius];
+        let (tr, cf, dtr, dcf) = ht_ratio_gradients(&g, 209.4, &sr, &free);
+        for (j, p) in free.iter().enumerate() {
+            let h = 1e-7;
+            let mut v = g.values;
+            v[p.index()] += h;
+            let (tr2, cf2, _, _) = ht_ratio_gradients(&HtGeometry { values: v }, 209.4, &sr, &[]);
+            for i in 0..sr.len() {
+                let (fd_tr, fd_cf) = ((tr2[i] - tr[i]) / h, (cf2[i] - cf[i]) / h);
+                assert!(
+                    (dtr[i * 3 + j] - fd_tr).abs() < 1e-5 * (1.0 + fd_tr.abs()),
+                    "{} SR {}: {} vs {fd_tr}",
+                    p.key(),
+                    sr[i],
+                    dtr[i * 3 + j]
+                );
+                assert!((dcf[i * 3 + j] - fd_cf).abs() < 1e-5 * (1e-3 + fd_cf.abs()), "{} SR {}", p.key(), sr[i]);
+            }
+        }
+    }
 }

@@ -239,13 +239,13 @@ fn hrovat_tobler_follows_its_steady_state_when_the_flow_is_quasi_steady() {
     let (_, cols) = run(&ht([0.0; 3]), &drive, &t, InitialState::default());
     let g = HtGeometry::appendix_d();
     let mut worst = 0.0f64;
-    for i in 1..t.len() {
+    for (i, &time) in t.iter().enumerate().skip(1) {
         let (wp, wt) = (col(&cols, "pump_speed_rad_s")[i], col(&cols, "turbine_speed_rad_s")[i]);
         let ss = steady_state(&g, wp, wt).unwrap();
         let tp = col(&cols, "pump_torque_nm")[i] - 0.109 * 10.0; // minus the pump inertia torque I_p ω̇_p
         worst = worst.max((tp - ss.pump_torque_nm).abs() / ss.pump_torque_nm);
         // the flow lags its steady value by τ_Q·|Q̇|/Q ≈ 3 ms × 0.005/0.08 s⁻¹ ≈ 2·10⁻⁴
-        assert!((tp - ss.pump_torque_nm).abs() < 3e-4 * ss.pump_torque_nm, "t {}: {tp} vs {}", t[i], ss.pump_torque_nm);
+        assert!((tp - ss.pump_torque_nm).abs() < 3e-4 * ss.pump_torque_nm, "t {time}: {tp} vs {}", ss.pump_torque_nm);
     }
     println!("Hrovat & Tobler, S = 0, slow ramp: largest relative difference from the closed form {worst:.2e}");
 }

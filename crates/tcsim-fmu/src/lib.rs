@@ -8,6 +8,9 @@
 //! (`python/tcsim/fmu.py`). Every entry point catches panics: none crosses the C boundary; a
 //! failure returns `fmi2Error` with its message through the logger callback.
 
+// The `unsafe extern "C"` functions are the FMI 2.0 C API, called by the host with the pointers
+// the standard defines; their safety contract is the FMI specification, not a per-function
+// `# Safety` section.
 #![allow(clippy::missing_safety_doc)]
 
 mod instance;

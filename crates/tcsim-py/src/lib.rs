@@ -186,22 +186,20 @@ fn ht_coupling_point(geometry: PyReadonlyArray2<'_, f64>) -> PyResult<Option<f64
     })
 }
 
+/// `(tr, cf, d_tr, d_cf)` of [`ht_ratio_gradients`].
+type RatioGradients<'py> =
+    (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// TR and CF at `speed_ratio` (pump at `pump_speed_rad_s`) with exact derivatives with respect to
 /// the parameters named in `free`: returns (tr, cf, d_tr, d_cf), derivatives shaped (n, len(free)).
 #[pyfunction]
-#[allow(clippy::type_complexity)]
 fn ht_ratio_gradients<'py>(
     py: Python<'py>,
     geometry: PyReadonlyArray2<'py, f64>,
     pump_speed_rad_s: f64,
     speed_ratio: PyReadonlyArray1<'py, f64>,
     free: Vec<String>,
-) -> PyResult<(
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-)> {
+) -> PyResult<RatioGradients<'py>> {
     guard(|| {
         let g = geometry_rows(&geometry)?;
         let g = *g.first().ok_or_else(|| PyValueError::new_err("geometry has no row"))?;
@@ -240,7 +238,6 @@ fn table_check(
 
 /// Steady states of the table model at `pump[i], turbine[i]` (rad/s). Returns a dict of arrays.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 fn table_steady_states<'py>(
     py: Python<'py>,
     speed_ratio: PyReadonlyArray1<'py, f64>,

@@ -475,6 +475,39 @@ impl ConverterDynamics for HtDynamics {
     }
 }
 
+impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
+    fn coordinates(&self) -> [bool; 4] {
+        (**self).coordinates()
+    }
+    fn mass(&self) -> Mat4 {
+        (**self).mass()
+    }
+    fn forces(&self, u: &Vec4, s: f64) -> Vec4 {
+        (**self).forces(u, s)
+    }
+    fn force_jacobian(&self, u: &Vec4, s: f64) -> Mat4 {
+        (**self).force_jacobian(u, s)
+    }
+    fn transferred(&self, f: &Vec4) -> (f64, f64) {
+        (**self).transferred(f)
+    }
+    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
+        (**self).loss_power_w(u, f)
+    }
+    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
+        (**self).steady_point(wp, wt)
+    }
+    fn has_stator_clutch(&self) -> bool {
+        (**self).has_stator_clutch()
+    }
+    fn has_flow_sign(&self) -> bool {
+        (**self).has_flow_sign()
+    }
+    fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
+        (**self).zero_flow_head(u)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -611,38 +644,5 @@ mod tests {
         let b = ht([0.0; 3]).shape_effect_bounds()[1];
         assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.0, 0.999 * b, 0.0]).is_ok());
         assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.0, 1.001 * b, 0.0]).is_err());
-    }
-}
-
-impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
-    fn coordinates(&self) -> [bool; 4] {
-        (**self).coordinates()
-    }
-    fn mass(&self) -> Mat4 {
-        (**self).mass()
-    }
-    fn forces(&self, u: &Vec4, s: f64) -> Vec4 {
-        (**self).forces(u, s)
-    }
-    fn force_jacobian(&self, u: &Vec4, s: f64) -> Mat4 {
-        (**self).force_jacobian(u, s)
-    }
-    fn transferred(&self, f: &Vec4) -> (f64, f64) {
-        (**self).transferred(f)
-    }
-    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
-        (**self).loss_power_w(u, f)
-    }
-    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
-        (**self).steady_point(wp, wt)
-    }
-    fn has_stator_clutch(&self) -> bool {
-        (**self).has_stator_clutch()
-    }
-    fn has_flow_sign(&self) -> bool {
-        (**self).has_flow_sign()
-    }
-    fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
-        (**self).zero_flow_head(u)
     }
 }

@@ -1,5 +1,6 @@
 //! Shared scenarios for the transient tests: the bundled li-sunden-2016 converter and the
 //! isolated take-off of `bench/scipy_reference.py`.
+// Each test binary includes this module and uses a different part of it.
 #![allow(dead_code)]
 
 use tcsim_core::converter::dynamics::{HtDynamics, Inertias, TableDynamics};
