@@ -1,8 +1,9 @@
 //! `tcsim._core`: the thin PyO3 layer over `tcsim-core`.
 //!
 //! Every entry point converts NumPy arrays to slices, releases the GIL for the computation and
-//! turns a core error into `tcsim._core.CoreError(message, field, value, expected)`. A Rust panic
-//! is caught here and becomes a `RuntimeError`; it never unwinds into Python.
+//! turns a core error ([`CoreError`]) into `tcsim._core.CoreInputError(message, field, value,
+//! expected)`. A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
+//! Python.
 
 use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};

@@ -232,7 +232,7 @@ struct HtConst {
     area: f64,
     r2: [f64; 3],
     /// R_x tan α_x at each exit.
-    rt: [f64; 3],
+    radius_tan: [f64; 3],
     /// Coefficients of q in the shock velocities (eqs 2.20–2.22).
     b: [f64; 3],
     c: [f64; 3],
@@ -316,7 +316,7 @@ impl HtDynamics {
             rho: g.get(FluidDensity),
             area: g.get(FlowArea),
             r2: r.map(|x| x * x),
-            rt: [r[0] * t[0], r[1] * t[1], r[2] * t[2]],
+            radius_tan: [r[0] * t[0], r[1] * t[1], r[2] * t[2]],
             // pump inlet from stator exit, turbine inlet from pump exit, stator inlet from turbine exit
             b: [t[2] - ti[0], t[0] - ti[1], t[1] - ti[2]],
             c: [g.get(PumpShockLoss), g.get(TurbineShockLoss), g.get(StatorShockLoss)],
@@ -406,12 +406,13 @@ impl ConverterDynamics for HtDynamics {
         let flow = u[FLOW];
         let q = flow / k.area;
         // angular momentum per unit mass flow leaving each element
-        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.rt[i] * q);
+        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.radius_tan[i] * q);
         let head = k.r2[0] * w[0] * w[0] + k.r2[1] * w[1] * w[1] + k.r2[2] * w[2] * w[2]
             - k.r2[2] * w[0] * w[2]
             - k.r2[0] * w[1] * w[0]
             - k.r2[1] * w[2] * w[1];
-        let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
+        let a =
+            [k.radius_tan[0] - k.radius_tan[2], k.radius_tan[1] - k.radius_tan[0], k.radius_tan[2] - k.radius_tan[1]];
         let linear = q * (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]);
         let v = shock_velocities(k, &w, q);
         let loss =
@@ -429,8 +430,9 @@ impl ConverterDynamics for HtDynamics {
         let w = [u[PUMP], u[TURBINE], u[STATOR]];
         let flow = u[FLOW];
         let q = flow / area;
-        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.rt[i] * q);
-        let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
+        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.radius_tan[i] * q);
+        let a =
+            [k.radius_tan[0] - k.radius_tan[2], k.radius_tan[1] - k.radius_tan[0], k.radius_tan[2] - k.radius_tan[1]];
         let v = shock_velocities(k, &w, q);
         let mut j = [[0.0; 4]; 4];
         // torques: F_i = −ρ (h_i − h_prev(i)) Q with prev = stator, pump, turbine
@@ -439,7 +441,7 @@ impl ConverterDynamics for HtDynamics {
             let p = prev[i];
             j[i][i] = -rho * k.r2[i] * flow;
             j[i][p] = rho * k.r2[p] * flow;
-            j[i][FLOW] = -rho * (h[i] - h[p]) - rho * flow * (k.rt[i] - k.rt[p]) / area;
+            j[i][FLOW] = -rho * (h[i] - h[p]) - rho * flow * (k.radius_tan[i] - k.radius_tan[p]) / area;
         }
         // head of eq 2.15
         let dhead = [

@@ -154,11 +154,11 @@ pub fn flow_sign_from_balance((d, p0): (f64, f64)) -> f64 {
 
 /// Switch `mode` for `root` and adjust `u` (a locking stator stops, a reversing flow passes zero).
 /// `flow_sign_at_zero` gives the sign of the flow that starts from the adjusted `u` (Q = 0).
-pub fn switch<const N: usize>(
+pub fn switch<const LEN: usize>(
     root: ConverterRoot,
     mode: &mut Mode,
-    u: &mut [f64; N],
-    flow_sign_at_zero: impl FnOnce(&[f64; N]) -> f64,
+    u: &mut [f64; LEN],
+    flow_sign_at_zero: impl FnOnce(&[f64; LEN]) -> f64,
 ) -> EventKind {
     match root {
         ConverterRoot::StatorTorque => mode.stator_locked = false,
