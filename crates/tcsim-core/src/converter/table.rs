@@ -219,7 +219,7 @@ mod tests {
     #[test]
     fn overrun_rows_reverse_the_pump_torque() {
         // JAMBE/TRAMI 9AT excerpt: negative capacity above SR = 1 (turbine drives the pump).
-        let c = |v: f64| v * (60.0 / (2.0 * std::f64::consts::PI)).powi(2);
+        let c = |v: f64| v * crate::units::RPM_PER_RAD_S.powi(2);
         let t = Characteristic::new(vec![0.9, 1.0, 1.1, 1.2], vec![1.0; 4], vec![c(30e-6), 0.0, c(-5e-6), c(-10e-6)])
             .unwrap();
         let op = t.operating_point(200.0, 230.0).unwrap();
@@ -231,7 +231,7 @@ mod tests {
     #[test]
     fn torques_balance_and_follow_eq_2_8_and_2_9() {
         let t = c1();
-        let wp = 2000.0 * std::f64::consts::PI / 30.0;
+        let wp = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
         let op = t.operating_point(wp, 0.3 * wp).unwrap();
         assert!((op.pump_torque_nm - 3.181e-3 * wp * wp).abs() < 1e-9);
         assert!((op.turbine_torque_nm - 1.70 * op.pump_torque_nm).abs() < 1e-9);

@@ -19,7 +19,8 @@ use crate::engine::options::Hysteresis;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Mode {
     pub stator_locked: bool,
-    /// Sign of Q in the losses: +1, −1, or 0 while the flow is held at zero.
+    /// Sign of Q in the losses: +1, −1, or 0 while the flow is held at zero. The output column
+    /// `flow_direction` ([`crate::engine::outputs::COLUMNS`]) and the events' flow field carry it.
     pub flow_sign: f64,
 }
 
