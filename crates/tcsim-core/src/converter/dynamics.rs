@@ -16,7 +16,7 @@
 //!
 //! * [`TableDynamics`]: the steady-state table with pump and turbine inertias, eqs 2.8–2.11.
 //! * [`HtDynamics`]: Hrovat & Tobler, eqs 2.12–2.25.
-//! * [`QuasiDynamics`]: tcsim's quasi-dynamic model (tables plus fluid inertia), physics notes §5.
+//! * [`QuasiDynamics`](super::quasi_dynamic::QuasiDynamics): tcsim's quasi-dynamic model (tables plus fluid inertia), physics notes §5.
 //!
 //! Sign conventions follow physics notes §2: `T_ext` holds the external torques on pump, turbine
 //! and stator; the torque delivered to the transmission is `−T_ext[TURBINE]`.

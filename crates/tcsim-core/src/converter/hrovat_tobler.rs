@@ -301,7 +301,7 @@ pub fn steady_mode_names() -> Vec<(i8, &'static str)> {
 }
 
 /// The torque ratio of a steady state from its `stator_mode` code and torques (the rule of
-/// [`SteadyState::torque_ratio`] on batch columns): 1 in `no-flow` (zero torques, TR = 1 by
+/// [`HtSteadyState::torque_ratio`] on batch columns): 1 in `no-flow` (zero torques, TR = 1 by
 /// continuity), else `T_t / T_p` (a zero pump torque divides by 1); NaN without a steady state.
 pub fn steady_torque_ratio(stator_mode: i8, pump_torque_nm: f64, turbine_torque_nm: f64) -> f64 {
     if stator_mode == StatorMode::NoFlow.code() {
