@@ -2,11 +2,12 @@
 //! `cargo run --release --example takeoff_timing`.
 use std::time::Instant;
 
-use tcsim_core::dynamics::{HtDynamics, Inertias};
-use tcsim_core::hrovat_tobler::HtGeometry;
-use tcsim_core::outputs::columns;
-use tcsim_core::signal::Signal;
-use tcsim_core::transient::{simulate, Drive, InitialState, SolverOptions, TurbineLoad};
+use tcsim_core::converter::dynamics::{HtDynamics, Inertias};
+use tcsim_core::converter::hrovat_tobler::HtGeometry;
+use tcsim_core::engine::isolated::{simulate, Drive, InitialState, TurbineLoad};
+use tcsim_core::engine::options::SolverOptions;
+use tcsim_core::engine::outputs::columns;
+use tcsim_core::engine::signal::Signal;
 
 fn main() {
     let model = HtDynamics::new(

@@ -3,8 +3,8 @@
 //! These loops are what the Python API calls (with the GIL released) for characteristics, the
 //! parameter study and the fit.
 
+use crate::converter::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE};
 use crate::error::CoreError;
-use crate::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode};
 use crate::scalar::{Dual, Scalar};
 
 /// Column-wise steady states of the Hrovat & Tobler model.
@@ -64,7 +64,7 @@ pub fn ht_steady_states(
                 out.pump_torque_nm.push(s.pump_torque_nm);
                 out.turbine_torque_nm.push(s.turbine_torque_nm);
                 out.stator_torque_nm.push(s.stator_torque_nm);
-                out.stator_mode.push(s.mode as i8);
+                out.stator_mode.push(s.mode.code());
             }
             Err(error) if strict => return Err(PointError { index: i, error }),
             Err(_) => {
@@ -77,7 +77,7 @@ pub fn ht_steady_states(
                 ] {
                     col.push(f64::NAN);
                 }
-                out.stator_mode.push(-1);
+                out.stator_mode.push(NO_STEADY_STATE);
             }
         }
     }
@@ -119,6 +119,85 @@ pub fn ht_ratio_gradients(
         }
     }
     (tr, cf, dtr, dcf)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Transient runs
+
+/// One transient run of a batch.
+pub struct TransientJob {
+    pub model: Box<dyn crate::converter::dynamics::ConverterDynamics + Send>,
+    pub drive: crate::engine::isolated::Drive,
+    pub times_s: Vec<f64>,
+    pub init: crate::engine::isolated::InitialState,
+    pub options: crate::engine::options::SolverOptions,
+}
+
+/// Columns of a run (see [`crate::engine::outputs::COLUMNS`]) and its events.
+pub type RunOutput = (Vec<Vec<f64>>, Vec<crate::engine::isolated::Event>);
+
+/// Run `f`, turning a panic into a solver error instead of unwinding.
+pub fn catch_panic<T>(
+    f: impl FnOnce() -> crate::engine::options::TransientResult<T>,
+) -> crate::engine::options::TransientResult<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let msg = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_else(|| "unknown panic".into());
+        Err(crate::engine::options::TransientError::Solver {
+            time_s: f64::NAN,
+            state: vec![],
+            message: format!("internal error: {msg}"),
+        })
+    })
+}
+
+/// Run one job.
+pub fn run_transient_job(job: &TransientJob) -> crate::engine::options::TransientResult<RunOutput> {
+    catch_panic(|| {
+        let traj =
+            crate::engine::isolated::simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
+        Ok((crate::engine::outputs::columns(job.model.as_ref(), &traj), traj.events))
+    })
+}
+
+/// `f` over `jobs` on `threads` worker threads (0: one per core), results in job order.
+pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J) -> R + Sync) -> Vec<R> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    use std::sync::Mutex;
+    let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }
+        .min(jobs.len())
+        .max(1);
+    if threads == 1 {
+        return jobs.iter().map(&f).collect();
+    }
+    let next = AtomicUsize::new(0);
+    let results: Mutex<Vec<Option<R>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
+    std::thread::scope(|scope| {
+        for _ in 0..threads {
+            scope.spawn(|| loop {
+                let i = next.fetch_add(1, Ordering::Relaxed);
+                if i >= jobs.len() {
+                    break;
+                }
+                let r = f(&jobs[i]);
+                if let Ok(mut guard) = results.lock() {
+                    guard[i] = Some(r);
+                }
+            });
+        }
+    });
+    results.into_inner().unwrap_or_default().into_iter().map(|r| r.expect("every job ran")).collect()
+}
+
+/// Run all jobs on `threads` worker threads (0: one per core). Results are in job order.
+pub fn run_transient_jobs(
+    jobs: &[TransientJob],
+    threads: usize,
+) -> Vec<crate::engine::options::TransientResult<RunOutput>> {
+    parallel_map(jobs, threads, run_transient_job)
 }
 
 #[cfg(test)]
@@ -164,79 +243,4 @@ mod tests {
             }
         }
     }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Transient runs
-
-/// One transient run of a batch.
-pub struct TransientJob {
-    pub model: Box<dyn crate::dynamics::ConverterDynamics + Send>,
-    pub drive: crate::transient::Drive,
-    pub times_s: Vec<f64>,
-    pub init: crate::transient::InitialState,
-    pub options: crate::transient::SolverOptions,
-}
-
-/// Columns of a run (see [`crate::outputs::COLUMNS`]) and its events.
-pub type RunOutput = (Vec<Vec<f64>>, Vec<crate::transient::Event>);
-
-/// Run `f`, turning a panic into a solver error instead of unwinding.
-pub fn catch_panic<T>(
-    f: impl FnOnce() -> crate::transient::TransientResult<T>,
-) -> crate::transient::TransientResult<T> {
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
-        let msg = payload
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_else(|| "unknown panic".into());
-        Err(crate::transient::TransientError::Solver {
-            time_s: f64::NAN,
-            state: vec![],
-            message: format!("internal error: {msg}"),
-        })
-    })
-}
-
-/// Run one job.
-pub fn run_transient_job(job: &TransientJob) -> crate::transient::TransientResult<RunOutput> {
-    catch_panic(|| {
-        let traj = crate::transient::simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
-        Ok((crate::outputs::columns(job.model.as_ref(), &traj), traj.events))
-    })
-}
-
-/// `f` over `jobs` on `threads` worker threads (0: one per core), results in job order.
-pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J) -> R + Sync) -> Vec<R> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
-    use std::sync::Mutex;
-    let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }
-        .min(jobs.len())
-        .max(1);
-    if threads == 1 {
-        return jobs.iter().map(&f).collect();
-    }
-    let next = AtomicUsize::new(0);
-    let results: Mutex<Vec<Option<R>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
-    std::thread::scope(|scope| {
-        for _ in 0..threads {
-            scope.spawn(|| loop {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                if i >= jobs.len() {
-                    break;
-                }
-                let r = f(&jobs[i]);
-                if let Ok(mut guard) = results.lock() {
-                    guard[i] = Some(r);
-                }
-            });
-        }
-    });
-    results.into_inner().unwrap_or_default().into_iter().map(|r| r.expect("every job ran")).collect()
-}
-
-/// Run all jobs on `threads` worker threads (0: one per core). Results are in job order.
-pub fn run_transient_jobs(jobs: &[TransientJob], threads: usize) -> Vec<crate::transient::TransientResult<RunOutput>> {
-    parallel_map(jobs, threads, run_transient_job)
 }

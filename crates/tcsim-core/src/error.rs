@@ -1,7 +1,8 @@
 //! The one error type of the core: which field, which value, what was expected.
 //!
-//! The Python layer turns it into a user-input error (exit code 2) and adds the file name;
-//! the core never panics on bad input.
+//! The binding raises it as `tcsim._core.CoreInputError(message, field, value, expected)`, which
+//! the Python layer turns into a user-input error (exit code 2) with the file name; the FMU reports
+//! it through its logger. The core never panics on bad input.
 
 use std::fmt;
 

@@ -1,30 +1,30 @@
 //! tcsim-core: torque-converter models in pure Rust.
 //!
 //! The core holds the models and their solvers and knows nothing of Python, so that the same code
-//! builds the Python extension and, later, the FMU. Units are SI throughout (rad/s, N·m, m, m²,
-//! m³/s, kg, kg/m³, s; angles in radians); signs follow the tcsim physics notes §2.
+//! builds the Python extension (`tcsim-py`) and the FMU (`tcsim-fmu`). Units are SI throughout
+//! (rad/s, N·m, m, m², m³/s, kg, kg/m³, s; angles in radians); signs follow the tcsim physics notes
+//! §2. Errors in the user's input are [`CoreError`]s (the Python layer raises them as
+//! `CoreInputError`).
 //!
-//! * [`capacity`]: the six capacity conventions of characteristic tables.
-//! * [`table`]: the steady-state look-up-table model (Li & Sundén 2016, eqs 2.8–2.11).
-//! * [`hrovat_tobler`]: the Hrovat & Tobler model's closed-form steady state and coupling point.
-//! * [`batch`]: batched evaluation for characteristics, studies and fitting.
-//! * [`dynamics`]: the three models in mass-matrix form (table, Hrovat & Tobler, quasi-dynamic).
-//! * [`signal`]: sampled input signals with a smoothed derivative.
-//! * [`transient`]: the transient engine on diffsol (BDF, root-finding events).
+//! Folders depend one way: `converter` ← `engine` ← `vehicle`; the shared utilities below them.
+//!
+//! * [`converter`]: the converter models (tables, Hrovat & Tobler, quasi-dynamic, specifications).
+//! * [`engine`]: the transient engines on diffsol (BDF segments, converter events, isolated runs,
+//!   Model Exchange view, co-simulation stepper, signals, output columns).
+//! * [`vehicle`]: whole-vehicle take-off (parameters, components, plant, modes, launch, columns).
+//! * [`batch`]: batched evaluation for characteristics, studies, fitting and parallel runs.
+//! * [`interp`]: linear interpolation with the end values held.
+//! * [`units`]: unit constants and the 2000 rpm reference pump speed.
+//! * [`linalg`], [`scalar`], [`error`]: small dense inverse, dual numbers, the error type.
 
 pub mod batch;
-pub mod capacity;
-pub mod dynamics;
+pub mod converter;
+pub mod engine;
 pub mod error;
-pub mod hrovat_tobler;
+pub mod interp;
 pub mod linalg;
-pub mod outputs;
 pub mod scalar;
-pub mod segment;
-pub mod signal;
-pub mod stepper;
-pub mod table;
-pub mod transient;
+pub mod units;
 pub mod vehicle;
 
 pub use error::{CoreError, CoreResult};

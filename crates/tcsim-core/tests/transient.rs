@@ -3,11 +3,13 @@
 mod common;
 
 use common::*;
-use tcsim_core::dynamics::ConverterDynamics;
-use tcsim_core::hrovat_tobler::{coupling_point, steady_state, HtGeometry, StatorMode};
-use tcsim_core::outputs::{columns, COLUMNS};
-use tcsim_core::signal::Signal;
-use tcsim_core::transient::{simulate, Drive, EventKind, InitialState, SolverOptions, Trajectory};
+use tcsim_core::converter::dynamics::ConverterDynamics;
+use tcsim_core::converter::hrovat_tobler::{coupling_point, steady_state, HtGeometry, StatorMode};
+use tcsim_core::engine::converter_events::EventKind;
+use tcsim_core::engine::isolated::{simulate, Drive, InitialState, Trajectory};
+use tcsim_core::engine::options::SolverOptions;
+use tcsim_core::engine::outputs::{columns, COLUMNS};
+use tcsim_core::engine::signal::Signal;
 
 fn col<'a>(cols: &'a [Vec<f64>], name: &str) -> &'a [f64] {
     &cols[COLUMNS.iter().position(|c| *c == name).unwrap_or_else(|| panic!("no column {name}"))]
@@ -237,13 +239,13 @@ fn hrovat_tobler_follows_its_steady_state_when_the_flow_is_quasi_steady() {
     let (_, cols) = run(&ht([0.0; 3]), &drive, &t, InitialState::default());
     let g = HtGeometry::appendix_d();
     let mut worst = 0.0f64;
-    for i in 1..t.len() {
+    for (i, &time) in t.iter().enumerate().skip(1) {
         let (wp, wt) = (col(&cols, "pump_speed_rad_s")[i], col(&cols, "turbine_speed_rad_s")[i]);
         let ss = steady_state(&g, wp, wt).unwrap();
         let tp = col(&cols, "pump_torque_nm")[i] - 0.109 * 10.0; // minus the pump inertia torque I_p ω̇_p
         worst = worst.max((tp - ss.pump_torque_nm).abs() / ss.pump_torque_nm);
         // the flow lags its steady value by τ_Q·|Q̇|/Q ≈ 3 ms × 0.005/0.08 s⁻¹ ≈ 2·10⁻⁴
-        assert!((tp - ss.pump_torque_nm).abs() < 3e-4 * ss.pump_torque_nm, "t {}: {tp} vs {}", t[i], ss.pump_torque_nm);
+        assert!((tp - ss.pump_torque_nm).abs() < 3e-4 * ss.pump_torque_nm, "t {time}: {tp} vs {}", ss.pump_torque_nm);
     }
     println!("Hrovat & Tobler, S = 0, slow ramp: largest relative difference from the closed form {worst:.2e}");
 }
@@ -316,7 +318,7 @@ fn bad_runs_are_input_errors() {
         turbine_speed_rad_s: Signal::constant(0.0),
     };
     match simulate(&ht(SHAPE), &drive, &t, &InitialState::default(), &SolverOptions::default()) {
-        Err(tcsim_core::transient::TransientError::Input(e)) => assert_eq!(e.field, "initial pump_torque_nm"),
+        Err(tcsim_core::engine::options::TransientError::Input(e)) => assert_eq!(e.field, "initial pump_torque_nm"),
         other => panic!("{other:?}"),
     }
     let init = InitialState {
@@ -332,7 +334,7 @@ fn bad_runs_are_input_errors() {
 #[test]
 fn a_run_stepped_interval_by_interval_follows_the_single_run() {
     // the co-simulation engine: inputs piecewise linear on the communication grid
-    use tcsim_core::stepper::{Causality, Stepper};
+    use tcsim_core::engine::stepper::{Causality, Stepper};
     let tp = |t: f64| {
         if t < 0.1 {
             40.0

@@ -3,9 +3,13 @@
 mod common;
 
 use common::*;
-use tcsim_core::dynamics::ConverterDynamics;
-use tcsim_core::signal::Signal;
-use tcsim_core::transient::SolverOptions;
+use tcsim_core::converter::dynamics::ConverterDynamics;
+use tcsim_core::engine::options::SolverOptions;
+use tcsim_core::engine::signal::Signal;
+use tcsim_core::vehicle::launch::*;
+use tcsim_core::vehicle::modes::*;
+use tcsim_core::vehicle::parameters::*;
+use tcsim_core::vehicle::plant::LaunchSample;
 use tcsim_core::vehicle::*;
 
 fn sedan() -> Vehicle {
@@ -140,11 +144,11 @@ fn dynamic_models_accelerate_less_at_first_and_rejoin_the_table_model() {
     assert!(first[1] < first[0] && first[2] < first[0], "{first:?}");
     // TR of the three models within 5 % of each other about 1 s after the release
     // effective TR (eqs 3.1–3.4): the table's TR(SR) for the table model
-    let effective = tcsim_core::outputs::COLUMNS.iter().position(|c| *c == "effective_torque_ratio").unwrap();
+    let effective = tcsim_core::engine::outputs::COLUMNS.iter().position(|c| *c == "effective_torque_ratio").unwrap();
     let models = models();
     let tr = |i: usize, r: &LaunchTrajectory, t: f64| {
         let s = r.samples.iter().find(|s| s.time_s >= t).unwrap();
-        tcsim_core::outputs::row(models[i].1.as_ref(), &s.converter)[effective]
+        tcsim_core::engine::outputs::row(models[i].1.as_ref(), &s.converter)[effective]
     };
     for dt in [0.6, 0.8, 1.0, 1.5, 2.0] {
         let v: Vec<f64> = runs.iter().enumerate().map(|(i, (_, r))| tr(i, r, release + dt)).collect();

@@ -2,14 +2,16 @@
 //! co-simulation stepper of the core. Safe Rust; the C boundary is in `lib.rs`.
 
 use serde_json::{Map, Value};
-use tcsim_core::dynamics::FLOW;
-use tcsim_core::dynamics::{build_model, ConverterDynamics, ModelSpec};
-use tcsim_core::outputs::{row, COLUMNS};
-use tcsim_core::signal::Signal;
-use tcsim_core::stepper::{Causality, Stepper};
-use tcsim_core::transient::{
-    initial_mode, initial_state, Drive, InitialState, Mode, ModeView, Sample, SolverOptions, EVENT_INDICATORS,
-};
+use tcsim_core::converter::dynamics::ConverterDynamics;
+use tcsim_core::converter::dynamics::FLOW;
+use tcsim_core::converter::spec::{build_model, ModelSpec};
+use tcsim_core::engine::converter_events::{Mode, Sample};
+use tcsim_core::engine::isolated::{initial_mode, initial_state, Drive, InitialState};
+use tcsim_core::engine::mode_view::{ModeView, EVENT_INDICATORS};
+use tcsim_core::engine::options::SolverOptions;
+use tcsim_core::engine::outputs::{row, COLUMNS};
+use tcsim_core::engine::signal::Signal;
+use tcsim_core::engine::stepper::{Causality, Stepper};
 use tcsim_core::CoreResult;
 
 /// Value references of the signals, fixed whatever the causality; 12 and 13 are the rates of the
@@ -559,7 +561,7 @@ mod me_tests {
         let config = Configuration::parse(&format!(
             r#"{{"model": {{"kind": "hrovat-tobler", "inertia_kg_m2": [0.109, 0.056, 0.01], "fluid_length_m": 0.2914,
                 "shape_effect_m2": [-0.00569, 0.00134, 0.0009], "geometry": {:?}}}, "parameters": []}}"#,
-            tcsim_core::hrovat_tobler::HtGeometry::appendix_d().values
+            tcsim_core::converter::hrovat_tobler::HtGeometry::appendix_d().values
         ))
         .unwrap();
         let mut inst = Instance::new(config);
@@ -580,8 +582,8 @@ mod me_tests {
         // the stator releases
         let mut x = [0.0; 3];
         inst.me_get_states(&mut x).unwrap();
-        let g_ht = tcsim_core::hrovat_tobler::HtGeometry::appendix_d();
-        let locked = tcsim_core::hrovat_tobler::locked_steady_state(&g_ht, x[0], 0.97 * x[0]).unwrap();
+        let g_ht = tcsim_core::converter::hrovat_tobler::HtGeometry::appendix_d();
+        let locked = tcsim_core::converter::hrovat_tobler::locked_steady_state(&g_ht, x[0], 0.97 * x[0]).unwrap();
         inst.set(2, 0.97 * x[0]).unwrap();
         inst.me_set_states(&[x[0], 0.0, locked.flow_m3_s]).unwrap();
         inst.me_indicators(&mut g).unwrap();

@@ -1,13 +1,16 @@
 //! The FMI 2.0 C API of the tcsim converter models: Co-Simulation, with diffsol's BDF inside
 //! `fmi2DoStep` (through `tcsim_core::stepper`), and Model Exchange, with the continuous states,
 //! their derivatives, the event indicators of the stator clutch and of flow reversal, and the mode
-//! switches in `fmi2NewDiscreteStates` (through `tcsim_core::transient::ModeView`). No Python at
+//! switches in `fmi2NewDiscreteStates` (through `tcsim_core::engine::mode_view::ModeView`). No Python at
 //! run time.
 //!
 //! The model and its parameters come from `resources/model.json`, written by `tcsim export-fmu`
 //! (`python/tcsim/fmu.py`). Every entry point catches panics: none crosses the C boundary; a
 //! failure returns `fmi2Error` with its message through the logger callback.
 
+// The `unsafe extern "C"` functions are the FMI 2.0 C API, called by the host with the pointers
+// the standard defines; their safety contract is the FMI specification, not a per-function
+// `# Safety` section.
 #![allow(clippy::missing_safety_doc)]
 
 mod instance;
@@ -149,7 +152,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 name: name.clone(),
                 callbacks,
                 instance: Instance::new(Configuration {
-                    causality: tcsim_core::stepper::Causality::Speeds,
+                    causality: tcsim_core::engine::stepper::Causality::Speeds,
                     model: Default::default(),
                     parameters: vec![],
                 }),

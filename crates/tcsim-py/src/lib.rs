@@ -1,9 +1,11 @@
 //! `tcsim._core`: the thin PyO3 layer over `tcsim-core`.
 //!
 //! Every entry point converts NumPy arrays to slices, releases the GIL for the computation and
-//! turns a core error into `tcsim._core.CoreError(message, field, value, expected)`. A Rust panic
-//! is caught here and becomes a `RuntimeError`; it never unwinds into Python.
+//! turns a core error ([`CoreError`]) into `tcsim._core.CoreInputError(message, field, value,
+//! expected)`. A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
+//! Python.
 
+use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
@@ -15,15 +17,23 @@ use tcsim_core::batch::{
     ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs,
     TransientJob,
 };
-use tcsim_core::capacity::CapacityConvention;
-use tcsim_core::dynamics::ConverterDynamics;
-use tcsim_core::hrovat_tobler::{coupling_point, HtGeometry, HtParam, N_PARAMS};
-use tcsim_core::signal::Signal;
-use tcsim_core::table::Characteristic;
-use tcsim_core::transient::{Drive, EventKind, InitialState, SolverOptions, TransientError, TurbineLoad};
-use tcsim_core::vehicle::{
-    launch_column_names, simulate_launch, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres,
-    Vehicle,
+use tcsim_core::converter::capacity::CapacityConvention;
+use tcsim_core::converter::dynamics::ConverterDynamics;
+use tcsim_core::converter::dynamics::{Inertias, MassMatrixBound};
+use tcsim_core::converter::hrovat_tobler::{
+    coupling_point, steady_mode_names as steady_mode_names_core, steady_torque_ratio as steady_torque_ratio_core,
+    HtGeometry, HtParam, N_PARAMS,
+};
+use tcsim_core::converter::table::Characteristic;
+use tcsim_core::engine::converter_events::EventKind;
+use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
+use tcsim_core::engine::options::{SolverOptions, TransientError};
+use tcsim_core::engine::signal::Signal;
+use tcsim_core::vehicle::components::engine_drag_nm;
+use tcsim_core::vehicle::launch::simulate_launch;
+use tcsim_core::vehicle::outputs::launch_column_names;
+use tcsim_core::vehicle::parameters::{
+    Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres, Vehicle,
 };
 use tcsim_core::CoreError;
 
@@ -177,22 +187,20 @@ fn ht_coupling_point(geometry: PyReadonlyArray2<'_, f64>) -> PyResult<Option<f64
     })
 }
 
+/// `(tr, cf, d_tr, d_cf)` of [`ht_ratio_gradients`].
+type RatioGradients<'py> =
+    (Bound<'py, PyArray1<f64>>, Bound<'py, PyArray1<f64>>, Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<f64>>);
+
 /// TR and CF at `speed_ratio` (pump at `pump_speed_rad_s`) with exact derivatives with respect to
 /// the parameters named in `free`: returns (tr, cf, d_tr, d_cf), derivatives shaped (n, len(free)).
 #[pyfunction]
-#[allow(clippy::type_complexity)]
 fn ht_ratio_gradients<'py>(
     py: Python<'py>,
     geometry: PyReadonlyArray2<'py, f64>,
     pump_speed_rad_s: f64,
     speed_ratio: PyReadonlyArray1<'py, f64>,
     free: Vec<String>,
-) -> PyResult<(
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray1<f64>>,
-    Bound<'py, PyArray2<f64>>,
-    Bound<'py, PyArray2<f64>>,
-)> {
+) -> PyResult<RatioGradients<'py>> {
     guard(|| {
         let g = geometry_rows(&geometry)?;
         let g = *g.first().ok_or_else(|| PyValueError::new_err("geometry has no row"))?;
@@ -231,7 +239,6 @@ fn table_check(
 
 /// Steady states of the table model at `pump[i], turbine[i]` (rad/s). Returns a dict of arrays.
 #[pyfunction]
-#[allow(clippy::too_many_arguments)]
 fn table_steady_states<'py>(
     py: Python<'py>,
     speed_ratio: PyReadonlyArray1<'py, f64>,
@@ -256,7 +263,7 @@ fn table_steady_states<'py>(
                     .collect::<Result<Vec<_>, _>>()
             })
             .map_err(|(i, e)| input_error(CoreError { field: format!("{} (point {i})", e.field), ..e }))?;
-        let col = |f: fn(&tcsim_core::table::TableOperatingPoint) -> f64| {
+        let col = |f: fn(&tcsim_core::converter::table::TableOperatingPoint) -> f64| {
             points.iter().map(f).collect::<Vec<_>>().into_pyarray(py)
         };
         let d = PyDict::new(py);
@@ -294,7 +301,7 @@ fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -
 /// A Python dict as a core model specification.
 struct DictSpec<'a, 'py>(&'a Bound<'py, PyDict>);
 
-impl tcsim_core::dynamics::ModelSpec for DictSpec<'_, '_> {
+impl tcsim_core::converter::spec::ModelSpec for DictSpec<'_, '_> {
     fn kind(&self) -> tcsim_core::CoreResult<String> {
         item::<String>(self.0, "kind").map_err(|e| CoreError::new("kind", e, "a model kind"))
     }
@@ -305,7 +312,7 @@ impl tcsim_core::dynamics::ModelSpec for DictSpec<'_, '_> {
 }
 
 fn model_from(d: &Bound<'_, PyDict>) -> PyResult<Box<dyn ConverterDynamics + Send>> {
-    tcsim_core::dynamics::build_model(&DictSpec(d)).map_err(input_error)
+    tcsim_core::converter::spec::build_model(&DictSpec(d)).map_err(input_error)
 }
 
 fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal> {
@@ -318,7 +325,8 @@ fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal
 
 fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
     let kind: String = item(d, "kind")?;
-    let window: f64 = opt_item(d, "derivative_window_s")?.unwrap_or(tcsim_core::signal::DEFAULT_DERIVATIVE_WINDOW_S);
+    let window: f64 =
+        opt_item(d, "derivative_window_s")?.unwrap_or(tcsim_core::engine::signal::DEFAULT_DERIVATIVE_WINDOW_S);
     let out: Vec<f64> = match opt_item(d, "output_time_s")? {
         Some(t) => t,
         None => item(d, "time_s")?,
@@ -392,12 +400,7 @@ fn options_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<SolverOptions> {
 }
 
 fn event_name(k: EventKind) -> &'static str {
-    match k {
-        EventKind::StatorRelease => "stator-release",
-        EventKind::StatorLock => "stator-lock",
-        EventKind::FlowZero => "flow-zero",
-        EventKind::FlowStart => "flow-start",
-    }
+    k.name()
 }
 
 /// The smoothed derivative the transient engine uses for given speeds (local least-squares slope
@@ -419,7 +422,7 @@ fn smoothed_rate<'py>(
 /// Output column names of a transient run.
 #[pyfunction]
 fn transient_columns() -> Vec<&'static str> {
-    tcsim_core::outputs::COLUMNS.to_vec()
+    tcsim_core::engine::outputs::COLUMNS.to_vec()
 }
 
 /// Run transient jobs: `models[i]` under `drives[i]` (a list of length one is broadcast), with
@@ -467,7 +470,7 @@ fn transient_runs<'py>(
                 Ok(match r {
                     Ok((cols, events)) => {
                         let d = PyDict::new(py);
-                        for (name, col) in tcsim_core::outputs::COLUMNS.iter().zip(cols) {
+                        for (name, col) in tcsim_core::engine::outputs::COLUMNS.iter().zip(cols) {
                             d.set_item(*name, col.into_pyarray(py))?;
                         }
                         let ev: Vec<(f64, &str, bool, f64)> = events
@@ -622,7 +625,7 @@ fn launch_runs<'py>(
             tcsim_core::batch::parallel_map(&parsed, threads, |m| {
                 tcsim_core::batch::catch_panic(|| {
                     let traj = simulate_launch(m.as_ref(), &v, &sc, step, &solver)?;
-                    Ok((tcsim_core::vehicle::launch_columns(m.as_ref(), &sc, &traj), traj.events))
+                    Ok((tcsim_core::vehicle::outputs::launch_columns(m.as_ref(), &sc, &traj), traj.events))
                 })
             })
         });
@@ -651,10 +654,119 @@ fn launch_runs<'py>(
     })
 }
 
+// ---------------------------------------------------------------------------------------------
+// Physics owned by the core that the Python layer needs (one owner per fact)
+
+fn one_geometry(geometry: &PyReadonlyArray2<'_, f64>) -> PyResult<HtGeometry<f64>> {
+    geometry_rows(geometry)?.into_iter().next().ok_or_else(|| PyValueError::new_err("geometry needs one row"))
+}
+
+/// Default flow time constant τ_Q of the quasi-dynamic model, s: `(ρL_f/A) / |∂F_Q/∂Q|` for the
+/// Hrovat & Tobler `geometry` (row 0 of an (n, 15) array, SI units, angles in rad) with fluid length
+/// `fluid_length_m` (m), at stall (locked stator) and the reference pump speed
+/// (`reference_pump_speed_rpm()`, 2000 rpm). Replaces `tcsim.transient.default_flow_time_constant_s`.
+#[pyfunction]
+fn default_flow_time_constant_s(geometry: PyReadonlyArray2<'_, f64>, fluid_length_m: f64) -> PyResult<f64> {
+    guard(|| {
+        let g = one_geometry(&geometry)?;
+        tcsim_core::converter::spec::default_flow_time_constant_s(&g, fluid_length_m).map_err(input_error)
+    })
+}
+
+/// The reference pump speed in rpm (2000): where the default τ_Q is evaluated and the default pump
+/// speed of a characterisation. Convert with `reference_pump_speed_rad_s()`.
+#[pyfunction]
+fn reference_pump_speed_rpm() -> f64 {
+    tcsim_core::units::REFERENCE_PUMP_SPEED_RPM
+}
+
+/// The reference pump speed in rad/s (`2000·π/30`).
+#[pyfunction]
+fn reference_pump_speed_rad_s() -> f64 {
+    tcsim_core::units::REFERENCE_PUMP_SPEED_RAD_S
+}
+
+/// The Hrovat & Tobler mass-matrix admissibility bound on the shape effects (physics notes §4): `M`
+/// is positive definite iff `ρL_f/A > Σ ρ²S_x²/I_x`. Arguments: `geometry` (row 0 of an (n, 15)
+/// array), `fluid_length_m` (m), `inertia_kg_m2` (pump, turbine, stator; kg·m²), `shape_effect_m2`
+/// (pump, turbine, stator; m²). Returns a dict: `density_kg_m3`, `inertance_kg_m4` (ρL_f/A),
+/// `shape_terms_kg_m4` (ρ²S_x²/I_x, three), `margin_kg_m4` (inertance less their sum; admissible iff
+/// > 0) and `shape_effect_bounds_m2` (largest admissible |S_x| with the others as given, three).
+/// Replaces the arithmetic of `tcsim.shape_fit.MassMatrixBound` (its `room` is `inertance_kg_m4 −
+/// shape_terms_kg_m4[2]`).
+#[pyfunction]
+fn mass_matrix_bound<'py>(
+    py: Python<'py>,
+    geometry: PyReadonlyArray2<'py, f64>,
+    fluid_length_m: f64,
+    inertia_kg_m2: [f64; 3],
+    shape_effect_m2: [f64; 3],
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let g = one_geometry(&geometry)?;
+        let inertia = Inertias::new(inertia_kg_m2[0], inertia_kg_m2[1], inertia_kg_m2[2]).map_err(input_error)?;
+        let b = MassMatrixBound::new(&g, &inertia, fluid_length_m, shape_effect_m2);
+        let d = PyDict::new(py);
+        d.set_item("density_kg_m3", b.density_kg_m3)?;
+        d.set_item("inertance_kg_m4", b.inertance_kg_m4)?;
+        d.set_item("shape_terms_kg_m4", b.shape_terms_kg_m4.to_vec())?;
+        d.set_item("margin_kg_m4", b.margin_kg_m4())?;
+        d.set_item("shape_effect_bounds_m2", b.shape_effect_bounds().to_vec())?;
+        Ok(d)
+    })
+}
+
+/// Codes of the `stator_mode` column of `ht_steady_states` and their names: `{0: "locked",
+/// 1: "free-wheeling", 2: "no-flow", -1: "no-steady-state"}`. Replaces `tcsim.steady.STATOR_MODES`
+/// and the bare `mode == 2` of `steady.py` and `study.py`.
+#[pyfunction]
+fn steady_mode_names() -> BTreeMap<i8, &'static str> {
+    steady_mode_names_core().into_iter().collect()
+}
+
+/// The torque ratio of steady states from the `stator_mode`, `pump_torque_nm` and
+/// `turbine_torque_nm` columns of `ht_steady_states`: 1 in no-flow (TR = 1 by continuity), else
+/// `T_t/T_p` (a zero pump torque divides by 1), NaN without a steady state. Replaces
+/// `np.where(mode == 2, 1.0, tt / np.where(tp == 0, 1.0, tp))` in `steady.py` and `study.py`.
+#[pyfunction]
+fn steady_torque_ratio<'py>(
+    py: Python<'py>,
+    stator_mode: PyReadonlyArray1<'py, i8>,
+    pump_torque_nm: PyReadonlyArray1<'py, f64>,
+    turbine_torque_nm: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    guard(|| {
+        let mode = stator_mode
+            .as_slice()
+            .map_err(|_| PyValueError::new_err("stator_mode must be a contiguous 1-D int8 array"))?;
+        let (tp, tt) = (slice(&pump_torque_nm, "pump_torque_nm")?, slice(&turbine_torque_nm, "turbine_torque_nm")?);
+        if mode.len() != tp.len() || tp.len() != tt.len() {
+            return Err(PyValueError::new_err("stator_mode and the torques need equal lengths"));
+        }
+        let tr: Vec<f64> = (0..mode.len()).map(|i| steady_torque_ratio_core(mode[i], tp[i], tt[i])).collect();
+        Ok(tr.into_pyarray(py))
+    })
+}
+
+/// The engine's drag torque in the vehicle plant, N·m, at engine speed `speed_rad_s` (rad/s):
+/// `drag_torque_nm·tanh(ω/1 rad/s) + drag_nm_s_per_rad·ω`, opposing rotation (zero at rest).
+/// Replaces `tcsim.vehicle.EngineSection.drag_at`, which lacks the tanh.
+#[pyfunction]
+fn vehicle_engine_drag_nm(speed_rad_s: f64, drag_torque_nm: f64, drag_nm_s_per_rad: f64) -> f64 {
+    engine_drag_nm(speed_rad_s, drag_torque_nm, drag_nm_s_per_rad)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
     m.add_function(wrap_pyfunction!(capacity_conventions, m)?)?;
+    m.add_function(wrap_pyfunction!(default_flow_time_constant_s, m)?)?;
+    m.add_function(wrap_pyfunction!(reference_pump_speed_rpm, m)?)?;
+    m.add_function(wrap_pyfunction!(reference_pump_speed_rad_s, m)?)?;
+    m.add_function(wrap_pyfunction!(mass_matrix_bound, m)?)?;
+    m.add_function(wrap_pyfunction!(steady_mode_names, m)?)?;
+    m.add_function(wrap_pyfunction!(steady_torque_ratio, m)?)?;
+    m.add_function(wrap_pyfunction!(vehicle_engine_drag_nm, m)?)?;
     m.add_function(wrap_pyfunction!(capacity_to_cf, m)?)?;
     m.add_function(wrap_pyfunction!(cf_to_capacity, m)?)?;
     m.add_function(wrap_pyfunction!(ht_parameter_names, m)?)?;

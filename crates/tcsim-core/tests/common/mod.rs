@@ -1,12 +1,14 @@
 //! Shared scenarios for the transient tests: the bundled li-sunden-2016 converter and the
 //! isolated take-off of `bench/scipy_reference.py`.
+// Each test binary includes this module and uses a different part of it.
 #![allow(dead_code)]
 
-use tcsim_core::dynamics::{HtDynamics, Inertias, QuasiDynamics, TableDynamics};
-use tcsim_core::hrovat_tobler::HtGeometry;
-use tcsim_core::signal::Signal;
-use tcsim_core::table::Characteristic;
-use tcsim_core::transient::{Drive, TurbineLoad};
+use tcsim_core::converter::dynamics::{HtDynamics, Inertias, TableDynamics};
+use tcsim_core::converter::hrovat_tobler::HtGeometry;
+use tcsim_core::converter::quasi_dynamic::QuasiDynamics;
+use tcsim_core::converter::table::Characteristic;
+use tcsim_core::engine::isolated::{Drive, TurbineLoad};
+use tcsim_core::engine::signal::Signal;
 
 pub fn c1() -> Characteristic {
     Characteristic::new(

@@ -12,8 +12,9 @@
 //!
 //! `T_t` is the torque delivered to the transmission (`turbine_torque_nm`).
 
-use crate::dynamics::{ConverterDynamics, FLOW, PUMP, STATOR, TURBINE};
-use crate::transient::{Sample, Trajectory};
+use crate::converter::dynamics::{ConverterDynamics, FLOW, PUMP, STATOR, TURBINE};
+use crate::engine::converter_events::Sample;
+use crate::engine::isolated::Trajectory;
 
 /// Column names, in order.
 pub const COLUMNS: [&str; 27] = [

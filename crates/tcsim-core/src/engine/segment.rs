@@ -3,7 +3,7 @@
 
 use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
 
-use crate::transient::{Hysteresis, SolverOptions, TransientError, TransientResult};
+use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
 
 type Matrix = NalgebraMat<f64>;
 type Lu = NalgebraLU<f64>;
@@ -32,6 +32,8 @@ pub type SegmentEnd<R> = Option<(f64, R, Vec<f64>)>;
 
 /// Integrate one segment from `x0` at `t0`, pushing a sample for every time of `times_s` it
 /// covers. Returns the root that ended it, with its time and state, or None at `t_end`.
+// Eight arguments: the segment, its start (state, time), end time, output times and options, and
+// the two outputs (samples, step count) that live in differently typed trajectories of the callers.
 #[allow(clippy::too_many_arguments)]
 pub fn run_segment<S: SmoothSegment>(
     seg: &S,

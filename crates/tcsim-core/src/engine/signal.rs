@@ -84,17 +84,7 @@ impl Signal {
     }
 
     fn interpolate(&self, y: &[f64], t: f64) -> f64 {
-        let x = &self.time_s;
-        let n = x.len();
-        if n == 1 || t <= x[0] {
-            return y[0];
-        }
-        if t >= x[n - 1] {
-            return y[n - 1];
-        }
-        let i = x.partition_point(|&xi| xi <= t).clamp(1, n - 1);
-        let w = (t - x[i - 1]) / (x[i] - x[i - 1]);
-        (1.0 - w) * y[i - 1] + w * y[i]
+        crate::interp::linear_held(&self.time_s, y, t)
     }
 }
 

@@ -14,6 +14,7 @@
 //! steady-state sweeps therefore stay inside the table, and overrun needs a table that has it.
 
 use crate::error::{CoreError, CoreResult};
+use crate::interp;
 
 /// A torque-converter characteristic: TR and CF against SR.
 #[derive(Debug, Clone, PartialEq)]
@@ -124,12 +125,9 @@ impl Characteristic {
         if sr > x[n - 1] {
             return held(n - 1);
         }
-        // first index with x[i] > sr, clamped so that [i-1, i] is a segment
-        let i = x.partition_point(|&xi| xi <= sr).clamp(1, n - 1);
+        let (i, w) = interp::segment(x, sr);
         let h = x[i] - x[i - 1];
-        let w = (sr - x[i - 1]) / h;
-        // (1 − w)·y0 + w·y1 returns the table values exactly at the nodes
-        let lerp = |y: &[f64]| ((1.0 - w) * y[i - 1] + w * y[i], (y[i] - y[i - 1]) / h);
+        let lerp = |y: &[f64]| (interp::mix(y, i, w), (y[i] - y[i - 1]) / h);
         let (tr, dtr) = lerp(&self.torque_ratio);
         let (cf, dcf) = lerp(&self.capacity_factor_nm_s2);
         Lookup {
@@ -221,7 +219,7 @@ mod tests {
     #[test]
     fn overrun_rows_reverse_the_pump_torque() {
         // JAMBE/TRAMI 9AT excerpt: negative capacity above SR = 1 (turbine drives the pump).
-        let c = |v: f64| v * (60.0 / (2.0 * std::f64::consts::PI)).powi(2);
+        let c = |v: f64| v * crate::units::RPM_PER_RAD_S.powi(2);
         let t = Characteristic::new(vec![0.9, 1.0, 1.1, 1.2], vec![1.0; 4], vec![c(30e-6), 0.0, c(-5e-6), c(-10e-6)])
             .unwrap();
         let op = t.operating_point(200.0, 230.0).unwrap();
@@ -233,7 +231,7 @@ mod tests {
     #[test]
     fn torques_balance_and_follow_eq_2_8_and_2_9() {
         let t = c1();
-        let wp = 2000.0 * std::f64::consts::PI / 30.0;
+        let wp = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
         let op = t.operating_point(wp, 0.3 * wp).unwrap();
         assert!((op.pump_torque_nm - 3.181e-3 * wp * wp).abs() < 1e-9);
         assert!((op.turbine_torque_nm - 1.70 * op.pump_torque_nm).abs() < 1e-9);

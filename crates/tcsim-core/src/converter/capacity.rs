@@ -5,11 +5,8 @@
 //! (docs `conventions.md`, physics notes §1); each converts to and from CF exactly.
 
 use crate::error::{CoreError, CoreResult};
+use crate::units::{NM_PER_LBF_FT, RPM_PER_RAD_S};
 
-/// Revolutions per minute in one rad/s: 60 / (2π).
-pub const RPM_PER_RAD_S: f64 = 60.0 / (2.0 * std::f64::consts::PI);
-/// One pound-force foot in newton metres.
-pub const NM_PER_LBF_FT: f64 = 1.355_817_948_331_400_4;
 /// Pump speed at which the VDI 2153 / VECTO MP1000 torque is quoted, rad/s.
 pub const MP1000_SPEED_RAD_S: f64 = 1000.0 / RPM_PER_RAD_S;
 

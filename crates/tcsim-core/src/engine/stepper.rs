@@ -7,11 +7,11 @@
 //! direction) carry over from one interval to the next, so a run stepped in many intervals follows
 //! the same trajectory as one run over the same piecewise-linear inputs (tested).
 
-use crate::dynamics::{ConverterDynamics, Vec4};
-use crate::signal::Signal;
-use crate::transient::{
-    initial_mode, initial_state, simulate_from, Drive, InitialState, Mode, Sample, SolverOptions, TransientResult,
-};
+use crate::converter::dynamics::{ConverterDynamics, Vec4};
+use crate::engine::converter_events::{Mode, Sample};
+use crate::engine::isolated::{initial_mode, initial_state, simulate_from, Drive, InitialState};
+use crate::engine::options::{SolverOptions, TransientResult};
+use crate::engine::signal::Signal;
 
 /// Which quantities the host gives and which come back.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -12,18 +12,18 @@
 //! A model that lacks a coordinate (the table model has no flow, only Hrovat & Tobler has a stator
 //! speed) leaves it out of [`ConverterDynamics::coordinates`]. Which of the remaining coordinates
 //! are states and which are prescribed (a measured speed, a locked stator, a stalled flow) is the
-//! engine's business ([`crate::transient`]), not the model's.
+//! engine's business ([`crate::engine`]), not the model's.
 //!
 //! * [`TableDynamics`]: the steady-state table with pump and turbine inertias, eqs 2.8–2.11.
 //! * [`HtDynamics`]: Hrovat & Tobler, eqs 2.12–2.25.
-//! * [`QuasiDynamics`]: tcsim's quasi-dynamic model (tables plus fluid inertia), physics notes §5.
+//! * [`QuasiDynamics`](super::quasi_dynamic::QuasiDynamics): tcsim's quasi-dynamic model (tables plus fluid inertia), physics notes §5.
 //!
 //! Sign conventions follow physics notes §2: `T_ext` holds the external torques on pump, turbine
 //! and stator; the torque delivered to the transmission is `−T_ext[TURBINE]`.
 
+use super::hrovat_tobler::{steady_state, HtGeometry, HtParam};
+use super::table::Characteristic;
 use crate::error::{CoreError, CoreResult};
-use crate::hrovat_tobler::{steady_state, HtGeometry, HtParam};
-use crate::table::Characteristic;
 
 pub const PUMP: usize = 0;
 pub const TURBINE: usize = 1;
@@ -76,7 +76,7 @@ pub trait ConverterDynamics: Sync {
         false
     }
     /// Forces on the flow coordinate that do not depend on sgn Q, and the magnitude of the
-    /// sgn-Q term, both at Q = 0 (the "dry friction" of the flow; see [`crate::transient`]).
+    /// sgn-Q term, both at Q = 0 (the "dry friction" of the flow; see [`crate::engine`]).
     fn zero_flow_head(&self, _u: &Vec4) -> (f64, f64) {
         (0.0, 0.0)
     }
@@ -140,7 +140,7 @@ pub struct TableDynamics {
 }
 
 /// SR = ω_t/ω_p, and its partial derivatives; zero when the pump stands still.
-fn speed_ratio(wp: f64, wt: f64) -> (f64, f64, f64) {
+pub(super) fn speed_ratio(wp: f64, wt: f64) -> (f64, f64, f64) {
     if wp == 0.0 {
         (0.0, 0.0, 0.0)
     } else {
@@ -149,7 +149,7 @@ fn speed_ratio(wp: f64, wt: f64) -> (f64, f64, f64) {
 }
 
 /// Table torques `(T_p,tr, T_t,tr)` and their gradients with respect to (ω_p, ω_t).
-fn table_torques(c: &Characteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [f64; 2]) {
+pub(super) fn table_torques(c: &Characteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [f64; 2]) {
     let (sr, dsr_dwp, dsr_dwt) = speed_ratio(wp, wt);
     let l = c.lookup(sr);
     let w2 = signed_square(wp);
@@ -167,7 +167,7 @@ fn table_torques(c: &Characteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [
 }
 
 /// Pump speed of a table steady state, and the table's pump torque there.
-fn table_steady(c: &Characteristic, wp: f64, wt: f64) -> CoreResult<f64> {
+pub(super) fn table_steady(c: &Characteristic, wp: f64, wt: f64) -> CoreResult<f64> {
     let op = c.operating_point(wp, wt)?;
     Ok(op.pump_torque_nm)
 }
@@ -197,116 +197,6 @@ impl ConverterDynamics for TableDynamics {
     }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         Ok(SteadyPoint { u: [wp, wt, 0.0, 0.0], pump_torque_nm: table_steady(&self.characteristic, wp, wt)? })
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Quasi-dynamic model
-
-/// tcsim's quasi-dynamic model: the steady-state tables plus fluid inertia (physics notes §5;
-/// derivation in docs/models.md). States ω_p, ω_t, Q:
-///
-/// ```text
-///     I_p ω̇_p + ρ S_p Q̇ = T_p − CF(SR) ω_p|ω_p|
-///     I_t ω̇_t + ρ S_t Q̇ = TR(SR) CF(SR) ω_p|ω_p| + T_t
-///     Q̇ = (Q_ss − Q)/τ_Q,    Q_ss = CF(SR) |ω_p| / (ρ R_p²)
-/// ```
-///
-/// `Q_ss` is the Euler-equation flow that carries the table's pump torque with the fluid leaving
-/// the pump at `R_p` and entering it with no swirl. At steady state Q̇ = 0, so the torques are the
-/// table's whatever the shape effects; with S = 0 the flow does not act on the speeds at all.
-#[derive(Debug, Clone)]
-pub struct QuasiDynamics {
-    pub characteristic: Characteristic,
-    pub inertia: Inertias,
-    pub fluid_density_kg_m3: f64,
-    pub pump_radius_m: f64,
-    pub pump_shape_effect_m2: f64,
-    pub turbine_shape_effect_m2: f64,
-    pub flow_time_constant_s: f64,
-}
-
-impl QuasiDynamics {
-    pub fn validate(&self) -> CoreResult<()> {
-        let checks = [
-            ("fluid_density_kg_m3", self.fluid_density_kg_m3, "a finite, positive density in kg/m³"),
-            ("pump_exit_radius_m", self.pump_radius_m, "a finite, positive radius in m"),
-            ("quasi_dynamic.flow_time_constant_s", self.flow_time_constant_s, "a finite, positive time constant in s"),
-        ];
-        for (name, v, expected) in checks {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(CoreError::new(name, v, expected));
-            }
-        }
-        for (name, v) in [
-            ("quasi_dynamic.pump_shape_effect_m2", self.pump_shape_effect_m2),
-            ("quasi_dynamic.turbine_shape_effect_m2", self.turbine_shape_effect_m2),
-        ] {
-            if !v.is_finite() {
-                return Err(CoreError::new(name, v, "a finite shape effect in m²"));
-            }
-        }
-        Ok(())
-    }
-
-    fn flow_scale(&self) -> f64 {
-        1.0 / (self.fluid_density_kg_m3 * self.pump_radius_m * self.pump_radius_m)
-    }
-
-    /// Steady flow Q_ss and its gradient with respect to (ω_p, ω_t).
-    fn steady_flow(&self, wp: f64, wt: f64) -> (f64, [f64; 2]) {
-        let (sr, dsr_dwp, dsr_dwt) = speed_ratio(wp, wt);
-        let l = self.characteristic.lookup(sr);
-        let k = self.flow_scale();
-        let q = k * l.capacity_factor_nm_s2 * wp.abs();
-        let dq = [
-            k * (l.d_capacity_factor * dsr_dwp * wp.abs() + l.capacity_factor_nm_s2 * wp.signum()),
-            k * l.d_capacity_factor * dsr_dwt * wp.abs(),
-        ];
-        (q, dq)
-    }
-}
-
-impl ConverterDynamics for QuasiDynamics {
-    fn coordinates(&self) -> [bool; 4] {
-        [true, true, false, true]
-    }
-    fn mass(&self) -> Mat4 {
-        let rho = self.fluid_density_kg_m3;
-        let mut m = [[0.0; 4]; 4];
-        m[PUMP][PUMP] = self.inertia.pump_kg_m2;
-        m[TURBINE][TURBINE] = self.inertia.turbine_kg_m2;
-        m[PUMP][FLOW] = rho * self.pump_shape_effect_m2;
-        m[TURBINE][FLOW] = rho * self.turbine_shape_effect_m2;
-        m[FLOW][FLOW] = 1.0;
-        m
-    }
-    fn forces(&self, u: &Vec4, _s: f64) -> Vec4 {
-        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
-        let (qss, _) = self.steady_flow(u[PUMP], u[TURBINE]);
-        [-tp, tt, 0.0, (qss - u[FLOW]) / self.flow_time_constant_s]
-    }
-    fn force_jacobian(&self, u: &Vec4, _s: f64) -> Mat4 {
-        let (_, _, dtp, dtt) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
-        let (_, dq) = self.steady_flow(u[PUMP], u[TURBINE]);
-        let tau = self.flow_time_constant_s;
-        let mut j = [[0.0; 4]; 4];
-        j[PUMP][PUMP] = -dtp[0];
-        j[PUMP][TURBINE] = -dtp[1];
-        j[TURBINE][PUMP] = dtt[0];
-        j[TURBINE][TURBINE] = dtt[1];
-        j[FLOW][PUMP] = dq[0] / tau;
-        j[FLOW][TURBINE] = dq[1] / tau;
-        j[FLOW][FLOW] = -1.0 / tau;
-        j
-    }
-    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
-        // the flow row is a lag, not a power balance
-        -(u[PUMP] * f[PUMP] + u[TURBINE] * f[TURBINE])
-    }
-    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
-        let tp = table_steady(&self.characteristic, wp, wt)?;
-        Ok(SteadyPoint { u: [wp, wt, 0.0, self.steady_flow(wp, wt).0], pump_torque_nm: tp })
     }
 }
 
@@ -342,7 +232,7 @@ struct HtConst {
     area: f64,
     r2: [f64; 3],
     /// R_x tan α_x at each exit.
-    rt: [f64; 3],
+    radius_tan: [f64; 3],
     /// Coefficients of q in the shock velocities (eqs 2.20–2.22).
     b: [f64; 3],
     c: [f64; 3],
@@ -382,42 +272,36 @@ impl HtDynamics {
 
     /// `ρ L_f / A`, the fluid's own inertance.
     pub fn fluid_inertance(&self) -> f64 {
-        self.geometry.get(HtParam::FluidDensity) * self.fluid_length_m / self.geometry.get(HtParam::FlowArea)
+        self.mass_matrix_bound().inertance_kg_m4
     }
 
-    /// Largest admissible magnitude of each shape effect with the others as given: M is positive
-    /// definite iff `ρL_f/A > Σ ρ² S_x² / I_x` (the Schur complement of the diagonal inertias).
+    /// The admissibility of the mass matrix with these parameters.
+    pub fn mass_matrix_bound(&self) -> MassMatrixBound {
+        MassMatrixBound::new(&self.geometry, &self.inertia, self.fluid_length_m, self.shape_effect_m2)
+    }
+
+    /// Largest admissible magnitude of each shape effect with the others as given (see
+    /// [`MassMatrixBound::shape_effect_bounds`]).
     pub fn shape_effect_bounds(&self) -> [f64; 3] {
-        let rho = self.geometry.get(HtParam::FluidDensity);
-        let inertia = self.inertia_array();
-        let terms: [f64; 3] = std::array::from_fn(|i| rho * rho * self.shape_effect_m2[i].powi(2) / inertia[i]);
-        std::array::from_fn(|i| {
-            let room = self.fluid_inertance() - (terms.iter().sum::<f64>() - terms[i]);
-            if room <= 0.0 {
-                0.0
-            } else {
-                (room * inertia[i]).sqrt() / rho
-            }
-        })
+        self.mass_matrix_bound().shape_effect_bounds()
     }
 
     fn check_mass_matrix(&self) -> CoreResult<()> {
-        let rho = self.geometry.get(HtParam::FluidDensity);
-        let inertia = self.inertia_array();
-        let terms: [f64; 3] = std::array::from_fn(|i| rho * rho * self.shape_effect_m2[i].powi(2) / inertia[i]);
-        if self.fluid_inertance() - terms.iter().sum::<f64>() > 0.0 {
+        let b = self.mass_matrix_bound();
+        if b.margin_kg_m4() > 0.0 {
             return Ok(());
         }
         // blame the largest contribution
+        let terms = b.shape_terms_kg_m4;
         let i = (0..3).max_by(|&a, &b| terms[a].total_cmp(&terms[b])).unwrap_or(0);
-        let bound = self.shape_effect_bounds()[i];
+        let bound = b.shape_effect_bounds()[i];
         Err(CoreError::new(
             SHAPE_KEYS[i],
             self.shape_effect_m2[i],
             format!(
                 "|S| < {} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
                 sig(bound),
-                sig(self.fluid_inertance()),
+                sig(b.inertance_kg_m4),
                 sig(terms.iter().sum::<f64>())
             ),
         ))
@@ -432,13 +316,60 @@ impl HtDynamics {
             rho: g.get(FluidDensity),
             area: g.get(FlowArea),
             r2: r.map(|x| x * x),
-            rt: [r[0] * t[0], r[1] * t[1], r[2] * t[2]],
+            radius_tan: [r[0] * t[0], r[1] * t[1], r[2] * t[2]],
             // pump inlet from stator exit, turbine inlet from pump exit, stator inlet from turbine exit
             b: [t[2] - ti[0], t[0] - ti[1], t[1] - ti[2]],
             c: [g.get(PumpShockLoss), g.get(TurbineShockLoss), g.get(StatorShockLoss)],
             friction: g.get(FrictionLoss) * (3.0 + t[0] * t[0] + t[1] * t[1] + t[2] * t[2]),
             r,
         }
+    }
+}
+
+/// The admissibility bound of the Hrovat & Tobler mass matrix on the shape effects (physics notes
+/// §4): `M` is positive definite iff `ρL_f/A > Σ ρ²S_x²/I_x` (the Schur complement of the diagonal
+/// inertias). Computed for any parameters, admissible or not.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MassMatrixBound {
+    /// Fluid density ρ, kg/m³.
+    pub density_kg_m3: f64,
+    /// Pump, turbine and stator inertias `I_x`, kg·m².
+    pub inertia_kg_m2: [f64; 3],
+    /// `ρ L_f / A`, the fluid's own inertance, kg/m⁴.
+    pub inertance_kg_m4: f64,
+    /// `ρ² S_x² / I_x` for pump, turbine and stator, kg/m⁴.
+    pub shape_terms_kg_m4: [f64; 3],
+}
+
+impl MassMatrixBound {
+    pub fn new(geometry: &HtGeometry<f64>, inertia: &Inertias, fluid_length_m: f64, shape_effect_m2: [f64; 3]) -> Self {
+        let rho = geometry.get(HtParam::FluidDensity);
+        let inertia = [inertia.pump_kg_m2, inertia.turbine_kg_m2, inertia.stator_kg_m2];
+        MassMatrixBound {
+            density_kg_m3: rho,
+            inertia_kg_m2: inertia,
+            inertance_kg_m4: rho * fluid_length_m / geometry.get(HtParam::FlowArea),
+            shape_terms_kg_m4: std::array::from_fn(|i| rho * rho * shape_effect_m2[i].powi(2) / inertia[i]),
+        }
+    }
+
+    /// `ρL_f/A − Σ ρ²S_x²/I_x`, kg/m⁴: the mass matrix is admissible iff this is positive.
+    pub fn margin_kg_m4(&self) -> f64 {
+        self.inertance_kg_m4 - self.shape_terms_kg_m4.iter().sum::<f64>()
+    }
+
+    /// Largest admissible magnitude of each shape effect with the others as given, m² (0 when the
+    /// others already use up the inertance).
+    pub fn shape_effect_bounds(&self) -> [f64; 3] {
+        let (rho, inertia, terms) = (self.density_kg_m3, self.inertia_kg_m2, self.shape_terms_kg_m4);
+        std::array::from_fn(|i| {
+            let room = self.inertance_kg_m4 - (terms.iter().sum::<f64>() - terms[i]);
+            if room <= 0.0 {
+                0.0
+            } else {
+                (room * inertia[i]).sqrt() / rho
+            }
+        })
     }
 }
 
@@ -475,12 +406,13 @@ impl ConverterDynamics for HtDynamics {
         let flow = u[FLOW];
         let q = flow / k.area;
         // angular momentum per unit mass flow leaving each element
-        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.rt[i] * q);
+        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.radius_tan[i] * q);
         let head = k.r2[0] * w[0] * w[0] + k.r2[1] * w[1] * w[1] + k.r2[2] * w[2] * w[2]
             - k.r2[2] * w[0] * w[2]
             - k.r2[0] * w[1] * w[0]
             - k.r2[1] * w[2] * w[1];
-        let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
+        let a =
+            [k.radius_tan[0] - k.radius_tan[2], k.radius_tan[1] - k.radius_tan[0], k.radius_tan[2] - k.radius_tan[1]];
         let linear = q * (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]);
         let v = shock_velocities(k, &w, q);
         let loss =
@@ -498,8 +430,9 @@ impl ConverterDynamics for HtDynamics {
         let w = [u[PUMP], u[TURBINE], u[STATOR]];
         let flow = u[FLOW];
         let q = flow / area;
-        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.rt[i] * q);
-        let a = [k.rt[0] - k.rt[2], k.rt[1] - k.rt[0], k.rt[2] - k.rt[1]];
+        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.radius_tan[i] * q);
+        let a =
+            [k.radius_tan[0] - k.radius_tan[2], k.radius_tan[1] - k.radius_tan[0], k.radius_tan[2] - k.radius_tan[1]];
         let v = shock_velocities(k, &w, q);
         let mut j = [[0.0; 4]; 4];
         // torques: F_i = −ρ (h_i − h_prev(i)) Q with prev = stator, pump, turbine
@@ -508,7 +441,7 @@ impl ConverterDynamics for HtDynamics {
             let p = prev[i];
             j[i][i] = -rho * k.r2[i] * flow;
             j[i][p] = rho * k.r2[p] * flow;
-            j[i][FLOW] = -rho * (h[i] - h[p]) - rho * flow * (k.rt[i] - k.rt[p]) / area;
+            j[i][FLOW] = -rho * (h[i] - h[p]) - rho * flow * (k.radius_tan[i] - k.radius_tan[p]) / area;
         }
         // head of eq 2.15
         let dhead = [
@@ -544,9 +477,43 @@ impl ConverterDynamics for HtDynamics {
     }
 }
 
+impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
+    fn coordinates(&self) -> [bool; 4] {
+        (**self).coordinates()
+    }
+    fn mass(&self) -> Mat4 {
+        (**self).mass()
+    }
+    fn forces(&self, u: &Vec4, s: f64) -> Vec4 {
+        (**self).forces(u, s)
+    }
+    fn force_jacobian(&self, u: &Vec4, s: f64) -> Mat4 {
+        (**self).force_jacobian(u, s)
+    }
+    fn transferred(&self, f: &Vec4) -> (f64, f64) {
+        (**self).transferred(f)
+    }
+    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
+        (**self).loss_power_w(u, f)
+    }
+    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
+        (**self).steady_point(wp, wt)
+    }
+    fn has_stator_clutch(&self) -> bool {
+        (**self).has_stator_clutch()
+    }
+    fn has_flow_sign(&self) -> bool {
+        (**self).has_flow_sign()
+    }
+    fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
+        (**self).zero_flow_head(u)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::converter::quasi_dynamic::QuasiDynamics;
 
     pub(crate) fn c1() -> Characteristic {
         Characteristic::new(
@@ -652,6 +619,19 @@ mod tests {
     }
 
     #[test]
+    fn mass_matrix_bound_is_the_models_check() {
+        let shape = [0.004, -0.003, 0.001];
+        let m = ht(shape);
+        let b = MassMatrixBound::new(&m.geometry, &m.inertia, m.fluid_length_m, shape);
+        assert_eq!(b.inertance_kg_m4, m.fluid_inertance());
+        assert_eq!(b.shape_effect_bounds(), m.shape_effect_bounds());
+        assert!(b.margin_kg_m4() > 0.0);
+        let too_big = MassMatrixBound::new(&m.geometry, &m.inertia, m.fluid_length_m, [1.0, 0.0, 0.0]);
+        assert!(too_big.margin_kg_m4() <= 0.0);
+        assert!(HtDynamics::new(m.geometry, m.inertia, m.fluid_length_m, [1.0, 0.0, 0.0]).is_err());
+    }
+
+    #[test]
     fn inadmissible_shape_effect_is_refused_with_its_bound() {
         // S_p = 0.2 m² (thesis §4.1 range) breaks ρL_f/A > ρ²S_p²/I_p; the bound is √(I_p ρL_f/A)/ρ
         let err = HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.2, 0.0, 0.0]).unwrap_err();
@@ -666,105 +646,5 @@ mod tests {
         let b = ht([0.0; 3]).shape_effect_bounds()[1];
         assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.0, 0.999 * b, 0.0]).is_ok());
         assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.0, 1.001 * b, 0.0]).is_err());
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
-// Building a model from a specification
-
-/// A model specification read field by field (the Python dicts of `tcsim.transient.DynamicModel`,
-/// the FMU's `resources/model.json`). `numbers(key)` is None when the key is missing.
-pub trait ModelSpec {
-    fn kind(&self) -> CoreResult<String>;
-    fn numbers(&self, key: &str) -> Option<Vec<f64>>;
-}
-
-fn numbers(spec: &dyn ModelSpec, key: &str, n: Option<usize>) -> CoreResult<Vec<f64>> {
-    let v = spec.numbers(key).ok_or_else(|| CoreError::new(key, "missing", "a value in the model specification"))?;
-    match n {
-        Some(n) if v.len() != n => Err(CoreError::new(key, format!("{} values", v.len()), format!("{n} values"))),
-        _ => Ok(v),
-    }
-}
-
-fn number(spec: &dyn ModelSpec, key: &str) -> CoreResult<f64> {
-    Ok(numbers(spec, key, Some(1))?[0])
-}
-
-/// The model a specification describes: `kind` is `table`, `quasi-dynamic` or `hrovat-tobler`;
-/// the keys are those of `tcsim.transient.DynamicModel.spec`.
-pub fn build_model(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics + Send>> {
-    let kind = spec.kind()?;
-    let i = numbers(spec, "inertia_kg_m2", Some(3))?;
-    let inertia = Inertias::new(i[0], i[1], i[2])?;
-    let table = || -> CoreResult<Characteristic> {
-        Characteristic::new(
-            numbers(spec, "speed_ratio", None)?,
-            numbers(spec, "torque_ratio", None)?,
-            numbers(spec, "capacity_factor_nm_s2", None)?,
-        )
-    };
-    Ok(match kind.as_str() {
-        "table" => Box::new(TableDynamics { characteristic: table()?, inertia }),
-        "quasi-dynamic" => {
-            let shape = numbers(spec, "shape_effect_m2", Some(2))?;
-            let m = QuasiDynamics {
-                characteristic: table()?,
-                inertia,
-                fluid_density_kg_m3: number(spec, "fluid_density_kg_m3")?,
-                pump_radius_m: number(spec, "pump_exit_radius_m")?,
-                pump_shape_effect_m2: shape[0],
-                turbine_shape_effect_m2: shape[1],
-                flow_time_constant_s: number(spec, "flow_time_constant_s")?,
-            };
-            m.validate()?;
-            Box::new(m)
-        }
-        "hrovat-tobler" => {
-            let g = numbers(spec, "geometry", Some(crate::hrovat_tobler::N_PARAMS))?;
-            let mut values = [0.0; crate::hrovat_tobler::N_PARAMS];
-            values.copy_from_slice(&g);
-            let shape = numbers(spec, "shape_effect_m2", Some(3))?;
-            Box::new(HtDynamics::new(
-                HtGeometry::new(values)?,
-                inertia,
-                number(spec, "fluid_length_m")?,
-                [shape[0], shape[1], shape[2]],
-            )?)
-        }
-        other => return Err(CoreError::new("kind", other, "table, quasi-dynamic or hrovat-tobler")),
-    })
-}
-
-impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
-    fn coordinates(&self) -> [bool; 4] {
-        (**self).coordinates()
-    }
-    fn mass(&self) -> Mat4 {
-        (**self).mass()
-    }
-    fn forces(&self, u: &Vec4, s: f64) -> Vec4 {
-        (**self).forces(u, s)
-    }
-    fn force_jacobian(&self, u: &Vec4, s: f64) -> Mat4 {
-        (**self).force_jacobian(u, s)
-    }
-    fn transferred(&self, f: &Vec4) -> (f64, f64) {
-        (**self).transferred(f)
-    }
-    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
-        (**self).loss_power_w(u, f)
-    }
-    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
-        (**self).steady_point(wp, wt)
-    }
-    fn has_stator_clutch(&self) -> bool {
-        (**self).has_stator_clutch()
-    }
-    fn has_flow_sign(&self) -> bool {
-        (**self).has_flow_sign()
-    }
-    fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
-        (**self).zero_flow_head(u)
     }
 }

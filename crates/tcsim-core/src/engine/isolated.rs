@@ -8,7 +8,7 @@
 //!
 //! * **free**: a state of the ODE;
 //! * **given**: a measured speed from the [`Drive`]; its rate is the signal's smoothed derivative
-//!   ([`crate::signal`]);
+//!   ([`crate::engine::signal`]);
 //! * **held** at zero: the stator while the one-way clutch holds, the flow while it is stalled.
 //!
 //! The free coordinates `x` obey `M_xx ẋ = F_x(u) + T_x(t, u) − M_xz ż(t)`, handed to diffsol in
@@ -36,10 +36,13 @@
 //! side is smooth and the energy identity holds exactly (the held flow does no work). This is the
 //! same state the closed-form steady state calls `no-flow` near SR = 1.
 
-use crate::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::engine::converter_events::{self, ConverterRoot};
+use crate::engine::converter_events::{EventKind, Mode, Sample};
+use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
+use crate::engine::segment::SmoothSegment;
+use crate::engine::signal::Signal;
 use crate::error::CoreError;
-use crate::segment::SmoothSegment;
-use crate::signal::Signal;
 
 /// How the converter is driven (issue: drives a, b, c).
 #[derive(Debug, Clone)]
@@ -63,7 +66,7 @@ pub struct TurbineLoad {
 }
 
 impl Drive {
-    fn given(&self, coordinate: usize) -> Option<&Signal> {
+    pub(super) fn given(&self, coordinate: usize) -> Option<&Signal> {
         match (self, coordinate) {
             (Drive::PumpTorqueTurbineSpeed { turbine_speed_rad_s, .. }, TURBINE) => Some(turbine_speed_rad_s),
             (Drive::Speeds { turbine_speed_rad_s, .. }, TURBINE) => Some(turbine_speed_rad_s),
@@ -101,47 +104,6 @@ impl Drive {
     }
 }
 
-/// Tolerances and limits of the BDF solver.
-#[derive(Debug, Clone, Copy)]
-pub struct SolverOptions {
-    pub rtol: f64,
-    pub speed_atol_rad_s: f64,
-    pub flow_atol_m3_s: f64,
-    /// Initial step at the start and after every event, s.
-    pub first_step_s: f64,
-    /// More events than this in one run is reported as chattering.
-    pub max_events: usize,
-    pub max_steps: usize,
-    /// Event hysteresis: a switch fires when its root function passes this far beyond zero
-    /// (flow m³/s, stator speed rad/s, stator torque N·m, flow head Pa). It keeps round-off at a
-    /// freshly switched zero (Q = 0, ω_s = 0) from firing the event back, and it is far below the
-    /// tolerances of the results.
-    pub hysteresis: Hysteresis,
-}
-
-/// See [`SolverOptions::hysteresis`].
-#[derive(Debug, Clone, Copy)]
-pub struct Hysteresis {
-    pub flow_m3_s: f64,
-    pub stator_speed_rad_s: f64,
-    pub stator_torque_nm: f64,
-    pub head_pa: f64,
-}
-
-impl Default for SolverOptions {
-    fn default() -> Self {
-        Self {
-            rtol: 1e-6,
-            speed_atol_rad_s: 1e-5,
-            flow_atol_m3_s: 1e-8,
-            first_step_s: 1e-5,
-            max_events: 10_000,
-            max_steps: 2_000_000,
-            hysteresis: Hysteresis { flow_m3_s: 1e-7, stator_speed_rad_s: 1e-4, stator_torque_nm: 1e-6, head_pa: 1e-3 },
-        }
-    }
-}
-
 /// Optional initial values; what is not given comes from the steady state consistent with the
 /// first input sample ([`initial_state`]).
 #[derive(Debug, Clone, Copy, Default)]
@@ -152,76 +114,12 @@ pub struct InitialState {
     pub flow_m3_s: Option<f64>,
 }
 
-/// Discrete state of the piecewise-smooth system.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Mode {
-    pub stator_locked: bool,
-    /// Sign of Q in the losses: +1, −1, or 0 while the flow is held at zero.
-    pub flow_sign: f64,
-}
-
-/// What went wrong in a transient run.
-#[derive(Debug, Clone)]
-pub enum TransientError {
-    /// The user's input (exit code 2).
-    Input(CoreError),
-    /// The solver failed (exit code 1): time, state and message.
-    Solver { time_s: f64, state: Vec<f64>, message: String },
-}
-
-impl From<CoreError> for TransientError {
-    fn from(e: CoreError) -> Self {
-        TransientError::Input(e)
-    }
-}
-
-impl std::fmt::Display for TransientError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            TransientError::Input(e) => write!(f, "{e}"),
-            TransientError::Solver { time_s, state, message } => {
-                let names = ["ω_p", "ω_t", "ω_s", "Q", "ω_o", "ω_f", "ω_r", "v", "θ_f", "θ_r", "T_fast", "T_boost"];
-                let shown: Vec<String> = state
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| format!("{} = {v:.6}", names.get(i).copied().unwrap_or("x")))
-                    .collect();
-                write!(f, "solver failed at t = {time_s:.6} s ({}): {message}", shown.join(", "))
-            }
-        }
-    }
-}
-
-pub type TransientResult<T> = Result<T, TransientError>;
-
-/// One sampled instant of a run.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Sample {
-    pub time_s: f64,
-    pub u: Vec4,
-    pub u_dot: Vec4,
-    /// External torques on pump, turbine, stator: `M u̇ − F` with the converter's own mass.
-    pub torque: [f64; 3],
-    pub transferred: (f64, f64),
-    pub mode: Mode,
-    pub loss_power_w: f64,
-    pub stored_energy_j: f64,
-}
-
 /// An event: time, kind and the mode after it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Event {
     pub time_s: f64,
     pub kind: EventKind,
     pub mode: Mode,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum EventKind {
-    StatorRelease,
-    StatorLock,
-    FlowZero,
-    FlowStart,
 }
 
 /// The result of a run: samples at the requested times, the events, and solver statistics.
@@ -245,17 +143,8 @@ enum Role {
     Absent,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Root {
-    StatorTorque,
-    StatorSpeed,
-    Flow,
-    FlowStartsPositive,
-    FlowStartsNegative,
-}
-
 /// One smooth piece of a run: a mode, the roles of the coordinates and the reduced mass matrix.
-struct Segment<'a> {
+pub(super) struct Segment<'a> {
     model: &'a dyn ConverterDynamics,
     drive: &'a Drive,
     /// The model's mass matrix.
@@ -267,20 +156,18 @@ struct Segment<'a> {
     free: Vec<usize>,
     /// Inverse of `M_xx`.
     inv: Mat4,
-    roots: Vec<Root>,
+    pub(super) roots: Vec<ConverterRoot>,
 }
 
 impl<'a> Segment<'a> {
-    fn new(model: &'a dyn ConverterDynamics, drive: &'a Drive, mode: Mode) -> Self {
+    pub(super) fn new(model: &'a dyn ConverterDynamics, drive: &'a Drive, mode: Mode) -> Self {
         let present = model.coordinates();
         let role: [Role; 4] = std::array::from_fn(|c| {
             if !present[c] {
                 Role::Absent
             } else if drive.given(c).is_some() {
                 Role::Given
-            } else if (c == STATOR && mode.stator_locked)
-                || (c == FLOW && model.has_flow_sign() && mode.flow_sign == 0.0)
-            {
+            } else if (c == STATOR && mode.stator_locked) || (c == FLOW && converter_events::flow_held(model, mode)) {
                 Role::Held
             } else {
                 Role::Free
@@ -300,17 +187,7 @@ impl<'a> Segment<'a> {
             }
         }
         let inv = invert(n, &sub).expect("the reduced mass matrix of a positive-definite M is invertible");
-        let mut roots = Vec::new();
-        if model.has_stator_clutch() && present[STATOR] {
-            roots.push(if mode.stator_locked { Root::StatorTorque } else { Root::StatorSpeed });
-        }
-        if model.has_flow_sign() {
-            if mode.flow_sign == 0.0 {
-                roots.extend([Root::FlowStartsPositive, Root::FlowStartsNegative]);
-            } else {
-                roots.push(Root::Flow);
-            }
-        }
+        let roots = converter_events::roots(model, mode);
         Self { model, drive, mass, dyn_mass, mode, role, free, inv, roots }
     }
 
@@ -319,7 +196,7 @@ impl<'a> Segment<'a> {
         self.free.len().max(1)
     }
 
-    fn full(&self, x: &[f64], t: f64) -> Vec4 {
+    pub(super) fn full(&self, x: &[f64], t: f64) -> Vec4 {
         let mut u = [0.0; 4];
         for (i, &c) in self.free.iter().enumerate() {
             u[c] = x[i];
@@ -332,7 +209,7 @@ impl<'a> Segment<'a> {
         u
     }
 
-    fn state(&self, u: &Vec4) -> Vec<f64> {
+    pub(super) fn state(&self, u: &Vec4) -> Vec<f64> {
         if self.free.is_empty() {
             vec![0.0]
         } else {
@@ -415,7 +292,7 @@ impl<'a> Segment<'a> {
     }
 
     /// All coordinates, their rates and the forces at (x, t).
-    fn kinematics(&self, x: &[f64], t: f64) -> (Vec4, Vec4, Vec4) {
+    pub(super) fn kinematics(&self, x: &[f64], t: f64) -> (Vec4, Vec4, Vec4) {
         let u = self.full(x, t);
         let f = self.model.forces(&u, self.mode.flow_sign);
         let mut ud = self.given_rates(t);
@@ -432,61 +309,32 @@ impl<'a> Segment<'a> {
 
     /// `M u̇ − F` with the converter's own mass: the external torque on every coordinate.
     fn external_torques(&self, ud: &Vec4, f: &Vec4) -> Vec4 {
-        std::array::from_fn(|r| (0..4).map(|c| self.mass[r][c] * ud[c]).sum::<f64>() - f[r])
+        converter_events::external_torques(&self.mass, ud, f)
     }
 
     /// The net head on a held flow, `d = F_Q(σ = 0) − (M u̇)_Q`, and the shock term `P₀`.
     fn held_flow_balance(&self, u: &Vec4, ud: &Vec4) -> (f64, f64) {
-        let (head, shock) = self.model.zero_flow_head(u);
-        let inertial: f64 = (0..4).map(|c| self.mass[FLOW][c] * ud[c]).sum();
-        (head - inertial, shock)
+        converter_events::held_flow_balance(self.model, u, &self.mass[FLOW], ud)
     }
 
     /// Root functions, each positive while the mode holds (with the hysteresis `h`).
-    fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
+    pub(super) fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
         let (u, ud, f) = self.kinematics(x, t);
         for (k, root) in self.roots.iter().enumerate() {
-            out[k] = match root {
-                Root::StatorTorque => self.external_torques(&ud, &f)[STATOR] + h.stator_torque_nm,
-                Root::StatorSpeed => u[STATOR] + h.stator_speed_rad_s,
-                Root::Flow => self.mode.flow_sign * u[FLOW] + h.flow_m3_s,
-                Root::FlowStartsPositive => {
-                    let (d, p0) = self.held_flow_balance(&u, &ud);
-                    p0 - d + h.head_pa
-                }
-                Root::FlowStartsNegative => {
-                    let (d, p0) = self.held_flow_balance(&u, &ud);
-                    p0 + d + h.head_pa
-                }
-            };
+            out[k] = converter_events::root_value(
+                *root,
+                self.mode,
+                &u,
+                h,
+                || self.external_torques(&ud, &f)[STATOR],
+                || self.held_flow_balance(&u, &ud),
+            );
         }
     }
 
-    fn sample(&self, x: &[f64], t: f64) -> Sample {
+    pub(super) fn sample(&self, x: &[f64], t: f64) -> Sample {
         let (u, ud, f) = self.kinematics(x, t);
-        let e = self.external_torques(&ud, &f);
-        let stored = 0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| self.mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
-        let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
-        let transferred = self.model.transferred(&f);
-        if self.role[STATOR] == Role::Absent {
-            // the reaction that balances the transferred torques
-            torque[2] = transferred.1 - transferred.0;
-        }
-        let loss = if self.mode.flow_sign == 0.0 && self.model.has_flow_sign() {
-            0.0
-        } else {
-            self.model.loss_power_w(&u, &f)
-        };
-        Sample {
-            time_s: t,
-            u,
-            u_dot: ud,
-            torque,
-            transferred,
-            mode: self.mode,
-            loss_power_w: loss,
-            stored_energy_j: stored,
-        }
+        converter_events::sample(self.model, self.mode, t, u, ud, f)
     }
 
     fn atol(&self, o: &SolverOptions) -> Vec<f64> {
@@ -542,14 +390,7 @@ fn flow_sign_at_zero(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: 
     let mut u0 = *u;
     u0[FLOW] = 0.0;
     let (uu, ud, _) = seg.kinematics(&seg.state(&u0), t);
-    let (d, p0) = seg.held_flow_balance(&uu, &ud);
-    if d > p0 {
-        1.0
-    } else if d < -p0 {
-        -1.0
-    } else {
-        0.0
-    }
+    converter_events::flow_sign_from_balance(seg.held_flow_balance(&uu, &ud))
 }
 
 /// The steady state consistent with the inputs at time `t0` (documented default of
@@ -725,9 +566,6 @@ pub fn simulate_from(
                 let mut next = seg.full(&x_root, t_root);
                 let (kind, new_mode) = switch(&seg, root, &mut next, t_root);
                 traj.events.push(Event { time_s: t_root, kind, mode: new_mode });
-                if std::env::var("TCSIM_DEBUG").is_ok() {
-                    eprintln!("event {t_root} {kind:?} {new_mode:?} u={next:?}");
-                }
                 if traj.events.len() > options.max_events {
                     return Err(TransientError::Solver {
                         time_s: t_root,
@@ -745,37 +583,16 @@ pub fn simulate_from(
 
 /// The mode after `root` fired, with the state adjusted (a locking stator stops, a reversing flow
 /// passes zero).
-fn switch(seg: &Segment, root: Root, u: &mut Vec4, t: f64) -> (EventKind, Mode) {
+pub(super) fn switch(seg: &Segment, root: ConverterRoot, u: &mut Vec4, t: f64) -> (EventKind, Mode) {
     let mut mode = seg.mode;
-    let kind = match root {
-        Root::StatorTorque => {
-            mode.stator_locked = false;
-            EventKind::StatorRelease
-        }
-        Root::StatorSpeed => {
-            mode.stator_locked = true;
-            u[STATOR] = 0.0;
-            EventKind::StatorLock
-        }
-        Root::Flow => {
-            u[FLOW] = 0.0;
-            mode.flow_sign = flow_sign_at_zero(seg.model, seg.drive, u, t, mode.stator_locked);
-            EventKind::FlowZero
-        }
-        Root::FlowStartsPositive => {
-            mode.flow_sign = 1.0;
-            EventKind::FlowStart
-        }
-        Root::FlowStartsNegative => {
-            mode.flow_sign = -1.0;
-            EventKind::FlowStart
-        }
-    };
+    let stator_locked = seg.mode.stator_locked;
+    let kind =
+        converter_events::switch(root, &mut mode, u, |u| flow_sign_at_zero(seg.model, seg.drive, u, t, stator_locked));
     (kind, mode)
 }
 
 impl SmoothSegment for Segment<'_> {
-    type Root = Root;
+    type Root = ConverterRoot;
     type Sample = Sample;
     fn n_states(&self) -> usize {
         Segment::n_states(self)
@@ -792,7 +609,7 @@ impl SmoothSegment for Segment<'_> {
     fn mass_times(&self, v: &[f64], beta: f64, y: &mut [f64]) {
         Segment::mass_times(self, v, beta, y)
     }
-    fn roots(&self) -> &[Root] {
+    fn roots(&self) -> &[ConverterRoot] {
         &self.roots
     }
     fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
@@ -806,7 +623,7 @@ impl SmoothSegment for Segment<'_> {
     }
 }
 
-/// Integrate one segment (see [`crate::segment::run_segment`]).
+/// Integrate one segment (see [`crate::engine::segment::run_segment`]).
 fn run_segment(
     seg: &Segment,
     u0: &Vec4,
@@ -814,78 +631,7 @@ fn run_segment(
     t_end: f64,
     times_s: &[f64],
     o: &SolverOptions,
-    traj: &mut Traj,
-) -> TransientResult<Option<(f64, Root, Vec<f64>)>> {
-    crate::segment::run_segment(seg, seg.state(u0), t0, t_end, times_s, o, &mut traj.samples, &mut traj.steps)
-}
-
-type Traj = Trajectory;
-
-// ---------------------------------------------------------------------------------------------
-// The model as a host's ODE: Model Exchange
-
-/// Number of event indicators of a model in [`ModeView`]: the stator clutch, and two for the flow
-/// direction (for models without them, indicators that never change sign).
-pub const EVENT_INDICATORS: usize = 3;
-
-/// One mode of a model under a drive, seen from outside: the coordinates that are states in some
-/// mode, their rates, the event indicators and the mode switches. This is what a Model Exchange
-/// FMU exposes; the engine's own runs use the same functions.
-pub struct ModeView<'a> {
-    seg: Segment<'a>,
-}
-
-impl<'a> ModeView<'a> {
-    pub fn new(model: &'a dyn ConverterDynamics, drive: &'a Drive, mode: Mode) -> Self {
-        Self { seg: Segment::new(model, drive, mode) }
-    }
-
-    /// The coordinates that are states in some mode of this model and drive (fixed for a host).
-    pub fn state_coordinates(model: &dyn ConverterDynamics, drive: &Drive) -> Vec<usize> {
-        let present = model.coordinates();
-        (0..4).filter(|&c| present[c] && drive.given(c).is_none()).collect()
-    }
-
-    /// All coordinates from the given ones (drive at `t`) and `u`'s free ones; held ones are zero.
-    pub fn coordinates(&self, u: &Vec4, t: f64) -> Vec4 {
-        self.seg.full(&self.seg.state(u), t)
-    }
-
-    /// Rates of all coordinates at (u, t); a held coordinate's rate is zero.
-    pub fn rates(&self, u: &Vec4, t: f64) -> Vec4 {
-        self.seg.kinematics(&self.seg.state(u), t).1
-    }
-
-    /// Event indicators: positive while the mode holds.
-    pub fn indicators(&self, u: &Vec4, t: f64, h: &Hysteresis) -> [f64; EVENT_INDICATORS] {
-        let mut g = [1.0; EVENT_INDICATORS];
-        let mut values = vec![0.0; self.seg.roots.len()];
-        self.seg.root_values(&self.seg.state(u), t, h, &mut values);
-        for (root, v) in self.seg.roots.iter().zip(values) {
-            let slot = match root {
-                Root::StatorTorque | Root::StatorSpeed => 0,
-                Root::Flow | Root::FlowStartsPositive => 1,
-                Root::FlowStartsNegative => 2,
-            };
-            g[slot] = v;
-        }
-        g
-    }
-
-    /// The switch due at (u, t), if an indicator has reached zero: the event, the new mode, and
-    /// `u` adjusted (a locking stator stops, a reversing flow passes zero).
-    pub fn event(&self, u: &mut Vec4, t: f64, h: &Hysteresis) -> Option<(EventKind, Mode)> {
-        let mut values = vec![0.0; self.seg.roots.len()];
-        self.seg.root_values(&self.seg.state(u), t, h, &mut values);
-        let (i, _) = values.iter().enumerate().filter(|(_, v)| **v <= 0.0).min_by(|a, b| a.1.total_cmp(b.1))?;
-        let mut full = self.coordinates(u, t);
-        let (kind, mode) = switch(&self.seg, self.seg.roots[i], &mut full, t);
-        *u = full;
-        Some((kind, mode))
-    }
-
-    /// The sample (torques, effective torques, energy) at (u, t).
-    pub fn sample(&self, u: &Vec4, t: f64) -> Sample {
-        self.seg.sample(&self.seg.state(u), t)
-    }
+    traj: &mut Trajectory,
+) -> TransientResult<Option<(f64, ConverterRoot, Vec<f64>)>> {
+    crate::engine::segment::run_segment(seg, seg.state(u0), t0, t_end, times_s, o, &mut traj.samples, &mut traj.steps)
 }

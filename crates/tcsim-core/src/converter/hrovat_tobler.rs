@@ -270,6 +270,47 @@ pub enum StatorMode {
     NoFlow = 2,
 }
 
+/// The mode code of a batch point without a steady state ([`crate::batch::ht_steady_states`]
+/// with `strict = false`): its values are NaN.
+pub const NO_STEADY_STATE: i8 = -1;
+
+impl StatorMode {
+    pub const ALL: [StatorMode; 3] = [StatorMode::Locked, StatorMode::FreeWheeling, StatorMode::NoFlow];
+
+    /// The mode's code in batch outputs (`stator_mode` column).
+    pub fn code(self) -> i8 {
+        self as i8
+    }
+
+    /// The mode's name in outputs: `locked`, `free-wheeling`, `no-flow`.
+    pub fn name(self) -> &'static str {
+        match self {
+            StatorMode::Locked => "locked",
+            StatorMode::FreeWheeling => "free-wheeling",
+            StatorMode::NoFlow => "no-flow",
+        }
+    }
+}
+
+/// Every code of the `stator_mode` column with its name: the [`StatorMode`]s and
+/// [`NO_STEADY_STATE`] (`no-steady-state`).
+pub fn steady_mode_names() -> Vec<(i8, &'static str)> {
+    let mut names: Vec<(i8, &'static str)> = StatorMode::ALL.iter().map(|m| (m.code(), m.name())).collect();
+    names.push((NO_STEADY_STATE, "no-steady-state"));
+    names
+}
+
+/// The torque ratio of a steady state from its `stator_mode` code and torques (the rule of
+/// [`HtSteadyState::torque_ratio`] on batch columns): 1 in `no-flow` (zero torques, TR = 1 by
+/// continuity), else `T_t / T_p` (a zero pump torque divides by 1); NaN without a steady state.
+pub fn steady_torque_ratio(stator_mode: i8, pump_torque_nm: f64, turbine_torque_nm: f64) -> f64 {
+    if stator_mode == StatorMode::NoFlow.code() {
+        1.0
+    } else {
+        turbine_torque_nm / if pump_torque_nm == 0.0 { 1.0 } else { pump_torque_nm }
+    }
+}
+
 /// A steady state of the Hrovat & Tobler model. Torques follow physics notes §2: the pump and
 /// stator torques are the external torques on those elements, the turbine torque is the torque
 /// delivered to the transmission (−T_t).
@@ -475,7 +516,7 @@ pub fn coupling_point(g: &HtGeometry<f64>) -> Option<f64> {
 mod tests {
     use super::*;
 
-    const WP: f64 = 2000.0 * std::f64::consts::PI / 30.0;
+    const WP: f64 = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
 
     fn eq_2_15_rhs(g: &HtGeometry<f64>, wp: f64, wt: f64, ws: f64, flow: f64) -> f64 {
         // Direct transcription of the right-hand side of eq 2.15 with eqs 2.19–2.25, Q > 0.
@@ -675,5 +716,24 @@ mod tests {
         let p = Quad { c: [-1.0, 0.0, 1.0] };
         assert_eq!(largest_real_root(p).unwrap(), 1.0);
         assert!(largest_real_root(Quad { c: [1.0, 0.0, 1.0] }).is_none());
+    }
+
+    #[test]
+    fn steady_mode_codes_names_and_the_no_flow_torque_ratio() {
+        assert_eq!(
+            steady_mode_names(),
+            vec![(0, "locked"), (1, "free-wheeling"), (2, "no-flow"), (-1, "no-steady-state")]
+        );
+        assert_eq!(steady_torque_ratio(StatorMode::NoFlow.code(), 0.0, 0.0), 1.0);
+        assert_eq!(steady_torque_ratio(StatorMode::Locked.code(), 100.0, 180.0), 1.8);
+        assert_eq!(steady_torque_ratio(StatorMode::FreeWheeling.code(), 0.0, 3.0), 3.0);
+        assert!(steady_torque_ratio(NO_STEADY_STATE, f64::NAN, f64::NAN).is_nan());
+        // the rule on columns agrees with the steady state's own
+        let g = HtGeometry::appendix_d();
+        for sr in [0.0, 0.5, 0.9, 0.99, 1.0] {
+            let s = steady_state(&g, 200.0, sr * 200.0).unwrap();
+            let tr = steady_torque_ratio(s.mode.code(), s.pump_torque_nm, s.turbine_torque_nm);
+            assert_eq!(tr, s.torque_ratio());
+        }
     }
 }

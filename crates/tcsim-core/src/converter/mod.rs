@@ -1,0 +1,16 @@
+//! The converter models: characteristic tables, the Hrovat & Tobler closed form, and the three
+//! models in mass-matrix form for the transient engines. Depends on nothing above it.
+//!
+//! * [`capacity`]: the six capacity conventions of characteristic tables.
+//! * [`table`]: the steady-state look-up-table model (Li & Sundén 2016, eqs 2.8–2.11).
+//! * [`hrovat_tobler`]: the Hrovat & Tobler model's closed-form steady state and coupling point.
+//! * [`dynamics`]: the mass-matrix model trait and types, the table and Hrovat & Tobler models.
+//! * [`quasi_dynamic`]: tcsim's quasi-dynamic model (tables plus fluid inertia).
+//! * [`spec`]: building a model from a specification, and the default flow time constant.
+
+pub mod capacity;
+pub mod dynamics;
+pub mod hrovat_tobler;
+pub mod quasi_dynamic;
+pub mod spec;
+pub mod table;

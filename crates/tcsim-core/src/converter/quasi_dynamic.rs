@@ -1,0 +1,114 @@
+//! tcsim's quasi-dynamic converter model (tables plus fluid inertia) in mass-matrix form.
+
+use super::dynamics::{
+    speed_ratio, table_steady, table_torques, ConverterDynamics, Inertias, Mat4, SteadyPoint, Vec4, FLOW, PUMP, TURBINE,
+};
+use super::table::Characteristic;
+use crate::error::{CoreError, CoreResult};
+
+/// tcsim's quasi-dynamic model: the steady-state tables plus fluid inertia (physics notes §5;
+/// derivation in docs/models.md). States ω_p, ω_t, Q:
+///
+/// ```text
+///     I_p ω̇_p + ρ S_p Q̇ = T_p − CF(SR) ω_p|ω_p|
+///     I_t ω̇_t + ρ S_t Q̇ = TR(SR) CF(SR) ω_p|ω_p| + T_t
+///     Q̇ = (Q_ss − Q)/τ_Q,    Q_ss = CF(SR) |ω_p| / (ρ R_p²)
+/// ```
+///
+/// `Q_ss` is the Euler-equation flow that carries the table's pump torque with the fluid leaving
+/// the pump at `R_p` and entering it with no swirl. At steady state Q̇ = 0, so the torques are the
+/// table's whatever the shape effects; with S = 0 the flow does not act on the speeds at all.
+#[derive(Debug, Clone)]
+pub struct QuasiDynamics {
+    pub characteristic: Characteristic,
+    pub inertia: Inertias,
+    pub fluid_density_kg_m3: f64,
+    pub pump_radius_m: f64,
+    pub pump_shape_effect_m2: f64,
+    pub turbine_shape_effect_m2: f64,
+    pub flow_time_constant_s: f64,
+}
+
+impl QuasiDynamics {
+    pub fn validate(&self) -> CoreResult<()> {
+        let checks = [
+            ("fluid_density_kg_m3", self.fluid_density_kg_m3, "a finite, positive density in kg/m³"),
+            ("pump_exit_radius_m", self.pump_radius_m, "a finite, positive radius in m"),
+            ("quasi_dynamic.flow_time_constant_s", self.flow_time_constant_s, "a finite, positive time constant in s"),
+        ];
+        for (name, v, expected) in checks {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(CoreError::new(name, v, expected));
+            }
+        }
+        for (name, v) in [
+            ("quasi_dynamic.pump_shape_effect_m2", self.pump_shape_effect_m2),
+            ("quasi_dynamic.turbine_shape_effect_m2", self.turbine_shape_effect_m2),
+        ] {
+            if !v.is_finite() {
+                return Err(CoreError::new(name, v, "a finite shape effect in m²"));
+            }
+        }
+        Ok(())
+    }
+
+    fn flow_scale(&self) -> f64 {
+        1.0 / (self.fluid_density_kg_m3 * self.pump_radius_m * self.pump_radius_m)
+    }
+
+    /// Steady flow Q_ss and its gradient with respect to (ω_p, ω_t).
+    fn steady_flow(&self, wp: f64, wt: f64) -> (f64, [f64; 2]) {
+        let (sr, dsr_dwp, dsr_dwt) = speed_ratio(wp, wt);
+        let l = self.characteristic.lookup(sr);
+        let k = self.flow_scale();
+        let q = k * l.capacity_factor_nm_s2 * wp.abs();
+        let dq = [
+            k * (l.d_capacity_factor * dsr_dwp * wp.abs() + l.capacity_factor_nm_s2 * wp.signum()),
+            k * l.d_capacity_factor * dsr_dwt * wp.abs(),
+        ];
+        (q, dq)
+    }
+}
+
+impl ConverterDynamics for QuasiDynamics {
+    fn coordinates(&self) -> [bool; 4] {
+        [true, true, false, true]
+    }
+    fn mass(&self) -> Mat4 {
+        let rho = self.fluid_density_kg_m3;
+        let mut m = [[0.0; 4]; 4];
+        m[PUMP][PUMP] = self.inertia.pump_kg_m2;
+        m[TURBINE][TURBINE] = self.inertia.turbine_kg_m2;
+        m[PUMP][FLOW] = rho * self.pump_shape_effect_m2;
+        m[TURBINE][FLOW] = rho * self.turbine_shape_effect_m2;
+        m[FLOW][FLOW] = 1.0;
+        m
+    }
+    fn forces(&self, u: &Vec4, _s: f64) -> Vec4 {
+        let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        let (qss, _) = self.steady_flow(u[PUMP], u[TURBINE]);
+        [-tp, tt, 0.0, (qss - u[FLOW]) / self.flow_time_constant_s]
+    }
+    fn force_jacobian(&self, u: &Vec4, _s: f64) -> Mat4 {
+        let (_, _, dtp, dtt) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
+        let (_, dq) = self.steady_flow(u[PUMP], u[TURBINE]);
+        let tau = self.flow_time_constant_s;
+        let mut j = [[0.0; 4]; 4];
+        j[PUMP][PUMP] = -dtp[0];
+        j[PUMP][TURBINE] = -dtp[1];
+        j[TURBINE][PUMP] = dtt[0];
+        j[TURBINE][TURBINE] = dtt[1];
+        j[FLOW][PUMP] = dq[0] / tau;
+        j[FLOW][TURBINE] = dq[1] / tau;
+        j[FLOW][FLOW] = -1.0 / tau;
+        j
+    }
+    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
+        // the flow row is a lag, not a power balance
+        -(u[PUMP] * f[PUMP] + u[TURBINE] * f[TURBINE])
+    }
+    fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
+        let tp = table_steady(&self.characteristic, wp, wt)?;
+        Ok(SteadyPoint { u: [wp, wt, 0.0, self.steady_flow(wp, wt).0], pump_torque_nm: tp })
+    }
+}

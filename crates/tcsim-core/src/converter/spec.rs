@@ -1,0 +1,142 @@
+//! Building a converter model from a specification (the binding's dicts, the FMU's model.json).
+
+use super::dynamics::{ConverterDynamics, HtDynamics, Inertias, TableDynamics};
+use super::hrovat_tobler::{steady_state, HtGeometry, HtParam, N_PARAMS};
+use super::quasi_dynamic::QuasiDynamics;
+use super::table::Characteristic;
+use crate::error::{CoreError, CoreResult};
+use crate::units::REFERENCE_PUMP_SPEED_RAD_S;
+
+/// A model specification read field by field (the Python dicts of `tcsim.transient.DynamicModel`,
+/// the FMU's `resources/model.json`). `numbers(key)` is None when the key is missing.
+pub trait ModelSpec {
+    fn kind(&self) -> CoreResult<String>;
+    fn numbers(&self, key: &str) -> Option<Vec<f64>>;
+}
+
+fn numbers(spec: &dyn ModelSpec, key: &str, n: Option<usize>) -> CoreResult<Vec<f64>> {
+    let v = spec.numbers(key).ok_or_else(|| CoreError::new(key, "missing", "a value in the model specification"))?;
+    match n {
+        Some(n) if v.len() != n => Err(CoreError::new(key, format!("{} values", v.len()), format!("{n} values"))),
+        _ => Ok(v),
+    }
+}
+
+fn number(spec: &dyn ModelSpec, key: &str) -> CoreResult<f64> {
+    Ok(numbers(spec, key, Some(1))?[0])
+}
+
+/// The model a specification describes: `kind` is `table`, `quasi-dynamic` or `hrovat-tobler`;
+/// the keys are those of `tcsim.transient.DynamicModel.spec`.
+pub fn build_model(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics + Send>> {
+    let kind = spec.kind()?;
+    let i = numbers(spec, "inertia_kg_m2", Some(3))?;
+    let inertia = Inertias::new(i[0], i[1], i[2])?;
+    let table = || -> CoreResult<Characteristic> {
+        Characteristic::new(
+            numbers(spec, "speed_ratio", None)?,
+            numbers(spec, "torque_ratio", None)?,
+            numbers(spec, "capacity_factor_nm_s2", None)?,
+        )
+    };
+    Ok(match kind.as_str() {
+        "table" => Box::new(TableDynamics { characteristic: table()?, inertia }),
+        "quasi-dynamic" => {
+            let shape = numbers(spec, "shape_effect_m2", Some(2))?;
+            let m = QuasiDynamics {
+                characteristic: table()?,
+                inertia,
+                fluid_density_kg_m3: number(spec, "fluid_density_kg_m3")?,
+                pump_radius_m: number(spec, "pump_exit_radius_m")?,
+                pump_shape_effect_m2: shape[0],
+                turbine_shape_effect_m2: shape[1],
+                flow_time_constant_s: number(spec, "flow_time_constant_s")?,
+            };
+            m.validate()?;
+            Box::new(m)
+        }
+        "hrovat-tobler" => {
+            let g = numbers(spec, "geometry", Some(N_PARAMS))?;
+            let mut values = [0.0; N_PARAMS];
+            values.copy_from_slice(&g);
+            let shape = numbers(spec, "shape_effect_m2", Some(3))?;
+            Box::new(HtDynamics::new(
+                HtGeometry::new(values)?,
+                inertia,
+                number(spec, "fluid_length_m")?,
+                [shape[0], shape[1], shape[2]],
+            )?)
+        }
+        other => return Err(CoreError::new("kind", other, "table, quasi-dynamic or hrovat-tobler")),
+    })
+}
+
+/// The default flow time constant τ_Q of the quasi-dynamic model, s: the fluid's inertance over the
+/// slope of the net head with respect to the flow, `τ_Q = (ρL_f/A) / |∂F_Q/∂Q|`, for the Hrovat &
+/// Tobler `geometry` with fluid length `fluid_length_m` (m) at stall (locked stator, ω_t = 0) and
+/// the reference pump speed [`REFERENCE_PUMP_SPEED_RAD_S`] (2000 rpm), physics notes §5. It scales
+/// as 1/ω_p. The arithmetic is that of the Python copy it replaces (`tcsim.transient`), term for
+/// term: `L_f / |∂(eq 2.15 right-hand side / ρ)/∂q|` with `q = Q/A`.
+pub fn default_flow_time_constant_s(geometry: &HtGeometry<f64>, fluid_length_m: f64) -> CoreResult<f64> {
+    use HtParam::*;
+    let wp = REFERENCE_PUMP_SPEED_RAD_S;
+    let flow = steady_state(geometry, wp, 0.0)?.flow_m3_s;
+    let g = |p: HtParam| geometry.get(p);
+    let (tp, tt, ts) = (g(PumpExitAngle).tan(), g(TurbineExitAngle).tan(), g(StatorExitAngle).tan());
+    let (tpp, ttt, tss) = (g(PumpInletAngle).tan(), g(TurbineInletAngle).tan(), g(StatorInletAngle).tan());
+    let (rp, rs) = (g(PumpExitRadius), g(StatorExitRadius));
+    let q = flow / g(FlowArea);
+    // ∂/∂q of eq 2.15's right-hand side divided by ρ, at ω_t = ω_s = 0 (head, shock and friction)
+    let slope = wp * (rp * tp - rs * ts)
+        - (g(PumpShockLoss) * (-rs * wp + q * (ts - tpp)) * (ts - tpp)
+            + g(TurbineShockLoss) * (rp * wp + q * (tp - ttt)) * (tp - ttt)
+            + g(StatorShockLoss) * q * ((tt - tss) * (tt - tss))
+            + g(FrictionLoss) * (3.0 + tp * tp + tt * tt + ts * ts) * q);
+    let tau = fluid_length_m / slope.abs();
+    if tau.is_finite() && tau > 0.0 {
+        Ok(tau)
+    } else {
+        Err(CoreError::new(
+            "quasi_dynamic.flow_time_constant_s",
+            tau,
+            "a finite, positive default from [geometry] (give flow_time_constant_s explicitly)",
+        ))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_flow_time_constant_matches_the_python_value() {
+        // tcsim.transient.default_flow_time_constant_s of the bundled li-sunden-2016 (Appendix D)
+        // and li-sunden-2016-fitted converters, L_f = 0.2914 m, printed by Python (repr)
+        let tau = default_flow_time_constant_s(&HtGeometry::appendix_d(), 0.2914).unwrap();
+        assert!((tau - 0.002931041445525305).abs() <= 1e-12 * tau, "{tau}");
+        let fitted = HtGeometry::new([
+            0.01,
+            840.0,
+            0.12,
+            0.065,
+            0.06,
+            -0.44846278309449555,
+            -0.831883250727564,
+            0.9055174170930996,
+            0.9068172214994222,
+            -0.3263351452601018,
+            -0.8672346227619814,
+            0.5658235096868285,
+            0.9473337805257149,
+            0.22645682280069623,
+            0.01,
+        ])
+        .unwrap();
+        let tau_fitted = default_flow_time_constant_s(&fitted, 0.2914).unwrap();
+        assert!((tau_fitted - 0.01135401823191251).abs() <= 1e-12 * tau_fitted, "{tau_fitted}");
+        // it scales with the fluid length
+        let double = default_flow_time_constant_s(&HtGeometry::appendix_d(), 2.0 * 0.2914).unwrap();
+        assert!((double - 2.0 * tau).abs() <= 1e-15 * tau);
+        assert!(default_flow_time_constant_s(&HtGeometry::appendix_d(), f64::NAN).is_err());
+    }
+}

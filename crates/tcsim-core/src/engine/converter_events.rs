@@ -1,0 +1,201 @@
+//! The converter's discrete events, shared by the isolated engine ([`crate::engine::isolated`],
+//! [`crate::engine::mode_view`]) and the vehicle plant ([`crate::vehicle`]).
+//!
+//! A converter model has two kinds of discrete state ([`Mode`]): the stator's one-way clutch
+//! (locked or free-wheeling) and the sign of the flow in the losses (+1, −1, or 0 while the flow is
+//! held at zero). This module owns the root kinds of those switches, their root functions, the
+//! switch arms, the held-flow balance that decides the direction of a starting flow, and the
+//! assembly of the converter's [`Sample`]. A plant hands in what only it knows: the constraint
+//! torque on the stator, the net head on a held flow and, at a flow reversal, the held-flow
+//! balance of the plant with the flow held (as closures), so that each plant keeps its own
+//! arithmetic and the numbers stay those of the plant.
+//!
+//! See [`crate::engine::isolated`] for the physics of the events (the Filippov treatment of sgn Q).
+
+use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::engine::options::Hysteresis;
+
+/// Discrete state of the piecewise-smooth converter.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Mode {
+    pub stator_locked: bool,
+    /// Sign of Q in the losses: +1, −1, or 0 while the flow is held at zero. The output column
+    /// `flow_direction` ([`crate::engine::outputs::COLUMNS`]) and the events' flow field carry it.
+    pub flow_sign: f64,
+}
+
+/// One sampled instant of the converter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Sample {
+    pub time_s: f64,
+    pub u: Vec4,
+    pub u_dot: Vec4,
+    /// External torques on pump, turbine, stator: `M u̇ − F` with the converter's own mass.
+    pub torque: [f64; 3],
+    pub transferred: (f64, f64),
+    pub mode: Mode,
+    pub loss_power_w: f64,
+    pub stored_energy_j: f64,
+}
+
+/// What a converter event did.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum EventKind {
+    StatorRelease,
+    StatorLock,
+    FlowZero,
+    FlowStart,
+}
+
+impl EventKind {
+    /// The event's name in outputs (`stator-release`, `stator-lock`, `flow-zero`, `flow-start`).
+    pub fn name(self) -> &'static str {
+        match self {
+            EventKind::StatorRelease => "stator-release",
+            EventKind::StatorLock => "stator-lock",
+            EventKind::FlowZero => "flow-zero",
+            EventKind::FlowStart => "flow-start",
+        }
+    }
+}
+
+/// The root functions of the converter's switches.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ConverterRoot {
+    /// Stator locked: its holding torque crosses zero and the clutch releases.
+    StatorTorque,
+    /// Stator free-wheeling: its speed reaches zero and the clutch locks.
+    StatorSpeed,
+    /// Flow with sign ±1: Q reaches zero.
+    Flow,
+    /// Flow held at zero: the net head beats the shock term forwards.
+    FlowStartsPositive,
+    /// Flow held at zero: the net head beats the shock term backwards.
+    FlowStartsNegative,
+}
+
+impl ConverterRoot {
+    /// The event this root fires.
+    pub fn kind(self) -> EventKind {
+        match self {
+            ConverterRoot::StatorTorque => EventKind::StatorRelease,
+            ConverterRoot::StatorSpeed => EventKind::StatorLock,
+            ConverterRoot::Flow => EventKind::FlowZero,
+            ConverterRoot::FlowStartsPositive | ConverterRoot::FlowStartsNegative => EventKind::FlowStart,
+        }
+    }
+}
+
+/// Whether `mode` holds the flow of `model` at zero.
+pub fn flow_held(model: &dyn ConverterDynamics, mode: Mode) -> bool {
+    model.has_flow_sign() && mode.flow_sign == 0.0
+}
+
+/// The converter's root functions in `mode`.
+pub fn roots(model: &dyn ConverterDynamics, mode: Mode) -> Vec<ConverterRoot> {
+    let mut roots = Vec::new();
+    if model.has_stator_clutch() && model.coordinates()[STATOR] {
+        roots.push(if mode.stator_locked { ConverterRoot::StatorTorque } else { ConverterRoot::StatorSpeed });
+    }
+    if model.has_flow_sign() {
+        if mode.flow_sign == 0.0 {
+            roots.extend([ConverterRoot::FlowStartsPositive, ConverterRoot::FlowStartsNegative]);
+        } else {
+            roots.push(ConverterRoot::Flow);
+        }
+    }
+    roots
+}
+
+/// The value of `root`, positive while the mode holds (with the hysteresis `h`). `u` holds the
+/// converter's coordinates first; `stator_torque` is the constraint torque on the stator and
+/// `held_flow` the held-flow balance `(d, P₀)` ([`held_flow_balance`]) of the plant.
+pub fn root_value(
+    root: ConverterRoot,
+    mode: Mode,
+    u: &[f64],
+    h: &Hysteresis,
+    stator_torque: impl FnOnce() -> f64,
+    held_flow: impl FnOnce() -> (f64, f64),
+) -> f64 {
+    match root {
+        ConverterRoot::StatorTorque => stator_torque() + h.stator_torque_nm,
+        ConverterRoot::StatorSpeed => u[STATOR] + h.stator_speed_rad_s,
+        ConverterRoot::Flow => mode.flow_sign * u[FLOW] + h.flow_m3_s,
+        ConverterRoot::FlowStartsPositive => {
+            let (d, p0) = held_flow();
+            p0 - d + h.head_pa
+        }
+        ConverterRoot::FlowStartsNegative => {
+            let (d, p0) = held_flow();
+            p0 + d + h.head_pa
+        }
+    }
+}
+
+/// The net head on a held flow, `d = F_Q(σ = 0) − (M u̇)_Q`, and the shock term `P₀`, from the
+/// converter coordinates `u`, the flow row of the plant's mass matrix and the plant's rates.
+pub fn held_flow_balance(model: &dyn ConverterDynamics, u: &Vec4, flow_mass_row: &[f64], u_dot: &[f64]) -> (f64, f64) {
+    let (head, shock) = model.zero_flow_head(u);
+    let inertial: f64 = flow_mass_row.iter().zip(u_dot).map(|(m, a)| m * a).sum();
+    (head - inertial, shock)
+}
+
+/// Sign of the flow that starts from Q = 0, from the held-flow balance `(d, P₀)`: +1 or −1 when
+/// the net head beats the shock term, else 0 (held).
+pub fn flow_sign_from_balance((d, p0): (f64, f64)) -> f64 {
+    if d > p0 {
+        1.0
+    } else if d < -p0 {
+        -1.0
+    } else {
+        0.0
+    }
+}
+
+/// Switch `mode` for `root` and adjust `u` (a locking stator stops, a reversing flow passes zero).
+/// `flow_sign_at_zero` gives the sign of the flow that starts from the adjusted `u` (Q = 0).
+pub fn switch<const LEN: usize>(
+    root: ConverterRoot,
+    mode: &mut Mode,
+    u: &mut [f64; LEN],
+    flow_sign_at_zero: impl FnOnce(&[f64; LEN]) -> f64,
+) -> EventKind {
+    match root {
+        ConverterRoot::StatorTorque => mode.stator_locked = false,
+        ConverterRoot::StatorSpeed => {
+            mode.stator_locked = true;
+            u[STATOR] = 0.0;
+        }
+        ConverterRoot::Flow => {
+            u[FLOW] = 0.0;
+            mode.flow_sign = flow_sign_at_zero(u);
+        }
+        ConverterRoot::FlowStartsPositive => mode.flow_sign = 1.0,
+        ConverterRoot::FlowStartsNegative => mode.flow_sign = -1.0,
+    }
+    root.kind()
+}
+
+/// `M u̇ − F` with the converter's own mass `mass`: the external torque on every coordinate.
+pub fn external_torques(mass: &Mat4, u_dot: &Vec4, f: &Vec4) -> Vec4 {
+    std::array::from_fn(|r| (0..4).map(|c| mass[r][c] * u_dot[c]).sum::<f64>() - f[r])
+}
+
+/// The converter's sample at time `t` from its coordinates `u`, rates `u_dot` and forces
+/// `f = F(u)` in `mode`: external torques with the converter's own mass, the transferred torques
+/// (with the stator reaction that balances them when the model has no stator), the loss power
+/// (none while the flow is held) and the stored kinetic energy.
+pub fn sample(model: &dyn ConverterDynamics, mode: Mode, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
+    let mass = model.mass();
+    let e = external_torques(&mass, &u_dot, &f);
+    let stored = 0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
+    let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
+    let transferred = model.transferred(&f);
+    if !model.coordinates()[STATOR] {
+        // the reaction that balances the transferred torques
+        torque[2] = transferred.1 - transferred.0;
+    }
+    let loss = if flow_held(model, mode) { 0.0 } else { model.loss_power_w(&u, &f) };
+    Sample { time_s: t, u, u_dot, torque, transferred, mode, loss_power_w: loss, stored_energy_j: stored }
+}

@@ -1,0 +1,21 @@
+//! The transient engines on diffsol: one BDF segment loop, the converter's events, the isolated
+//! converter under a drive, its Model Exchange view and its co-simulation stepper. Uses
+//! [`crate::converter`]; never the vehicle.
+//!
+//! * [`options`]: solver tolerances, event hysteresis, the engines' error type.
+//! * [`segment`]: the generic BDF loop over one smooth segment, up to the first root.
+//! * [`converter_events`]: the converter's modes, roots, switches and samples (shared with the vehicle).
+//! * [`isolated`]: a converter model under a [`isolated::Drive`]: initial state, runs, events.
+//! * [`mode_view`]: one mode seen from outside (rates, event indicators, switches) for Model Exchange.
+//! * [`stepper`]: a model stepped interval by interval by its host (co-simulation).
+//! * [`signal`]: sampled input signals with a smoothed derivative.
+//! * [`outputs`]: the named output columns of a run.
+
+pub mod converter_events;
+pub mod isolated;
+pub mod mode_view;
+pub mod options;
+pub mod outputs;
+pub mod segment;
+pub mod signal;
+pub mod stepper;

@@ -1,0 +1,51 @@
+//! Linear interpolation with the end values held: the one helper behind the characteristic
+//! tables ([`crate::converter::table`]), the input signals ([`crate::engine::signal`]) and the
+//! vehicle's curves and pedal schedules ([`crate::vehicle`]).
+
+/// The segment `[x[i−1], x[i]]` of the sorted abscissae `x` (two or more) that holds `t`, clamped
+/// to the first or last segment, and the weight `w = (t − x[i−1])/(x[i] − x[i−1])` of `x[i]`.
+pub fn segment(x: &[f64], t: f64) -> (usize, f64) {
+    let n = x.len();
+    // first index with x[i] > t, clamped so that [i-1, i] is a segment
+    let i = x.partition_point(|&v| v <= t).clamp(1, n - 1);
+    (i, (t - x[i - 1]) / (x[i] - x[i - 1]))
+}
+
+/// `(1 − w)·y[i−1] + w·y[i]`: returns the table values exactly at the nodes.
+pub fn mix(y: &[f64], i: usize, w: f64) -> f64 {
+    (1.0 - w) * y[i - 1] + w * y[i]
+}
+
+/// `y(t)` linear between the points `(x, y)` (x strictly increasing), end values held outside;
+/// a single point is a constant.
+pub fn linear_held(x: &[f64], y: &[f64], t: f64) -> f64 {
+    let n = x.len();
+    if n == 1 || t <= x[0] {
+        return y[0];
+    }
+    if t >= x[n - 1] {
+        return y[n - 1];
+    }
+    let (i, w) = segment(x, t);
+    mix(y, i, w)
+}
+
+/// Two-point form: `at_zero` at p = 0, `at_one` at p = 1, linear between, ends held (pedal
+/// schedules).
+pub fn blend_held(at_zero: f64, at_one: f64, p: f64) -> f64 {
+    at_zero + p.clamp(0.0, 1.0) * (at_one - at_zero)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn interpolates_and_holds_ends() {
+        let (x, y) = ([0.0, 1.0, 3.0], [0.0, 2.0, 6.0]);
+        assert_eq!([-1.0, 0.5, 2.0, 9.0].map(|t| linear_held(&x, &y, t)), [0.0, 1.0, 4.0, 6.0]);
+        assert_eq!(linear_held(&[1.0], &[5.0], 9.0), 5.0);
+        assert_eq!([-1.0, 0.25, 2.0].map(|p| blend_held(2.0, 6.0, p)), [2.0, 3.0, 6.0]);
+        assert!(linear_held(&x, &y, f64::NAN).is_nan());
+    }
+}
