@@ -445,25 +445,6 @@ pub fn parameters(spec: &[(String, SpecValue)]) -> Result<Vec<Parameter>, String
     Ok(out)
 }
 
-/// The numeric entries of a JSON model specification, in its key order (`kind` and anything else
-/// that is not a number or a non-empty array of numbers left out).
-pub fn spec_entries(model: &serde_json::Map<String, serde_json::Value>) -> Vec<(String, SpecValue)> {
-    use serde_json::Value;
-    model
-        .iter()
-        .filter_map(|(key, value)| {
-            let value = match value {
-                Value::Number(n) => SpecValue::Scalar(n.as_f64()?),
-                Value::Array(a) if !a.is_empty() => {
-                    SpecValue::Array(a.iter().map(Value::as_f64).collect::<Option<Vec<f64>>>()?)
-                }
-                _ => return None,
-            };
-            Some((key.clone(), value))
-        })
-        .collect()
-}
-
 // ---------------------------------------------------------------------------------------------
 // The variables of an FMU
 
