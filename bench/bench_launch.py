@@ -37,7 +37,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(__file__))
 import scipy_vehicle as ref  # noqa: E402
 import tcsim._core as core  # noqa: E402
-from tcsim.transient import dynamic_model  # noqa: E402
+from tcsim.models.dynamic import dynamic_model  # noqa: E402
 from timing import median_and_fastest  # noqa: E402
 
 CONVERTER = "li-sunden-2016-fitted"
@@ -139,8 +139,8 @@ def print_agreement(agree: dict) -> None:
 def bundled_timing():
     """The three models on the bundled vehicle (informational), when this tcsim has one."""
     try:
-        from tcsim.launch import flip_flop
-        from tcsim.vehicle import load_vehicle
+        from tcsim.models.vehicle import load_vehicle
+        from tcsim.simulation.scenarios import flip_flop
     except ImportError:
         return None
     v = load_vehicle()

@@ -28,7 +28,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
 import scipy_reference as ref  # noqa: E402
-from tcsim.transient import dynamic_model, isolated_takeoff, simulate, simulate_batch  # noqa: E402
+from tcsim.models.drives import isolated_takeoff  # noqa: E402
+from tcsim.models.dynamic import dynamic_model  # noqa: E402
+from tcsim.simulation.transient import simulate, simulate_batch  # noqa: E402
 from timing import median_and_fastest  # noqa: E402
 
 REPEATS = 50

@@ -15,8 +15,8 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from .converter import CAPACITY_KEYS, Characteristic
-from .errors import InputError
+from ..errors import InputError
+from .characteristic import CAPACITY_KEYS, Characteristic
 
 
 def _rows(path: Path) -> list[tuple[int, list[str]]]:

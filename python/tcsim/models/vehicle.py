@@ -51,9 +51,9 @@ from typing import Annotated, Any
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from ..errors import InputError
 from .converter import Converter, load_converter
 from .converter import bundled_names as bundled_converter_names
-from .errors import InputError
 
 #: The bundled vehicle used when none is named.
 DEFAULT_VEHICLE = "midsize-awd-8at"
