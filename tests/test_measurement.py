@@ -16,7 +16,7 @@ from tcsim.errors import InputError
 from tcsim.io.measurement import INPUT_CHANNELS, parse_channel_map, read_measurement
 from tcsim.models.measurement import Measurement
 
-N = 200
+N = 200  # samples of the synthetic measurement
 TIME_S = np.linspace(0.0, 2.0, N)
 ORIGINAL = {
     "pump_torque_nm": 150.0 + 40.0 * np.sin(3.0 * TIME_S),

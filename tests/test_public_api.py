@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 import tcsim
+from tcsim import transient as tr
 from tcsim.cli import main
 from tcsim.io import fmu as fmu_io
 
@@ -93,8 +94,6 @@ def test_facades_export_what_all_says(module):
 
 
 def test_readme_python_example():
-    from tcsim import transient as tr
-
     df = tcsim.characterise("li-sunden-2016", model="hrovat-tobler")
     conv = tcsim.load_converter("li-sunden-2016")
     assert "hrovat-tobler" in conv.models and 0 < tcsim.coupling_point(conv) < 1

@@ -4,20 +4,16 @@ Arrays are float64 NumPy arrays; speeds in rad/s, torques in N·m, flows in m³/
 raises :class:`CoreInputError` for input the core refuses (``ValueError`` for wrong shapes).
 """
 
-from typing import Any, Literal, TypeAlias
+from typing import Any, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
 
 _Array: TypeAlias = npt.NDArray[np.float64]
 _ArrayLike: TypeAlias = npt.ArrayLike
-#: One run of a batch: ("ok", columns, events), ("input", message, field, value, expected) or
-#: ("solver", message).
-_RunEntry: TypeAlias = (
-    tuple[Literal["ok"], dict[str, _Array], list[tuple[Any, ...]]]
-    | tuple[Literal["input"], str, str, str, str]
-    | tuple[Literal["solver"], str]
-)
+#: One run of a batch, a tuple tagged by its first item: ("ok", {column: array}, [event tuple]),
+#: ("input", message, field, value, expected) or ("solver", message).
+_RunEntry: TypeAlias = tuple[Any, ...]
 
 class CoreInputError(ValueError):
     """Bad input to the tcsim core: args are (message, field, value, expected)."""

@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 from scipy.optimize import least_squares
 
@@ -227,10 +228,10 @@ class _Problem:
         self._cache: tuple[bytes, tuple] | None = None
         self.nfev = 0
 
-    def to_x(self, u: np.ndarray) -> np.ndarray:
+    def to_x(self, u: npt.ArrayLike) -> np.ndarray:
         return self.lo + np.asarray(u) * self.span
 
-    def to_u(self, x: np.ndarray) -> np.ndarray:
+    def to_u(self, x: npt.ArrayLike) -> np.ndarray:
         return (np.asarray(x) - self.lo) / self.span
 
     def evaluate(self, u: np.ndarray):

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 import pandas as pd
 from scipy.optimize import least_squares
 
@@ -390,7 +391,7 @@ def shape_effect_sweep(
     drive,
     values_m2: Sequence[float] = THESIS_VALUES_M2,
     pairs: Sequence[tuple[float, float]] | None = None,
-    times_s: Sequence[float] | None = None,
+    times_s: npt.ArrayLike | None = None,
     rtol: float | None = None,
 ) -> pd.DataFrame:
     """Effective TR for S_p = S_t = v (each v in ``values_m2``) and for the explicit ``pairs``
@@ -408,7 +409,9 @@ def shape_effect_sweep(
     todo = _pairs(values_m2, pairs)
     ok = [p for p in todo if bound is None or bound.admissible(*p)]
     runs = dict(zip(ok, _runs([base.with_shape_effects(*p) for p in ok], drive, times, rtol)))
-    frames = [_sweep_rows(p, runs.get(p), "" if p in runs else inadmissible_note(bound, *p)) for p in todo]
+    frames = [
+        _sweep_rows(p, runs.get(p), "" if p in runs or bound is None else inadmissible_note(bound, *p)) for p in todo
+    ]
     return pd.concat(frames, ignore_index=True)
 
 

@@ -149,11 +149,13 @@ def _valid_row(row: np.ndarray) -> bool:
 
 def _cases(converter: Converter, definition: StudyDefinition) -> tuple[pd.DataFrame, np.ndarray]:
     """One (parameter, value) per case with its geometry row in core order and units."""
-    base = converter.geometry.core_row()
+    geometry = converter.geometry
+    assert geometry is not None  # run_study's converter.require checked it
+    base = geometry.core_row()
     names, values, rows = [], [], []
     for p in definition.parameters:
         j = STEADY_KEYS.index(p.key)
-        for v in p.values(getattr(converter.geometry, p.key), definition.values_per_parameter):
+        for v in p.values(getattr(geometry, p.key), definition.values_per_parameter):
             row = base.copy()
             row[j] = v * STEADY_SCALE[j]
             names.append(p.key)

@@ -61,9 +61,10 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as e:  # typer/click's own exits
         return e.code if isinstance(e.code, int) else 1
     except Exception as e:  # click usage errors, and failures that are not the user's
-        if callable(getattr(e, "show", None)) and isinstance(getattr(e, "exit_code", None), int):
-            e.show()  # a usage error from the command-line parser (exit code 2)
-            return e.exit_code
+        show, code = getattr(e, "show", None), getattr(e, "exit_code", None)
+        if callable(show) and isinstance(code, int):
+            show()  # a usage error from the command-line parser (exit code 2)
+            return code
         console.print(f"[red]tcsim failed:[/red] {type(e).__name__}: {escape(str(e))}", highlight=False, soft_wrap=True)
         return 1
     return 0

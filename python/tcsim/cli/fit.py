@@ -27,6 +27,7 @@ def fit_command(
     user_bounds = fitting.parse_bounds(bounds)
     start = load_converter(converter)
     start.require("hrovat-tobler")
+    assert start.geometry is not None  # require() checked it
     table = fitting.target_table(target)
     try:
         result = fitting.fit_hrovat_tobler(start.geometry, table, free_names, user_bounds, speed_ratio_max)

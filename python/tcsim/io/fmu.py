@@ -56,7 +56,7 @@ from xml.sax.saxutils import quoteattr
 from .. import _core
 from ..errors import InputError, TcsimWarning
 from ..models.converter import MODELS, Converter
-from ..models.drives import PumpTorqueTurbineSpeed, Speeds
+from ..models.drives import Drive, PumpTorqueTurbineSpeed, Speeds
 from ..models.dynamic import DynamicModel, resolve_model
 from ..simulation.transient import SolverError, simulate
 
@@ -313,7 +313,8 @@ def _version() -> str:
         return "0+unknown"
 
 
-def _fmt(value: float) -> str:
+def _xml_real(value: float) -> str:
+    """A real as modelDescription.xml writes it (Python's shortest round-trip form)."""
     return repr(float(value))
 
 
@@ -321,6 +322,150 @@ def _check_causality(causality: str) -> tuple[str, str]:
     if causality not in CAUSALITIES:
         raise InputError("command line", "--causality", causality, f"one of {', '.join(CAUSALITIES)}")
     return CAUSALITIES[causality]
+
+
+class _Variables:
+    """``<ModelVariables>`` being written: the lines, and each variable's 1-based index by name."""
+
+    def __init__(self) -> None:
+        self.lines: list[str] = []
+        self.index: dict[str, int] = {}
+
+    def add(self, name: str, vr: int, description: str, attrs: str, real: str) -> None:
+        self.index[name] = len(self.index) + 1
+        q = quoteattr
+        self.lines.append(f"    <!-- index {self.index[name]} -->")
+        self.lines.append(
+            f'    <ScalarVariable name={q(name)} valueReference="{vr}" description={q(description)} {attrs}>'
+        )
+        self.lines.append(f"      <Real {real}/>")
+        self.lines.append("    </ScalarVariable>")
+
+
+def _header_lines(
+    model: DynamicModel, inputs: tuple[str, str], outputs: list[Signal], name: str, guid: str, stamp: str
+):
+    """From the XML declaration to the capabilities of Model Exchange and Co-Simulation."""
+    version = _version()
+    description = (
+        f"Torque converter {Path(model.source).stem}, {model.name} model (tcsim {version}). Inputs "
+        f"{', '.join(inputs)}; outputs {', '.join(s.name for s in outputs)}. Starts from the steady "
+        "state consistent with the inputs."
+    )
+    a = quoteattr
+    return [
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<fmiModelDescription fmiVersion="2.0" modelName={a(name)} guid={a(guid)}',
+        f"  description={a(description)}",
+        f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
+        f'  variableNamingConvention="flat" numberOfEventIndicators="{EVENT_INDICATORS.get(model.name, 0)}">',
+        f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
+        ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+        f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
+        ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="false"'
+        ' canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+    ]
+
+
+def _unit_lines() -> list[str]:
+    """``<UnitDefinitions>`` of :data:`UNITS`."""
+    lines = ["  <UnitDefinitions>"]
+    for u in UNITS:
+        base = " ".join(f'{k}="{v}"' for k, v in u.base.items())
+        lines.append(f"    <Unit name={quoteattr(u.name)}>")
+        lines.append(f"      <BaseUnit {base}/>" if base else "      <BaseUnit/>")
+        for name, factor in u.display:
+            lines.append(f'      <DisplayUnit name={quoteattr(name)} factor="{_xml_real(factor)}"/>')
+        lines.append("    </Unit>")
+    lines.append("  </UnitDefinitions>")
+    return lines
+
+
+def _signal_variables(v: _Variables, signals: list[Signal], inputs: tuple[str, str]) -> None:
+    """The signals (inputs with their start values, outputs), then the rates of the speed inputs."""
+    for s in signals:
+        if s.name in inputs:
+            v.add(
+                s.name,
+                s.vr,
+                s.description,
+                'causality="input" variability="continuous"',
+                f'unit="{s.unit}" start="{_xml_real(INPUT_START[s.name])}"',
+            )
+        else:
+            v.add(
+                s.name,
+                s.vr,
+                s.description,
+                'causality="output" variability="continuous" initial="calculated"',
+                f'unit="{s.unit}"',
+            )
+    for name in inputs:
+        if name in RATE_INPUTS:
+            vr, rate, text = RATE_INPUTS[name]
+            v.add(rate, vr, text, 'causality="input" variability="continuous"', 'unit="rad/s2" start="0"')
+
+
+def _start_variables(v: _Variables, inputs: tuple[str, str]) -> None:
+    """``start_from_steady_state`` and the ``initial_*`` values of the states that are not inputs."""
+    v.add(
+        "start_from_steady_state",
+        30,
+        "1: start at the steady state consistent with the inputs (as tcsim replay); 0: at the initial_* values",
+        'causality="parameter" variability="fixed" initial="exact"',
+        'unit="1" start="1"',
+    )
+    for name, vr, unit, start in (
+        ("pump_speed_rad_s", 31, "rad/s", 150.0),
+        ("stator_speed_rad_s", 32, "rad/s", 0.0),
+        ("flow_m3_s", 33, "m3/s", 0.05),
+    ):
+        if name in v.index and name not in inputs:
+            v.add(
+                f"initial_{name}",
+                vr,
+                f"Initial {name.replace('_', ' ').rsplit(' ', 2)[0]} when start_from_steady_state = 0",
+                'causality="parameter" variability="fixed" initial="exact"',
+                f'unit="{unit}" start="{_xml_real(start)}"',
+            )
+
+
+def _derivative_variables(v: _Variables, inputs: tuple[str, str]) -> list[str]:
+    """``der(x)`` of each continuous state that is not an input (Model Exchange); their names."""
+    derivatives = []
+    for name, c in [(name, c) for name, c in _STATES if name in v.index and name not in inputs]:
+        der = f"der({name})"
+        unit = "m3/s2" if c == 3 else "rad/s2"
+        v.add(
+            der,
+            FIRST_DERIVATIVE + c,
+            f"Time derivative of {name}",
+            'causality="local" variability="continuous" initial="calculated"',
+            f'unit="{unit}" derivative="{v.index[name]}"',
+        )
+        derivatives.append(der)
+    return derivatives
+
+
+def _structure_lines(
+    index: dict[str, int], inputs: tuple[str, str], outputs: list[Signal], derivatives: list[str]
+) -> list[str]:
+    """``<ModelStructure>``: outputs with their dependencies, derivatives, initial unknowns."""
+    both = " ".join(str(index[n]) for n in inputs)
+    lines = ["  <ModelStructure>", "    <Outputs>"]
+    for s in outputs:
+        # a state (pump speed, flow, stator speed) does not depend directly on the inputs
+        lines.append(f'      <Unknown index="{index[s.name]}" dependencies="{"" if s.state else both}"/>')
+    lines.append("    </Outputs>")
+    if derivatives:
+        lines.append("    <Derivatives>")
+        lines += [f'      <Unknown index="{index[der]}"/>' for der in derivatives]
+        lines.append("    </Derivatives>")
+    lines.append("    <InitialUnknowns>")
+    for name in sorted([s.name for s in outputs] + derivatives, key=lambda n: index[n]):
+        lines.append(f'      <Unknown index="{index[name]}"/>')
+    lines += ["    </InitialUnknowns>", "  </ModelStructure>"]
+    return lines
 
 
 def model_description_xml(
@@ -334,133 +479,28 @@ def model_description_xml(
     causality."""
     inputs = _check_causality(causality)
     signals = model_signals(model.name)
-    params = fmu_parameters(model)
-    version = _version()
-    model_name = model_name or f"tcsim {Path(model.source).stem} {model.name}"
-    guid = guid or "{" + str(uuid.uuid4()) + "}"
-    stamp = (generation_time or datetime.now(UTC)).strftime("%Y-%m-%dT%H:%M:%SZ")
     outputs = [s for s in signals if s.name not in inputs]
-    description = (
-        f"Torque converter {Path(model.source).stem}, {model.name} model (tcsim {version}). Inputs "
-        f"{', '.join(inputs)}; outputs {', '.join(s.name for s in outputs)}. Starts from the steady "
-        "state consistent with the inputs."
-    )
-
-    a = quoteattr
-    lines = [
-        '<?xml version="1.0" encoding="UTF-8"?>',
-        f'<fmiModelDescription fmiVersion="2.0" modelName={a(model_name)} guid={a(guid)}',
-        f"  description={a(description)}",
-        f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
-        f'  variableNamingConvention="flat" numberOfEventIndicators="{EVENT_INDICATORS.get(model.name, 0)}">',
-        f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
-        ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
-        f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
-        ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="false"'
-        ' canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
-        "  <UnitDefinitions>",
-    ]
-    for u in UNITS:
-        base = " ".join(f'{k}="{v}"' for k, v in u.base.items())
-        lines.append(f"    <Unit name={a(u.name)}>")
-        lines.append(f"      <BaseUnit {base}/>" if base else "      <BaseUnit/>")
-        for name, factor in u.display:
-            lines.append(f'      <DisplayUnit name={a(name)} factor="{_fmt(factor)}"/>')
-        lines.append("    </Unit>")
-    lines += [
-        "  </UnitDefinitions>",
-        '  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>',
-        "  <ModelVariables>",
-    ]
-
-    index: dict[str, int] = {}
-
-    def variable(name: str, vr: int, description: str, attrs: str, real: str) -> None:
-        index[name] = len(index) + 1
-        lines.append(f"    <!-- index {index[name]} -->")
-        lines.append(f'    <ScalarVariable name={a(name)} valueReference="{vr}" description={a(description)} {attrs}>')
-        lines.append(f"      <Real {real}/>")
-        lines.append("    </ScalarVariable>")
-
-    for s in signals:
-        if s.name in inputs:
-            variable(
-                s.name,
-                s.vr,
-                s.description,
-                'causality="input" variability="continuous"',
-                f'unit="{s.unit}" start="{_fmt(INPUT_START[s.name])}"',
-            )
-        else:
-            variable(
-                s.name,
-                s.vr,
-                s.description,
-                'causality="output" variability="continuous" initial="calculated"',
-                f'unit="{s.unit}"',
-            )
-    for name in inputs:
-        if name in RATE_INPUTS:
-            vr, rate, text = RATE_INPUTS[name]
-            variable(rate, vr, text, 'causality="input" variability="continuous"', 'unit="rad/s2" start="0"')
-    variable(
-        "start_from_steady_state",
-        30,
-        "1: start at the steady state consistent with the inputs (as tcsim replay); 0: at the initial_* values",
-        'causality="parameter" variability="fixed" initial="exact"',
-        'unit="1" start="1"',
-    )
-    for name, vr, unit, start in (
-        ("pump_speed_rad_s", 31, "rad/s", 150.0),
-        ("stator_speed_rad_s", 32, "rad/s", 0.0),
-        ("flow_m3_s", 33, "m3/s", 0.05),
-    ):
-        if name in index and name not in inputs:
-            variable(
-                f"initial_{name}",
-                vr,
-                f"Initial {name.replace('_', ' ').rsplit(' ', 2)[0]} when start_from_steady_state = 0",
-                'causality="parameter" variability="fixed" initial="exact"',
-                f'unit="{unit}" start="{_fmt(start)}"',
-            )
-    states = [(name, c) for name, c in _STATES if name in index and name not in inputs]
-    derivatives = []
-    for name, c in states:
-        der = f"der({name})"
-        unit = "m3/s2" if c == 3 else "rad/s2"
-        variable(
-            der,
-            FIRST_DERIVATIVE + c,
-            f"Time derivative of {name}",
-            'causality="local" variability="continuous" initial="calculated"',
-            f'unit="{unit}" derivative="{index[name]}"',
-        )
-        derivatives.append(der)
-    for p in params:
+    name = model_name or f"tcsim {Path(model.source).stem} {model.name}"
+    stamp = (generation_time or datetime.now(UTC)).strftime("%Y-%m-%dT%H:%M:%SZ")
+    lines = _header_lines(model, inputs, outputs, name, guid or "{" + str(uuid.uuid4()) + "}", stamp)
+    lines += _unit_lines()
+    lines.append('  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>')
+    v = _Variables()
+    _signal_variables(v, signals, inputs)
+    _start_variables(v, inputs)
+    derivatives = _derivative_variables(v, inputs)
+    for p in fmu_parameters(model):
         display = ' displayUnit="deg"' if p.unit == "rad" else ""
-        variable(
+        v.add(
             p.name,
             p.vr,
             p.description,
             'causality="parameter" variability="tunable"',
-            f'unit="{p.unit}"{display} start="{_fmt(p.value)}"',
+            f'unit="{p.unit}"{display} start="{_xml_real(p.value)}"',
         )
-    lines.append("  </ModelVariables>")
-
-    both = " ".join(str(index[n]) for n in inputs)
-    lines += ["  <ModelStructure>", "    <Outputs>"]
-    for s in outputs:
-        # a state (pump speed, flow, stator speed) does not depend directly on the inputs
-        lines.append(f'      <Unknown index="{index[s.name]}" dependencies="{"" if s.state else both}"/>')
-    lines.append("    </Outputs>")
-    if derivatives:
-        lines.append("    <Derivatives>")
-        lines += [f'      <Unknown index="{index[der]}"/>' for der in derivatives]
-        lines.append("    </Derivatives>")
-    lines.append("    <InitialUnknowns>")
-    for name in sorted([s.name for s in outputs] + derivatives, key=index.get):
-        lines.append(f'      <Unknown index="{index[name]}"/>')
-    lines += ["    </InitialUnknowns>", "  </ModelStructure>", "</fmiModelDescription>", ""]
+    lines += ["  <ModelVariables>", *v.lines, "  </ModelVariables>"]
+    lines += _structure_lines(v.index, inputs, outputs, derivatives)
+    lines += ["</fmiModelDescription>", ""]
     return "\n".join(lines)
 
 
@@ -699,6 +739,7 @@ def _check_model(model: DynamicModel, causality: str) -> None:
     """A short run from the default inputs' steady state, so that an inadmissible model (a shape
     effect beyond the mass-matrix bound, ...) is an input error now, not an fmi2Error later."""
     t = [0.0, 1e-3]
+    drive: Drive
     if causality == "speeds":
         drive = Speeds(t, [INPUT_START["pump_speed_rad_s"]] * 2, [INPUT_START["turbine_speed_rad_s"]] * 2)
     else:

@@ -109,6 +109,7 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
             bad = np.flatnonzero((values < 0) | (values > limit * (1 + 1e-12)))
             if bad.size:
                 row = int(bad[0])
+                assert time_s is not None  # the time column comes first
                 raise InputError(
                     str(path),
                     column,

@@ -173,6 +173,7 @@ class Converter:
     def core_geometry(self) -> np.ndarray:
         """The geometry as a (1, 15) array for the core."""
         self.require("hrovat-tobler")
+        assert self.geometry is not None  # require() checked it
         return self.geometry.core_row()[None, :]
 
     def to_toml_dict(self) -> dict[str, Any]:

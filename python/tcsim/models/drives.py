@@ -7,6 +7,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 #: Default width of the smoothing window of measured-speed derivatives, s (see docs/transient.md).
 DERIVATIVE_WINDOW_S = 0.04
@@ -16,9 +17,9 @@ DERIVATIVE_WINDOW_S = 0.04
 # Drives
 
 
-def _arr(x) -> list[float] | float:
+def _arr(x: Any) -> list[float] | float:
     if np.isscalar(x):
-        return float(x)
+        return float(x)  # type: ignore[arg-type]  # a real scalar; complex inputs are not drives
     return np.asarray(x, dtype=float).tolist()
 
 
@@ -28,9 +29,9 @@ class PumpTorqueTurbineSpeed:
     pump speed and turbine torque come out. The turbine speed's derivative is smoothed over
     ``derivative_window_s`` (local least-squares slope)."""
 
-    time_s: np.ndarray
-    pump_torque_nm: np.ndarray
-    turbine_speed_rad_s: np.ndarray
+    time_s: ArrayLike
+    pump_torque_nm: ArrayLike
+    turbine_speed_rad_s: ArrayLike
     derivative_window_s: float = DERIVATIVE_WINDOW_S
 
     def spec(self) -> dict[str, Any]:
@@ -47,9 +48,9 @@ class PumpTorqueTurbineSpeed:
 class Speeds:
     """Drive (b): pump and turbine speeds given; the torques come out."""
 
-    time_s: np.ndarray
-    pump_speed_rad_s: np.ndarray
-    turbine_speed_rad_s: np.ndarray
+    time_s: ArrayLike
+    pump_speed_rad_s: ArrayLike
+    turbine_speed_rad_s: ArrayLike
     derivative_window_s: float = DERIVATIVE_WINDOW_S
 
     def spec(self) -> dict[str, Any]:
@@ -67,10 +68,10 @@ class PumpTorqueLoad:
     """Drive (c): pump torque given; the turbine drives a load inertia against
     ``load_torque_nm + load_drag_nm_s2·ω_t|ω_t|``. Both speeds come out."""
 
-    time_s: np.ndarray
-    pump_torque_nm: np.ndarray
+    time_s: ArrayLike
+    pump_torque_nm: ArrayLike
     load_inertia_kg_m2: float
-    load_torque_nm: np.ndarray | float = 0.0
+    load_torque_nm: ArrayLike = 0.0
     load_drag_nm_s2: float = 0.0
 
     def spec(self) -> dict[str, Any]:

@@ -59,6 +59,7 @@ def _require(conv: Converter, section: str, model: str) -> Any:
 
 def _table_spec(conv: Converter) -> dict[str, Any]:
     c = conv.characteristic
+    assert c is not None  # the caller's conv.require(model) checked it
     return {
         "speed_ratio": c.speed_ratio.tolist(),
         "torque_ratio": c.torque_ratio.tolist(),
@@ -109,6 +110,7 @@ def dynamic_model(converter: Converter | str, model: str = "hrovat-tobler") -> D
         spec.update(_table_spec(conv))
     elif model == "hrovat-tobler":
         g = conv.geometry
+        assert g is not None  # conv.require(model) checked it
         spec.update(
             geometry=conv.core_geometry()[0].tolist(),
             fluid_length_m=g.fluid_length_m,
@@ -145,6 +147,8 @@ def resolve_model(
     else:
         if model not in allowed:
             raise InputError("command line", "--model", model, expected)
+        if converter is None:
+            raise InputError("command line", "converter", "none", "a converter (or a DynamicModel as the model)")
         m = dynamic_model(converter, model)
     if m.name not in allowed:
         raise InputError("command line", "--model", m.name, expected)

@@ -42,6 +42,7 @@ def _check_speed(pump_speed_rpm: float) -> float:
 
 def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
     """A sweep over the table's own range that contains every table point."""
+    assert conv.characteristic is not None  # the callers' conv.require checked it
     sr = conv.characteristic.speed_ratio
     return np.unique(np.concatenate([np.linspace(sr[0], sr[-1], n), sr]))
 
@@ -58,8 +59,10 @@ def characterise_table(
     wp = _check_speed(pump_speed_rpm)
     sr = table_speed_ratios(conv) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
     pump = np.full(sr.shape, wp)
+    assert conv.characteristic is not None  # conv.require("table") checked it
+    table_sr, table_tr, table_cf = conv.characteristic.arrays()
     try:
-        out = _core.table_steady_states(*conv.characteristic.arrays(), pump, np.ascontiguousarray(sr * wp))
+        out = _core.table_steady_states(table_sr, table_tr, table_cf, pump, np.ascontiguousarray(sr * wp))
     except _core.CoreInputError as e:
         raise from_core(e, conv.path) from None
     df = pd.DataFrame(

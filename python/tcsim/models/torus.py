@@ -58,7 +58,7 @@ def torus_estimate(
     fluid_density_kg_m3: float,
     n: int = 2001,
 ) -> TorusEstimate:
-    rp, rt, rs = pump_exit_radius_m, turbine_exit_radius_m, stator_exit_radius_m
+    rp, rt, rs = pump_exit_radius_m, turbine_exit_radius_m, stator_exit_radius_m  # exit radii: pump, turbine, stator
     if not rs < rt < rp:
         raise ValueError("the torus estimate needs stator exit radius < turbine exit radius < pump exit radius")
     rc, a = 0.5 * (rp + rs), 0.5 * (rp - rs)

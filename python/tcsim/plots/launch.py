@@ -211,7 +211,8 @@ def plot_sweep(sweep: pd.DataFrame | None, steady: pd.DataFrame | None, release:
         return []
     a, b = release - SWEEP_WINDOW_S[0], release + SWEEP_WINDOW_S[1]
     paths = []
-    for model, g in sweep.groupby("model", sort=False):
+    for key, g in sweep.groupby("model", sort=False):
+        model = str(key)
         for column, ylabel, what, figure in _SWEEP_FIGURES:
             fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
             for label, run in g.groupby("label", sort=False):
