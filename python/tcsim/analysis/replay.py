@@ -53,12 +53,12 @@ speeds in drive (b)) or absent from a model is not a state and is ignored, with 
 Derivative window
 -----------------
 A prescribed speed enters the equations with its derivative (the inertia and shape-effect
-terms). ``--window S`` (default :data:`tcsim.DERIVATIVE_WINDOW_S`, 0.04 s) sets the
+terms). ``--window S`` (default :data:`tcsim.models.drives.DERIVATIVE_WINDOW_S`, 0.04 s) sets the
 smoothing of that derivative: at each sample, the slope of the straight line fitted by least
 squares to all samples within ±S/2 (at least the neighbouring samples; a first-order
 Savitzky–Golay filter on non-uniform samples). ``--window 0`` gives the central difference.
 The *same* local least-squares slope, with the same window, differentiates the measured speeds
-for the measured effective torques below (:func:`tcsim.effective.smoothed_rate`).
+for the measured effective torques below (:func:`tcsim.analysis.effective.smoothed_rate`).
 
 Outputs (in DIR, default ``replay``; written all at once, nothing on error)
 ---------------------------------------------------------------------------

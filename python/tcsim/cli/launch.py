@@ -1,7 +1,60 @@
-"""``tcsim launch``: whole-vehicle take-off with every converter model (see :mod:`tcsim.analysis.launch`).
+"""``tcsim launch``: whole-vehicle take-off with every converter model on the same vehicle.
 
-:func:`launch_files` (load → compute) and :func:`write_launch` (files and figures) are also the
-Python API ``tcsim.launch.launch`` and ``tcsim.launch.write_launch``.
+The thesis's central comparison (Li & Sundén 2016, §3.2.2, §3.5.2.2, §4.1): a vehicle held on
+the brake in first gear, then brake off and pedal on; the steady-state (table) model against the
+dynamic models, whose effective torque ratio dips in the first tenths of a second.
+
+::
+
+    tcsim launch [VEHICLE] [--out DIR] [--scenario flip-flop|part-pedal|FILE] [--model M ...]
+                 [--sweep-shape-effects]
+
+Scenarios
+---------
+A :class:`~tcsim.simulation.scenarios.Scenario` is accelerator and brake pedal positions (0–1,
+linearly interpolated) against time, an end time, an optional stop speed (the run ends when the
+vehicle reaches it) and the brake release time from which the summary's times are measured.
+
+* :func:`tcsim.simulation.scenarios.flip_flop` (``--scenario flip-flop``, the default; thesis §3.2.2
+  and §3.5.1): first gear, brake 1 and pedal 0 for ``hold_s`` = 5 s, then within 0.05 s brake 0 and
+  pedal 1; to 100 km/h or 30 s.
+* :func:`tcsim.simulation.scenarios.part_pedal` (``--scenario part-pedal``): the same with pedal
+  0.3; to 50 km/h or 40 s.
+* :func:`tcsim.io.scenario.read_scenario` (``--scenario FILE``): a CSV, Parquet, ``.mat`` or MDF4
+  file with ``time_s`` (or ``time_ms``), ``accelerator_pedal`` and ``brake_pedal`` (0–1; or
+  ``accelerator_pedal_percent``/``brake_pedal_percent``, 0–100). Runs to the last time stamp. The
+  brake release time is where the brake pedal's last fall to zero begins. The file's times are
+  shifted so that its first sample is time 0.
+
+Time 0 is the start of the scenario: the vehicle at rest (held by the brake if it is applied).
+
+Runs
+----
+:func:`tcsim.simulation.launch.run_launch` is the only call into the core
+(``tcsim._core.launch_runs``): all models in one call, the GIL released, one worker per core. Each
+run gives a time series with at least :data:`tcsim.simulation.launch.LAUNCH_COLUMNS` and events
+(gear shifts, lock-up, converter events) as ``(time_s, kind, ...)``, the ``events`` field of each
+:class:`~tcsim.simulation.launch.LaunchRun`.
+
+Outputs (in DIR, default ``launch``; written all at once, nothing on error)
+---------------------------------------------------------------------------
+* ``summary.csv``: one row per model, :data:`tcsim.analysis.launch.SUMMARY_COLUMNS`. Times are
+  measured from the brake release; "first 0.5 s" is the 0.5 s after it; NaN where a speed is not reached.
+* ``<model>.csv``: each model's time series; ``timeseries.csv``: all of them with a ``model`` column.
+* ``events.csv``: ``model, time_s, kind, detail``; ``scenario.csv``: the pedal inputs.
+* Plots like thesis figures 3.5, 3.6 and 3.20 (:mod:`tcsim.plots.launch`).
+* With ``--sweep-shape-effects``: ``shape_sweep.csv``, ``shape_sweep_summary.csv`` and, per dynamic
+  model, plots like figures 4.3–4.6: S_p = S_t over the thesis's values (quasi-dynamic, with the
+  thesis's pair S_p = 0.4, S_t = 0.3) or over admissible values (Hrovat & Tobler,
+  :func:`tcsim.models.shape_effects.sweep_values`), all runs in one batched core call, each to
+  :data:`tcsim.simulation.launch.SWEEP_SPAN_S` after the brake release. A sweep run that fails is
+  left out with a warning.
+
+Errors: a bad vehicle file, scenario file or option is an :class:`~tcsim.errors.InputError` (exit 2,
+nothing written); a solver failure is a :class:`~tcsim.simulation.transient.SolverError` (exit 1).
+
+:func:`launch_files` (load → compute) and :func:`write_launch` (files and figures) are the Python
+API of the command.
 """
 
 from __future__ import annotations

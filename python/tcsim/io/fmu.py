@@ -198,7 +198,6 @@ SIGNALS: tuple[Signal, ...] = (
     Signal(10, "effective_turbine_torque_nm", "N.m", "Effective turbine output torque T_t + I_t dw_t/dt (LS16 eq 3.4)"),
     Signal(11, "effective_torque_ratio", "1", "Effective torque ratio: effective turbine / effective pump torque"),
 )
-SIGNAL_NAMES: tuple[str, ...] = tuple(s.name for s in SIGNALS)
 
 
 def model_signals(model: str) -> list[Signal]:
@@ -616,11 +615,6 @@ def find_libraries(build: bool = True) -> list[Path]:
     )
 
 
-def find_library(build: bool = True) -> Path:
-    """The first library of :func:`find_libraries`."""
-    return find_libraries(build)[0]
-
-
 def _check_library(lib: Path) -> None:
     """The library exports the FMI 2.0 Co-Simulation functions (and, if it is for this platform,
     it loads)."""
@@ -765,9 +759,9 @@ def export_fmu(
     out_path: str | Path,
     causality: str = "pump-torque",
 ) -> Path:
-    """Write the FMU of ``model`` (a name of :data:`tcsim.converter.MODELS`, or a
+    """Write the FMU of ``model`` (a name of :data:`tcsim.models.converter.MODELS`, or a
     :class:`~tcsim.transient.DynamicModel`, with ``converter`` then ignored) of ``converter`` (a
-    :class:`~tcsim.converter.Converter`, bundled name or file) to ``out_path`` (``*.fmu``), written
+    :class:`~tcsim.models.converter.Converter`, bundled name or file) to ``out_path`` (``*.fmu``), written
     atomically. Returns the path."""
     _check_causality(causality)
     out = _output_path(out_path)
