@@ -172,3 +172,16 @@ def test_a_cycle_and_an_upward_import_are_found():
 )
 def test_relative_imports_resolve(module, is_package, level, target, expected):
     assert resolve(module, is_package, level, target) == expected
+
+
+FACADES = ("transient", "replay", "fmu", "fitting", "shape_fit", "steady", "study", "torus", "measurement")
+
+
+@pytest.mark.parametrize("name", FACADES)
+def test_facades_only_re_export(name):
+    """A documented path that moved is a thin facade: a docstring, imports and ``__all__``."""
+    tree = ast.parse((PACKAGE / f"{name}.py").read_text(encoding="utf-8"))
+    for node in tree.body[1:]:
+        is_all = isinstance(node, ast.Assign) and [getattr(t, "id", None) for t in node.targets] == ["__all__"]
+        assert isinstance(node, ast.ImportFrom) or is_all, (name, ast.dump(node)[:80])
+    assert layer(f"tcsim.{name}") == FACADE

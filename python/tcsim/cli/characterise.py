@@ -7,13 +7,14 @@ from typing import Annotated
 
 import typer
 
+from ..units import DEFAULT_PUMP_SPEED_RPM
 from .app import ModelOpt, OutOpt, stdout
 
 
 def characterise(
     converter: Annotated[str, typer.Argument(help="bundled name, converter .toml, or table .csv/.vtcc")],
     model: ModelOpt = "",
-    pump_speed_rpm: Annotated[float, typer.Option(help="fixed pump speed of the sweep")] = 2000.0,
+    pump_speed_rpm: Annotated[float, typer.Option(help="fixed pump speed of the sweep")] = DEFAULT_PUMP_SPEED_RPM,
     out: OutOpt = Path("characteristic"),
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""

@@ -30,12 +30,12 @@ import pandas as pd
 
 from ..errors import InputError
 from ..models.measurement import Measurement
-from ..units import LBF_FT_IN_NM
+from ..units import LBF_FT_IN_NM, RAD_S_PER_RPM
 
 #: Name suffix -> factor to SI, per quantity; the first suffix of each is the SI one.
 _SUFFIXES: dict[str, dict[str, float]] = {
     "time": {"s": 1.0, "ms": 1e-3},
-    "speed": {"rad_s": 1.0, "rpm": math.pi / 30.0, "deg_s": math.pi / 180.0},
+    "speed": {"rad_s": 1.0, "rpm": RAD_S_PER_RPM, "deg_s": math.pi / 180.0},
     "torque": {"nm": 1.0, "knm": 1e3, "lbf_ft": LBF_FT_IN_NM},
     "flow": {"m3_s": 1.0, "l_s": 1e-3},
 }
@@ -46,9 +46,9 @@ _UNITS: dict[str, dict[str, float]] = {
     "speed": {
         "rad/s": 1.0,
         "1/s": 1.0,
-        "rpm": math.pi / 30.0,
-        "1/min": math.pi / 30.0,
-        "min-1": math.pi / 30.0,
+        "rpm": RAD_S_PER_RPM,
+        "1/min": RAD_S_PER_RPM,
+        "min-1": RAD_S_PER_RPM,
         "deg/s": math.pi / 180.0,
     },
     "torque": {"nm": 1.0, "knm": 1e3, "lbfft": LBF_FT_IN_NM},

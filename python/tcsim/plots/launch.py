@@ -23,6 +23,7 @@ from typing import Any
 import pandas as pd
 from matplotlib.ticker import MaxNLocator
 
+from ..units import KM_H
 from .common import finish_figure, plt
 
 COLOURS = {"table": "C0", "hrovat-tobler": "C1", "quasi-dynamic": "C2"}
@@ -152,7 +153,7 @@ def plot_speeds(frames: Frames, scenario_name: str, out_dir: Path) -> list[Path]
     gear_ax = ax.twinx()
     for name, f in frames.items():
         style = _style(name)
-        ax.plot(f["time_s"], f["vehicle_speed_m_s"] * 3.6, lw=1.3, **style)
+        ax.plot(f["time_s"], f["vehicle_speed_m_s"] / KM_H, lw=1.3, **style)
         if "gear" in f:
             gear_ax.step(f["time_s"], f["gear"], where="post", lw=0.8, ls="--", color=style["color"], alpha=0.7)
     ax.set_ylabel("Vehicle speed [km/h]")
