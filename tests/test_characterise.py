@@ -11,8 +11,9 @@ import pytest
 import tcsim
 from conftest import C1_CF, C1_SR, C1_TR, CONVERTER_DATA
 from tcsim import _core
-from tcsim.converter import load_converter
-from tcsim.steady import characterise, coupling_point
+from tcsim.models.converter import load_converter
+from tcsim.models.steady import characterise, coupling_point
+from tcsim.models.torus import torus_estimate
 
 WP = 2000 * math.pi / 30
 
@@ -155,8 +156,6 @@ def test_bundled_converter_documents_every_value(ls):
 
 
 def test_bundled_fluid_parameters_come_from_the_torus_estimate(ls):
-    from tcsim.torus import torus_estimate
-
     g = ls.geometry
     e = torus_estimate(
         g.pump_exit_radius_m,
@@ -191,8 +190,6 @@ def test_bundled_fluid_parameters_come_from_the_torus_estimate(ls):
 
 def test_torus_bound_holds_for_any_angles():
     """Cauchy–Schwarz: ρ²S²/I_fluid ≤ (ρ/A)∫tan²α dl < ρL_f/A, element by element."""
-    from tcsim.torus import torus_estimate
-
     rng = np.random.default_rng(1)
     for _ in range(50):
         ang = rng.uniform(-75, 75, 6)

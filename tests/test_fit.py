@@ -16,10 +16,11 @@ import pytest
 import tomli_w
 
 from tcsim import _core
+from tcsim.analysis.fitting import DEFAULT_FREE, LOSSES, PUMP_SPEED_RAD_S, RADII, fit_hrovat_tobler, target_table
 from tcsim.cli import main
-from tcsim.converter import Characteristic, load_converter
 from tcsim.errors import InputError, TcsimWarning
-from tcsim.fitting import DEFAULT_FREE, LOSSES, PUMP_SPEED_RAD_S, RADII, fit_hrovat_tobler, target_table
+from tcsim.models.characteristic import Characteristic
+from tcsim.models.converter import load_converter
 
 SHARED_TABLES = Path(__file__).resolve().parent / "data" / "converters"
 

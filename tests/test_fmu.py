@@ -27,8 +27,8 @@ fmpy = pytest.importorskip("fmpy")
 from fmpy.fmi2 import FMU2Slave  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
-from tcsim import fmu as tfmu  # noqa: E402
 from tcsim.errors import InputError  # noqa: E402
+from tcsim.io import fmu as tfmu  # noqa: E402
 from tcsim.transient import PumpTorqueTurbineSpeed, Speeds, dynamic_model, isolated_takeoff, simulate  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[1]

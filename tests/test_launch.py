@@ -13,10 +13,26 @@ import pandas as pd
 import pytest
 
 import tcsim
-from tcsim import launch as L
+import tcsim.cli
+from tcsim.analysis.launch import (
+    EVENT_COLUMNS,
+    SUMMARY_COLUMNS,
+    events_table,
+    launch_summary,
+    peak_value,
+    time_to_speed,
+    window_mean,
+    window_min,
+)
+from tcsim.cli.launch import launch_files, write_launch
 from tcsim.errors import InputError, TcsimWarning
-from tcsim.transient import SolverError, dynamic_model
-from tcsim.vehicle import load_vehicle
+from tcsim.io.scenario import read_scenario, scenario_from_option
+from tcsim.models.dynamic import dynamic_model
+from tcsim.models.shape_effects import THESIS_VALUES_M2, mass_matrix_bound
+from tcsim.models.vehicle import load_vehicle
+from tcsim.simulation.launch import LAUNCH_COLUMNS, SWEEP_SPAN_S, run_launch, select_models, sweep_cases, sweep_scenario
+from tcsim.simulation.scenarios import Scenario, brake_release_time, flip_flop, part_pedal
+from tcsim.simulation.transient import SolverError
 
 HAS_CORE = hasattr(tcsim._core, "launch_runs")
 needs_core = pytest.mark.skipif(not HAS_CORE, reason="tcsim._core.launch_runs (the vehicle plant) is not built yet")
@@ -27,7 +43,7 @@ needs_core = pytest.mark.skipif(not HAS_CORE, reason="tcsim._core.launch_runs (t
 
 
 def test_flip_flop():
-    s = L.flip_flop()
+    s = flip_flop()
     assert s.name == "flip-flop" and s.end_time_s == 30.0 and s.brake_release_time_s == 5.0
     assert s.stop_speed_m_s == pytest.approx(27.7778, abs=1e-4)
     acc, brake = s.pedals_at([0.0, 4.99, 5.0, 5.025, 5.05, 10.0, 30.0])
@@ -36,29 +52,29 @@ def test_flip_flop():
     spec = s.core_spec()
     assert set(spec) == {"time_s", "accelerator_pedal", "brake_pedal", "end_time_s", "stop_speed_m_s"}
     json.dumps(spec)
-    other = L.flip_flop(hold_s=2.0, end_time_s=8.0)
+    other = flip_flop(hold_s=2.0, end_time_s=8.0)
     assert other.brake_release_time_s == 2.0 and other.time_s.tolist() == [0.0, 2.0, 2.05, 8.0]
 
 
 def test_part_pedal():
-    s = L.part_pedal()
+    s = part_pedal()
     assert s.name == "part-pedal" and s.end_time_s == 40.0 and s.brake_release_time_s == 5.0
     assert s.stop_speed_m_s == pytest.approx(50 / 3.6)
     acc, brake = s.pedals_at([4.0, 5.05, 20.0])
     np.testing.assert_allclose(acc, [0, 0.3, 0.3])
     np.testing.assert_allclose(brake, [1, 0, 0])
-    assert L.part_pedal(pedal=0.6).accelerator_pedal.max() == 0.6
-    assert L.part_pedal().core_spec()["stop_speed_m_s"] == pytest.approx(13.8889, abs=1e-4)
+    assert part_pedal(pedal=0.6).accelerator_pedal.max() == 0.6
+    assert part_pedal().core_spec()["stop_speed_m_s"] == pytest.approx(13.8889, abs=1e-4)
 
 
 @pytest.mark.parametrize(
     "make, field",
     [
-        (lambda: L.flip_flop(hold_s=5.0, end_time_s=5.0), "end_time_s"),
-        (lambda: L.flip_flop(hold_s=0.0), "hold_s"),
-        (lambda: L.part_pedal(pedal=0.0), "pedal"),
-        (lambda: L.part_pedal(pedal=1.5), "pedal"),
-        (lambda: L.part_pedal(pedal=math.nan), "pedal"),
+        (lambda: flip_flop(hold_s=5.0, end_time_s=5.0), "end_time_s"),
+        (lambda: flip_flop(hold_s=0.0), "hold_s"),
+        (lambda: part_pedal(pedal=0.0), "pedal"),
+        (lambda: part_pedal(pedal=1.5), "pedal"),
+        (lambda: part_pedal(pedal=math.nan), "pedal"),
     ],
 )
 def test_bad_builtin_scenarios(make, field):
@@ -93,17 +109,17 @@ def test_scenario_validation(kwargs, field):
     )
     args.update(kwargs)
     with pytest.raises(InputError) as err:
-        L.Scenario(**args)
+        Scenario(**args)
     assert err.value.field == field and err.value.source == "scenario x"
 
 
 def test_brake_release_time():
-    assert L.brake_release_time([0, 5, 5.05, 10], [1, 1, 0, 0]) == 5.0
-    assert L.brake_release_time([0, 1, 2, 3, 4], [0.5, 0.8, 0.4, 0.0, 0.0]) == 1.0  # start of the last fall
-    assert L.brake_release_time([0, 1, 2], [0, 0, 0]) == 0.0  # never applied
-    assert L.brake_release_time([0, 1, 2], [1, 1, 1]) == 2.0  # never released
+    assert brake_release_time([0, 5, 5.05, 10], [1, 1, 0, 0]) == 5.0
+    assert brake_release_time([0, 1, 2, 3, 4], [0.5, 0.8, 0.4, 0.0, 0.0]) == 1.0  # start of the last fall
+    assert brake_release_time([0, 1, 2], [0, 0, 0]) == 0.0  # never applied
+    assert brake_release_time([0, 1, 2], [1, 1, 1]) == 2.0  # never released
     # applied, released, applied again: the first release counts
-    assert L.brake_release_time([0, 1, 2, 3, 4], [1, 0, 0, 1, 0]) == 0.0
+    assert brake_release_time([0, 1, 2, 3, 4], [1, 0, 0, 1, 0]) == 0.0
 
 
 # ---------------------------------------------------------------------------------------------
@@ -121,16 +137,16 @@ def test_read_scenario_csv(tmp_path):
     path = tmp_path / "take_off.csv"
     df = _scenario_frame()
     df.to_csv(path, index=False)
-    s = L.read_scenario(path)
+    s = read_scenario(path)
     assert s.name == "take_off" and s.source == str(path)
     np.testing.assert_allclose(s.time_s, df.time_s)
     np.testing.assert_allclose(s.accelerator_pedal, df.accelerator_pedal)
     assert s.end_time_s == 8.0 and s.stop_speed_m_s is None
     assert s.brake_release_time_s == pytest.approx(3.0)
-    assert L.read_scenario(path, stop_speed_m_s=20.0, end_time_s=6.0).end_time_s == 6.0
+    assert read_scenario(path, stop_speed_m_s=20.0, end_time_s=6.0).end_time_s == 6.0
     shifted = df.assign(time_s=df.time_s + 100.0)
     shifted.to_csv(path, index=False)
-    s = L.read_scenario(path)  # the first sample becomes time 0
+    s = read_scenario(path)  # the first sample becomes time 0
     assert s.time_s[0] == 0.0 and s.end_time_s == pytest.approx(8.0) and s.brake_release_time_s == pytest.approx(3.0)
 
 
@@ -147,7 +163,7 @@ def test_read_scenario_percent_ms_and_parquet(tmp_path):
     for suffix in (".csv", ".parquet"):
         path = tmp_path / f"scen{suffix}"
         (other.to_csv(path, index=False) if suffix == ".csv" else other.to_parquet(path))
-        s = L.read_scenario(path)
+        s = read_scenario(path)
         np.testing.assert_allclose(s.time_s, df.time_s, atol=1e-12)
         np.testing.assert_allclose(s.accelerator_pedal, df.accelerator_pedal, atol=1e-12)
         np.testing.assert_allclose(s.brake_pedal, df.brake_pedal, atol=1e-12)
@@ -189,7 +205,7 @@ def test_read_scenario_bad_files(tmp_path, case):
     path = tmp_path / "bad.csv"
     _bad(case).to_csv(path, index=False)
     with pytest.raises(InputError) as err:
-        L.read_scenario(path)
+        read_scenario(path)
     msg = str(err.value)
     assert msg.startswith(str(path)), msg
     for w in SCENARIO_CASES[case]:
@@ -205,15 +221,15 @@ def test_read_scenario_percent_out_of_range_and_bad_paths(tmp_path):
     path = tmp_path / "pct.csv"
     pct.to_csv(path, index=False)
     with pytest.raises(InputError, match="accelerator_pedal_percent.*120.*from 0 to 100"):
-        L.read_scenario(path)
+        read_scenario(path)
     with pytest.raises(InputError, match="extension"):
-        L.read_scenario(tmp_path / "scen.txt")
+        read_scenario(tmp_path / "scen.txt")
     with pytest.raises(InputError, match="not found"):
-        L.read_scenario(tmp_path / "none.csv")
+        read_scenario(tmp_path / "none.csv")
     with pytest.raises(InputError, match="--scenario"):
-        L.scenario_from_option(str(tmp_path / "none.csv"))
-    assert L.scenario_from_option("flip-flop").name == "flip-flop"
-    assert L.scenario_from_option("part-pedal").name == "part-pedal"
+        scenario_from_option(str(tmp_path / "none.csv"))
+    assert scenario_from_option("flip-flop").name == "flip-flop"
+    assert scenario_from_option("part-pedal").name == "part-pedal"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -224,13 +240,13 @@ def test_time_to_speed_constant_acceleration():
     t = np.arange(0, 20.0001, 0.01)
     release, a = 5.0, 4.0
     v = np.maximum(0.0, a * (t - release))
-    assert L.time_to_speed(t, v, 100 / 3.6, release) == pytest.approx(100 / 3.6 / a, abs=1e-9)
-    assert L.time_to_speed(t, v, 50 / 3.6, release) == pytest.approx(50 / 3.6 / a, abs=1e-9)
-    assert math.isnan(L.time_to_speed(t, v, 100.0, release))  # never reached
+    assert time_to_speed(t, v, 100 / 3.6, release) == pytest.approx(100 / 3.6 / a, abs=1e-9)
+    assert time_to_speed(t, v, 50 / 3.6, release) == pytest.approx(50 / 3.6 / a, abs=1e-9)
+    assert math.isnan(time_to_speed(t, v, 100.0, release))  # never reached
     # coarse samples: linear interpolation between them
-    assert L.time_to_speed([0, 5, 6, 7], [0, 0, 10, 30], 20.0, 5.0) == pytest.approx(1.5)
+    assert time_to_speed([0, 5, 6, 7], [0, 0, 10, 30], 20.0, 5.0) == pytest.approx(1.5)
     # already above the target at the start
-    assert L.time_to_speed([0, 1, 2], [30, 30, 30], 20.0, 0.5) == 0.0
+    assert time_to_speed([0, 1, 2], [30, 30, 30], 20.0, 0.5) == 0.0
 
 
 def test_peak_and_window_metrics():
@@ -238,20 +254,20 @@ def test_peak_and_window_metrics():
     release = 5.0
     accel = np.where(t < release, 0.0, 6.0 * (t - release))  # ramp 6 m/s³ after release
     accel = np.minimum(accel, 5.0)
-    assert L.peak_value(t, accel, release) == pytest.approx(5.0)
+    assert peak_value(t, accel, release) == pytest.approx(5.0)
     # mean of 6 τ over the first 0.5 s (τ up to 0.5 s: 3 m/s² max, below the 5 m/s² cap) = 1.5
-    assert L.window_mean(t, accel, release, 0.5) == pytest.approx(1.5, abs=1e-9)
+    assert window_mean(t, accel, release, 0.5) == pytest.approx(1.5, abs=1e-9)
     # a V-shaped effective TR with its minimum between samples: edges and samples
     t2 = np.array([4.0, 5.0, 5.2, 5.45, 5.7, 6.0])
     etr = np.array([2.1, 2.1, 1.6, 1.4, 1.8, 2.0])
-    assert L.window_min(t2, etr, 5.0, 0.5) == pytest.approx(1.4)
+    assert window_min(t2, etr, 5.0, 0.5) == pytest.approx(1.4)
     # window edge interpolated: the window ends at 5.5 between 5.45 and 5.7
     step = np.array([2.0, 2.0, 2.0, 2.0, 1.0, 1.0])
-    assert L.window_min(t2, step, 5.0, 0.5) == pytest.approx(2 - (0.05 / 0.25) * 1.0)
+    assert window_min(t2, step, 5.0, 0.5) == pytest.approx(2 - (0.05 / 0.25) * 1.0)
     # the run ends before the window does
-    assert math.isnan(L.window_mean(t2, etr, 5.8, 0.5)) and math.isnan(L.window_min(t2, etr, 5.8, 0.5))
+    assert math.isnan(window_mean(t2, etr, 5.8, 0.5)) and math.isnan(window_min(t2, etr, 5.8, 0.5))
     # NaN samples ignored by the minimum
-    assert L.window_min([0, 0.25, 0.5], [np.nan, 1.0, 2.0], 0.0, 0.5) == 1.0
+    assert window_min([0, 0.25, 0.5], [np.nan, 1.0, 2.0], 0.0, 0.5) == 1.0
 
 
 def test_launch_summary_columns_and_values():
@@ -268,14 +284,14 @@ def test_launch_summary_columns_and_values():
                 "effective_torque_ratio": np.where(t < 5.0, 2.14, 2.14 - a / 10),
             }
         )
-    s = L.launch_summary(frames, 5.0)
-    assert list(s.columns) == list(L.SUMMARY_COLUMNS) and list(s.model) == ["table", "quasi-dynamic"]
+    s = launch_summary(frames, 5.0)
+    assert list(s.columns) == list(SUMMARY_COLUMNS) and list(s.model) == ["table", "quasi-dynamic"]
     row = s.set_index("model").loc["quasi-dynamic"]
     assert row.time_0_100_km_h_s == pytest.approx(100 / 3.6 / 4.0, abs=1e-9)
     assert row.time_0_50_km_h_s == pytest.approx(50 / 3.6 / 4.0, abs=1e-9)
     assert row.peak_accel_m_s2 == 4.0 and row.mean_accel_first_0_5_s_m_s2 == pytest.approx(4.0)
     assert row.min_effective_torque_ratio_first_0_5_s == pytest.approx(1.74)
-    assert math.isnan(L.launch_summary({"x": frames["table"].iloc[:700]}, 5.0).time_0_100_km_h_s[0])
+    assert math.isnan(launch_summary({"x": frames["table"].iloc[:700]}, 5.0).time_0_100_km_h_s[0])
 
 
 # ---------------------------------------------------------------------------------------------
@@ -338,37 +354,38 @@ def vehicle():
 
 
 def test_run_launch_unpacks_columns_and_events(fake_core, vehicle):
-    models = L.select_models(vehicle, [])
+    models = select_models(vehicle, [])
     assert [m.name for m in models] == ["table", "hrovat-tobler", "quasi-dynamic"]
-    frames = L.run_launch(vehicle, L.flip_flop(), models)
-    assert list(frames) == ["table", "hrovat-tobler", "quasi-dynamic"]
-    for f in frames.values():
-        assert set(L.LAUNCH_COLUMNS) <= set(f.columns) and "stator_speed_rad_s" not in f.columns  # all-NaN dropped
-        assert f.vehicle_speed_m_s.iloc[-1] >= 100 / 3.6 and f.attrs["events"][0][1] == "upshift"
-    ev = L.events_table(frames)
-    assert list(ev.columns) == list(L.EVENT_COLUMNS) and len(ev) == 3 and ev.detail[0] == "1 2"
+    runs = run_launch(vehicle, flip_flop(), models)
+    assert list(runs) == ["table", "hrovat-tobler", "quasi-dynamic"]
+    for run in runs.values():
+        f = run.frame
+        assert set(LAUNCH_COLUMNS) <= set(f.columns) and "stator_speed_rad_s" not in f.columns  # all-NaN dropped
+        assert f.vehicle_speed_m_s.iloc[-1] >= 100 / 3.6 and run.events[0][1] == "upshift"
+    ev = events_table(runs)
+    assert list(ev.columns) == list(EVENT_COLUMNS) and len(ev) == 3 and ev.detail[0] == "1 2"
 
 
 def test_run_launch_errors(fake_core, vehicle, monkeypatch):
     table = dynamic_model(vehicle.converter, "table")
-    scen = L.flip_flop()
+    scen = flip_flop()
     bad_vehicle = type(table)("table", {**table.spec, "fail_input": "engine.inertia_kg_m2"}, table.source)
     with pytest.raises(InputError) as err:
-        L.run_launch(vehicle, scen, [bad_vehicle])
+        run_launch(vehicle, scen, [bad_vehicle])
     assert err.value.source == vehicle.path and err.value.field == "engine.inertia_kg_m2" and err.value.value == -1.0
     bad_scen = type(table)("table", {**table.spec, "fail_input": "time_s"}, table.source)
     with pytest.raises(InputError) as err:
-        L.run_launch(vehicle, scen, [bad_scen])
+        run_launch(vehicle, scen, [bad_scen])
     assert err.value.source == "scenario flip-flop"
     bad_model = type(table)("table", {**table.spec, "fail_input": "capacity_factor_nm_s2"}, table.source)
     with pytest.raises(InputError) as err:
-        L.run_launch(vehicle, scen, [bad_model])
+        run_launch(vehicle, scen, [bad_model])
     assert err.value.source == table.source
     qd = dynamic_model(vehicle.converter, "quasi-dynamic").with_shape_effects(0.4, 0.3)
     with pytest.raises(SolverError, match="t = 5.12 s"):
-        L.run_launch(vehicle, scen, [table, qd])
+        run_launch(vehicle, scen, [table, qd])
     with pytest.warns(TcsimWarning, match="left out"):
-        frames = L.run_launch(vehicle, scen, [table, qd], labels=["a", "b"], on_error="warn")
+        frames = run_launch(vehicle, scen, [table, qd], labels=["a", "b"], on_error="warn")
     assert list(frames) == ["a"]
 
     def core_error(*args):
@@ -376,21 +393,19 @@ def test_run_launch_errors(fake_core, vehicle, monkeypatch):
 
     monkeypatch.setattr(tcsim._core, "launch_runs", core_error)
     with pytest.raises(InputError) as err:
-        L.run_launch(vehicle, scen, [table, qd])
+        run_launch(vehicle, scen, [table, qd])
     assert err.value.source == vehicle.path
 
 
 def test_run_launch_without_the_core_is_a_clear_failure(monkeypatch, vehicle):
     monkeypatch.delattr(tcsim._core, "launch_runs", raising=False)
     with pytest.raises(RuntimeError, match="launch_runs"):
-        L.run_launch(vehicle, L.flip_flop(), L.select_models(vehicle, ["table"]))
+        run_launch(vehicle, flip_flop(), select_models(vehicle, ["table"]))
 
 
 def test_sweep_cases_use_admissible_values(vehicle):
-    from tcsim.shape_fit import THESIS_VALUES_M2, mass_matrix_bound
-
-    models = L.select_models(vehicle, [])
-    cases = L.sweep_cases(models)
+    models = select_models(vehicle, [])
+    cases = sweep_cases(models)
     qd = [(c.pump_shape_effect_m2, c.turbine_shape_effect_m2) for c in cases if c.model == "quasi-dynamic"]
     assert qd == [(v, v) for v in THESIS_VALUES_M2] + [(0.4, 0.3)]
     ht = [c for c in cases if c.model == "hrovat-tobler"]
@@ -404,13 +419,13 @@ def test_sweep_cases_use_admissible_values(vehicle):
 def test_launch_writes_files_and_plots(fake_core, vehicle, tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TcsimWarning)  # the fake fails the (0.4, 0.3) pair
-        result = L.launch(vehicle, "flip-flop", sweep=True)
+        result = launch_files(vehicle, "flip-flop", sweep=True)
     assert list(result.summary.model) == ["table", "hrovat-tobler", "quasi-dynamic"]
     s = result.summary.set_index("model")
     assert s.time_0_100_km_h_s.notna().all() and (
         s.loc["table"].mean_accel_first_0_5_s_m_s2 > s.loc["quasi-dynamic"].mean_accel_first_0_5_s_m_s2
     )
-    paths = L.write_launch(result, tmp_path)
+    paths = write_launch(result, tmp_path)
     names = {p.name for p in paths}
     assert {
         "summary.csv",
@@ -435,20 +450,18 @@ def test_launch_writes_files_and_plots(fake_core, vehicle, tmp_path):
     } <= names
     assert all(p.exists() and p.stat().st_size > 0 for p in paths)
     summary = pd.read_csv(tmp_path / "summary.csv")
-    assert list(summary.columns) == list(L.SUMMARY_COLUMNS)
+    assert list(summary.columns) == list(SUMMARY_COLUMNS)
     ts = pd.read_csv(tmp_path / "quasi-dynamic.csv")
-    assert set(L.LAUNCH_COLUMNS) <= set(ts.columns) and ts.time_s.iloc[0] == 0.0
+    assert set(LAUNCH_COLUMNS) <= set(ts.columns) and ts.time_s.iloc[0] == 0.0
     sweep = pd.read_csv(tmp_path / "shape_sweep_summary.csv")
     assert (~sweep.finished).sum() == 1  # the pair the fake refuses
     assert pd.read_csv(tmp_path / "timeseries.csv").model.unique().tolist() == list(result.frames)
 
 
 def test_cli_launch_with_the_stand_in(fake_core, tmp_path, capsys):
-    from tcsim import cli
-
     out = tmp_path / "out"
     assert (
-        cli.main(
+        tcsim.cli.main(
             ["launch", "--out", str(out), "--scenario", "part-pedal", "--model", "table", "--model", "quasi-dynamic"]
         )
         == 0
@@ -469,34 +482,28 @@ def test_cli_launch_with_the_stand_in(fake_core, tmp_path, capsys):
     ],
 )
 def test_cli_bad_options_exit_2(fake_core, tmp_path, capsys, args, words):
-    from tcsim import cli
-
     out = tmp_path / "out"
-    assert cli.main(["launch", "--out", str(out), *args]) == 2
+    assert tcsim.cli.main(["launch", "--out", str(out), *args]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and all(w in err for w in words), err
     assert not out.exists()
 
 
 def test_cli_bad_scenario_file_exit_2(fake_core, tmp_path, capsys):
-    from tcsim import cli
-
     path = tmp_path / "scen.csv"
     _bad("above one").to_csv(path, index=False)
     out = tmp_path / "out"
-    assert cli.main(["launch", "--out", str(out), "--scenario", str(path)]) == 2
+    assert tcsim.cli.main(["launch", "--out", str(out), "--scenario", str(path)]) == 2
     err = capsys.readouterr().err
     assert str(path) in err and "accelerator_pedal" in err and not out.exists()
 
 
 def test_cli_solver_failure_exit_1_nothing_written(monkeypatch, tmp_path, capsys):
-    from tcsim import cli
-
     monkeypatch.setattr(
         tcsim._core, "launch_runs", lambda *a: [("solver", "step size too small at t = 5.3 s")] * 3, raising=False
     )
     out = tmp_path / "out"
-    assert cli.main(["launch", "--out", str(out)]) == 1
+    assert tcsim.cli.main(["launch", "--out", str(out)]) == 1
     err = capsys.readouterr().err
     assert "SolverError" in err and "t = 5.3 s" in err and not out.exists()
 
@@ -508,7 +515,7 @@ def test_cli_solver_failure_exit_1_nothing_written(monkeypatch, tmp_path, capsys
 @pytest.fixture(scope="module")
 def flip_flop_runs():
     veh = load_vehicle()
-    return L.run_launch(veh, L.flip_flop(), L.select_models(veh, []))
+    return {name: run.frame for name, run in run_launch(veh, flip_flop(), select_models(veh, [])).items()}
 
 
 @needs_core
@@ -526,23 +533,23 @@ def test_stall_phase_table_and_quasi_dynamic_agree_then_dynamic_models_start_low
     np.testing.assert_allclose(
         np.interp(t, qd.time_s, qd.torque_ratio), np.interp(t, table.time_s, table.torque_ratio), rtol=1e-4
     )
-    s = L.launch_summary(flip_flop_runs, 5.0).set_index("model")
+    s = launch_summary(flip_flop_runs, 5.0).set_index("model")
     for dyn in ("hrovat-tobler", "quasi-dynamic"):
         assert s.loc[dyn].mean_accel_first_0_5_s_m_s2 < s.loc["table"].mean_accel_first_0_5_s_m_s2
     assert s.time_0_100_km_h_s.notna().all()
 
 
 def test_sweep_scenario_ends_after_the_release():
-    s = L.sweep_scenario(L.flip_flop())
-    assert s.end_time_s == 5.0 + L.SWEEP_SPAN_S and s.brake_release_time_s == 5.0
-    np.testing.assert_array_equal(s.accelerator_pedal, L.flip_flop().accelerator_pedal)
-    assert L.sweep_scenario(L.flip_flop(hold_s=1.0, end_time_s=2.0)).end_time_s == 2.0
+    s = sweep_scenario(flip_flop())
+    assert s.end_time_s == 5.0 + SWEEP_SPAN_S and s.brake_release_time_s == 5.0
+    np.testing.assert_array_equal(s.accelerator_pedal, flip_flop().accelerator_pedal)
+    assert sweep_scenario(flip_flop(hold_s=1.0, end_time_s=2.0)).end_time_s == 2.0
 
 
 @needs_core
 def test_larger_shape_effects_lower_the_initial_acceleration(tmp_path):
     """Thesis §4.1, figs 4.3–4.6: a larger S deepens the effective-TR dip and lowers the acceleration."""
-    result = L.launch(None, "flip-flop", ["table", "quasi-dynamic", "hrovat-tobler"], sweep=True)
+    result = launch_files(None, "flip-flop", ["table", "quasi-dynamic", "hrovat-tobler"], sweep=True)
     s = result.sweep_summary
     assert s.finished.all()
     for model in ("quasi-dynamic", "hrovat-tobler"):
@@ -550,8 +557,8 @@ def test_larger_shape_effects_lower_the_initial_acceleration(tmp_path):
         equal = equal.sort_values("pump_shape_effect_m2")
         assert (np.diff(equal.mean_accel_first_0_5_s_m_s2) < 0).all(), equal
         assert (np.diff(equal.min_effective_torque_ratio_first_0_5_s) < 0).all(), equal
-    assert result.sweep.time_s.max() <= 5.0 + L.SWEEP_SPAN_S + 1e-9
-    names = {p.name for p in L.write_launch(result, tmp_path)}
+    assert result.sweep.time_s.max() <= 5.0 + SWEEP_SPAN_S + 1e-9
+    names = {p.name for p in write_launch(result, tmp_path)}
     assert "shape_sweep_quasi-dynamic_vehicle_accel.png" in names
 
 
@@ -614,7 +621,7 @@ def test_models_rejoin_in_torque_ratio_and_energy_balances(flip_flop_runs):
 @needs_core
 def test_part_pedal_launch_is_gentler(flip_flop_runs):
     veh = load_vehicle()
-    part = L.run_launch(veh, L.part_pedal(), L.select_models(veh, ["table"]))["table"]
+    part = run_launch(veh, part_pedal(), select_models(veh, ["table"]))["table"].frame
     full = flip_flop_runs["table"]
     assert part.vehicle_speed_m_s[part.time_s < 5.0].abs().max() == 0.0
 
@@ -629,7 +636,7 @@ def test_logged_engine_torque_is_replayed(tmp_path, cli, flip_flop_runs):
     """Thesis §3.5.2.2: the engine model replaced by a logged engine torque. Replaying the engine
     torque of the table model's own run reproduces its launch."""
     f = flip_flop_runs["table"]
-    sc = L.flip_flop()
+    sc = flip_flop()
     path = tmp_path / "logged.csv"
     pedal, brake = sc.pedals_at(f.time_s)
     pd.DataFrame(

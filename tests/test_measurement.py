@@ -5,14 +5,18 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pandas as pd
 import pytest
+import scipy.io
+from asammdf import MDF, Signal
 
 from tcsim.errors import InputError
-from tcsim.measurement import INPUT_CHANNELS, Measurement, parse_channel_map, read_measurement
+from tcsim.io.measurement import INPUT_CHANNELS, parse_channel_map, read_measurement
+from tcsim.models.measurement import Measurement
 
-N = 200
+N = 200  # samples of the synthetic measurement
 TIME_S = np.linspace(0.0, 2.0, N)
 ORIGINAL = {
     "pump_torque_nm": 150.0 + 40.0 * np.sin(3.0 * TIME_S),
@@ -36,8 +40,6 @@ def write_csv(path: Path, columns: dict[str, np.ndarray]) -> Path:
 
 def write_mat_v73(path: Path, columns: dict[str, np.ndarray]) -> Path:
     """An HDF5 file laid out like MATLAB v7.3: a 512-byte header, one 2-D double dataset per variable."""
-    import h5py
-
     with h5py.File(path, "w", userblock_size=512) as f:
         for k, (name, values) in enumerate(columns.items()):
             shape = (1, len(values)) if k % 2 else (len(values), 1)  # both orientations
@@ -52,8 +54,6 @@ def write_mat_v73(path: Path, columns: dict[str, np.ndarray]) -> Path:
 
 
 def write_mdf(path: Path, columns: dict[str, np.ndarray], units: dict[str, str], time_s=TIME_S) -> Path:
-    from asammdf import MDF, Signal
-
     mdf = MDF(version="4.10")
     mdf.append([Signal(values, time_s, name=name, unit=units.get(name, "")) for name, values in columns.items()])
     mdf.save(path, overwrite=True)
@@ -72,8 +72,6 @@ def write(path: Path, columns: dict[str, np.ndarray], units: dict[str, str] | No
     if path.name.endswith("v73.mat"):
         return write_mat_v73(path, columns)
     if suffix == ".mat":
-        import scipy.io
-
         scipy.io.savemat(path, columns)
         return path
     data = {k: v for k, v in columns.items() if k != "time_s"}
@@ -121,8 +119,6 @@ def test_optional_channels_absent_and_comments(tmp_path):
 
 
 def test_mdf_channels_resampled_onto_first_required(tmp_path):
-    from asammdf import MDF, Signal
-
     path = tmp_path / "m.mf4"
     mdf = MDF(version="4.10")
     mdf.append(

@@ -9,11 +9,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import pytest
+from asammdf import MDF, Signal
 
+import tcsim.cli
 from tcsim import transient
-from tcsim.effective import smoothed_rate
+from tcsim.analysis.effective import smoothed_rate
+from tcsim.analysis.replay import error_metrics, metric_windows, parse_initial
 from tcsim.errors import InputError
-from tcsim.replay import error_metrics, metric_windows, parse_initial
+from tcsim.simulation import transient as runs
 
 BUNDLED_TOML = Path(__file__).resolve().parents[1] / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
 STATOR_RELEASE_S = 2.37  # Hrovat & Tobler, isolated take-off of transient.isolated_takeoff()
@@ -196,8 +199,6 @@ def test_parquet_and_mdf4(cli, tmp_path, synthetic, fmt):
     if fmt == "parquet":
         synthetic.to_parquet(path)
     else:
-        from asammdf import MDF, Signal
-
         units = {"pump_torque_nm": "Nm", "turbine_torque_nm": "Nm"}
         with MDF(version="4.10") as mdf:
             mdf.append(
@@ -399,14 +400,14 @@ def test_bad_arguments_and_converters(cli, tmp_path, meas_csv, case):
 
 
 def test_solver_failure_is_exit_1_with_the_message(monkeypatch, capsys, tmp_path, meas_csv):
-    from tcsim import cli
-
     def fail(*args, **kwargs):
         raise transient.SolverError("hrovat-tobler: step size too small at t = 1.234 s, state [1, 2, 3, 4]")
 
-    monkeypatch.setattr(transient, "simulate", fail)
+    monkeypatch.setattr(runs, "simulate", fail)
     out = tmp_path / "out"
-    assert cli.main(["replay", "li-sunden-2016", str(meas_csv), "--model", "hrovat-tobler", "--out", str(out)]) == 1
+    assert (
+        tcsim.cli.main(["replay", "li-sunden-2016", str(meas_csv), "--model", "hrovat-tobler", "--out", str(out)]) == 1
+    )
     err = capsys.readouterr().err
     assert "SolverError" in err and "t = 1.234 s" in err and "Traceback" not in err
     assert not out.exists() and not [p for p in tmp_path.iterdir() if p.name.startswith(".out.")]

@@ -13,18 +13,11 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from tcsim.analysis.effective import measured_effective_torques, smoothed_rate
+from tcsim.analysis.shape_fit import fit_shape_effects, shape_effect_sweep, sweep_minima
+from tcsim.cli.fit_shapes import shape_fit_command
 from tcsim.errors import InputError
-from tcsim.shape_fit import (
-    THESIS_PAIR_M2,
-    THESIS_VALUES_M2,
-    fit_shape_effects,
-    mass_matrix_bound,
-    measured_effective_torques,
-    shape_effect_sweep,
-    shape_fit_command,
-    smoothed_rate,
-    sweep_minima,
-)
+from tcsim.models.shape_effects import THESIS_PAIR_M2, THESIS_VALUES_M2, mass_matrix_bound
 from tcsim.transient import PumpTorqueTurbineSpeed, dynamic_model, isolated_takeoff, simulate
 
 CONVERTER = "li-sunden-2016"

@@ -13,12 +13,12 @@ import numpy as np
 import pandas as pd
 import pytest
 
-import tcsim.study as study
+import tcsim.analysis.study as study
+from tcsim.analysis.study import COLUMNS, ParameterRange, default_definition, run_study
 from tcsim.cli import main
-from tcsim.converter import load_converter
 from tcsim.errors import InputError
-from tcsim.steady import characterise_hrovat_tobler
-from tcsim.study import COLUMNS, ParameterRange, default_definition, run_study
+from tcsim.models.converter import load_converter
+from tcsim.models.steady import characterise_hrovat_tobler
 
 REFERENCE_TOML = Path(__file__).resolve().parent / "data" / "converters" / "li_sunden_2016_appendix_d.toml"
 N_SR = 19  # SR 0 to 0.9 in steps of 0.05

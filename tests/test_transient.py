@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import threading
 import time
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -127,8 +128,6 @@ def test_initial_state_override():
 
 def test_quasi_dynamic_needs_its_section():
     conv = tcsim.load_converter("li-sunden-2016")
-    from dataclasses import replace
-
     with pytest.raises(InputError, match=r"\[quasi_dynamic\]"):
         tr.dynamic_model(replace(conv, quasi_dynamic=None), "quasi-dynamic")
     assert tr.default_flow_time_constant_s(conv) == pytest.approx(2.93e-3, rel=1e-2)

@@ -13,7 +13,7 @@ import pytest
 import tomli_w
 
 from tcsim.errors import InputError
-from tcsim.vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, bundled_vehicle_names, load_vehicle, parse_vehicle
+from tcsim.models.vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, bundled_vehicle_names, load_vehicle, parse_vehicle
 
 REPO = Path(__file__).resolve().parents[1]
 BUNDLED = REPO / "python" / "tcsim" / "data" / "vehicles" / "midsize-awd-8at.toml"

@@ -15,8 +15,8 @@ from __future__ import annotations
 import csv
 from pathlib import Path
 
-from .converter import CAPACITY_KEYS, Characteristic
-from .errors import InputError
+from ..errors import InputError
+from .characteristic import CAPACITY_KEYS, Characteristic
 
 
 def _rows(path: Path) -> list[tuple[int, list[str]]]:
@@ -44,7 +44,7 @@ def _number(path: Path, lineno: int, column: str, text: str) -> float:
 
 
 def _columns(path: Path, rows, names: list[str]):
-    cols = {n: [] for n in names}
+    cols: dict[str, list[float]] = {n: [] for n in names}
     lines = []
     for lineno, cells in rows:
         if len(cells) != len(names):

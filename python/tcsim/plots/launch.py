@@ -16,20 +16,15 @@ S, the table model dashed ("SS model").
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import Any
 
-import matplotlib
+import pandas as pd
+from matplotlib.ticker import MaxNLocator
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import pandas as pd  # noqa: E402
-from matplotlib.ticker import MaxNLocator  # noqa: E402
-
-if TYPE_CHECKING:  # pragma: no cover
-    from .launch import Launch
-
-from .plots import finish_figure  # noqa: E402
+from ..units import KM_H
+from .common import finish_figure, plt
 
 COLOURS = {"table": "C0", "hrovat-tobler": "C1", "quasi-dynamic": "C2"}
 LABELS = {"table": "SS (table) model", "hrovat-tobler": "H&T model", "quasi-dynamic": "quasi-dynamic model"}
@@ -57,12 +52,14 @@ def _release_line(ax, release: float) -> None:
     ax.axvline(release, color="0.6", ls=":", lw=1)
 
 
-def plot_ratios(result: Launch, out_dir: Path) -> list[Path]:
+Frames = Mapping[str, pd.DataFrame]
+
+
+def plot_ratios(frames: Frames, release: float, out_dir: Path) -> list[Path]:
     """Figure 3.5 (TR and SR against time) and the effective TR, around the brake release."""
-    release = result.scenario.brake_release_time_s
     a, b = release - RATIO_WINDOW_S[0], release + RATIO_WINDOW_S[1]
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-    for name, f in result.frames.items():
+    for name, f in frames.items():
         w = _window(f, a, b)
         style = _style(name)
         # the effective TR (eqs 3.1–3.4): the table's TR(SR) for the table model; the plain ratio
@@ -80,7 +77,7 @@ def plot_ratios(result: Launch, out_dir: Path) -> list[Path]:
     )
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-    for name, f in result.frames.items():
+    for name, f in frames.items():
         w = _window(f, a, b)
         ax.plot(w["time_s"], w["effective_torque_ratio"], lw=1.3, **_style(name))
     _release_line(ax, release)
@@ -94,11 +91,8 @@ def plot_ratios(result: Launch, out_dir: Path) -> list[Path]:
     return [p1, p2]
 
 
-def _mark_events(ax, result: Launch, start: float) -> None:
-    if not result.frames:
-        return
-    name, f = next(iter(result.frames.items()))
-    for e in f.attrs.get("events", []):
+def _mark_events(ax, events: Sequence[Sequence[Any]], start: float) -> None:
+    for e in events:
         t, kind = float(e[0]), str(e[1])
         if t < start or kind in _CONVERTER_EVENTS:
             continue
@@ -116,12 +110,12 @@ def _mark_events(ax, result: Launch, start: float) -> None:
         )
 
 
-def plot_acceleration(result: Launch, out_dir: Path) -> list[Path]:
-    """Figures 3.6 (around the release) and 3.20 (the whole run) of the vehicle acceleration."""
-    release = result.scenario.brake_release_time_s
+def plot_acceleration(frames: Frames, events: Sequence[Sequence[Any]], release: float, out_dir: Path) -> list[Path]:
+    """Figures 3.6 (around the release) and 3.20 (the whole run) of the vehicle acceleration;
+    ``events`` (``(time_s, kind, ...)``, those of the first model) are marked on the second."""
     paths = []
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-    for name, f in result.frames.items():
+    for name, f in frames.items():
         w = _window(f, release - ACCEL_WINDOW_S[0], release + ACCEL_WINDOW_S[1])
         ax.plot(w["time_s"], w["vehicle_accel_m_s2"], lw=1.3, **_style(name))
     _release_line(ax, release)
@@ -137,10 +131,10 @@ def plot_acceleration(result: Launch, out_dir: Path) -> list[Path]:
 
     fig, ax = plt.subplots(figsize=(7.2, 4.2), layout="constrained")
     start = release - ACCEL_WINDOW_S[0]
-    for name, f in result.frames.items():
+    for name, f in frames.items():
         w = f[f["time_s"] >= start]
         ax.plot(w["time_s"], w["vehicle_accel_m_s2"], lw=1.1, **_style(name))
-    _mark_events(ax, result, start)
+    _mark_events(ax, events, start)
     ax.set_ylabel("Acceleration [m/s²]")
     paths.append(
         _save(
@@ -153,22 +147,22 @@ def plot_acceleration(result: Launch, out_dir: Path) -> list[Path]:
     return paths
 
 
-def plot_speeds(result: Launch, out_dir: Path) -> list[Path]:
+def plot_speeds(frames: Frames, scenario_name: str, out_dir: Path) -> list[Path]:
     """Vehicle speed with the gear, and the pump and turbine speeds."""
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
     gear_ax = ax.twinx()
-    for name, f in result.frames.items():
+    for name, f in frames.items():
         style = _style(name)
-        ax.plot(f["time_s"], f["vehicle_speed_m_s"] * 3.6, lw=1.3, **style)
+        ax.plot(f["time_s"], f["vehicle_speed_m_s"] / KM_H, lw=1.3, **style)
         if "gear" in f:
             gear_ax.step(f["time_s"], f["gear"], where="post", lw=0.8, ls="--", color=style["color"], alpha=0.7)
     ax.set_ylabel("Vehicle speed [km/h]")
     gear_ax.set_ylabel("Gear (dashed)")
     gear_ax.yaxis.set_major_locator(MaxNLocator(integer=True))
-    p1 = _save(fig, ax, Path(out_dir) / "vehicle_speed.png", f"Vehicle speed and gear, scenario {result.scenario.name}")
+    p1 = _save(fig, ax, Path(out_dir) / "vehicle_speed.png", f"Vehicle speed and gear, scenario {scenario_name}")
 
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-    for name, f in result.frames.items():
+    for name, f in frames.items():
         style = _style(name)
         ax.plot(f["time_s"], f["pump_speed_rad_s"], lw=1.3, color=style["color"], label=f"{style['label']}: pump")
         ax.plot(
@@ -184,9 +178,15 @@ def plot_speeds(result: Launch, out_dir: Path) -> list[Path]:
     return [p1, p2]
 
 
-def plot_launch(result: Launch, out_dir: Path) -> list[Path]:
-    """All figures of a launch."""
-    return [*plot_ratios(result, out_dir), *plot_acceleration(result, out_dir), *plot_speeds(result, out_dir)]
+def plot_launch(
+    frames: Frames, first_events: Sequence[Sequence[Any]], release: float, scenario_name: str, out_dir: Path
+) -> list[Path]:
+    """All figures of a launch: ``frames`` by model, the first model's events, the brake release time."""
+    return [
+        *plot_ratios(frames, release, out_dir),
+        *plot_acceleration(frames, first_events, release, out_dir),
+        *plot_speeds(frames, scenario_name, out_dir),
+    ]
 
 
 _SWEEP_FIGURES = (
@@ -205,16 +205,15 @@ _SWEEP_FIGURES = (
 )
 
 
-def plot_sweep(result: Launch, out_dir: Path) -> list[Path]:
-    """Per dynamic model of the sweep: effective TR and vehicle acceleration against time, one line
-    per shape effect, with the table model dashed (figures 4.3–4.6)."""
-    if result.sweep is None or result.sweep.empty:
+def plot_sweep(sweep: pd.DataFrame | None, steady: pd.DataFrame | None, release: float, out_dir: Path) -> list[Path]:
+    """Per dynamic model of the sweep frame: effective TR and vehicle acceleration against time, one
+    line per shape effect, with the table model's run ``steady`` dashed (figures 4.3–4.6)."""
+    if sweep is None or sweep.empty:
         return []
-    release = result.scenario.brake_release_time_s
     a, b = release - SWEEP_WINDOW_S[0], release + SWEEP_WINDOW_S[1]
-    steady = result.frames.get("table")
     paths = []
-    for model, g in result.sweep.groupby("model", sort=False):
+    for key, g in sweep.groupby("model", sort=False):
+        model = str(key)
         for column, ylabel, what, figure in _SWEEP_FIGURES:
             fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
             for label, run in g.groupby("label", sort=False):

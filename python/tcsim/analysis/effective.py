@@ -14,9 +14,9 @@ from typing import Any
 
 import numpy as np
 
-from . import _core
-from .measurement import Measurement
-from .transient import DERIVATIVE_WINDOW_S
+from .. import _core
+from ..models.drives import DERIVATIVE_WINDOW_S
+from ..models.measurement import Measurement
 
 
 def smoothed_rate(time_s, values, window_s: float = DERIVATIVE_WINDOW_S) -> np.ndarray:

@@ -4,15 +4,12 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import matplotlib
+import numpy as np
+import pandas as pd
 
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import pandas as pd  # noqa: E402
-
-from . import _core  # noqa: E402
-from .converter import Characteristic  # noqa: E402
+from .. import _core
+from ..models.characteristic import Characteristic
+from .common import plt
 
 QUANTITIES = {
     "torque_ratio": ("Torque ratio [-]", "torque_ratio.png"),
@@ -20,18 +17,6 @@ QUANTITIES = {
     "k_factor_rpm_per_sqrt_nm": ("K-factor [rpm/√(N·m)]", "k_factor.png"),
     "efficiency": ("Efficiency [-]", "efficiency.png"),
 }
-
-
-def finish_figure(fig, ax, path: Path, title: str, xlabel: str = "Time [s]") -> Path:
-    """Label, grid, legend (when there are labelled lines), save at 120 dpi and close."""
-    ax.set_xlabel(xlabel)
-    ax.set_title(title, fontsize="medium")
-    ax.grid(True, alpha=0.3)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(fontsize="small")
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
 
 
 def table_columns(table: Characteristic) -> pd.DataFrame:

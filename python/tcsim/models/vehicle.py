@@ -50,10 +50,11 @@ from typing import Annotated, Any
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic_core import ErrorDetails
 
+from ..errors import InputError
 from .converter import Converter, load_converter
 from .converter import bundled_names as bundled_converter_names
-from .errors import InputError
 
 #: The bundled vehicle used when none is named.
 DEFAULT_VEHICLE = "midsize-awd-8at"
@@ -238,7 +239,7 @@ def _name(section: str, key: str, index: int | None = None) -> str:
     return f"[{section}].{key}" + (f"[{index}]" if index is not None else "")
 
 
-def _expected(e: dict[str, Any]) -> str:
+def _expected(e: ErrorDetails) -> str:
     ctx = e.get("ctx") or {}
     kind = e["type"]
     if kind == "greater_than":
@@ -282,7 +283,9 @@ def _pydantic_to_input_error(err: ValidationError, path: str) -> InputError:
     expected = _expected(e)
     if e["type"] == "extra_forbidden":
         if len(loc) > 1 and loc[0] in SECTIONS:
-            where, known = f"[{loc[0]}]", VehicleFile.model_fields[loc[0]].annotation.model_fields
+            section_type = VehicleFile.model_fields[loc[0]].annotation
+            assert section_type is not None  # every section field is annotated with its model
+            where, known = f"[{loc[0]}]", section_type.model_fields
         else:
             where, known = "the top level", VehicleFile.model_fields
         expected = f"a known key of {where}: {', '.join(known)} (this key is unknown)"
