@@ -643,7 +643,7 @@ one binary serves every converter, model and causality.
 ## Rebuilding the binary for another platform
 
 The library has no dependency but Rust crates (diffsol, nalgebra, serde_json); no Python, no
-FMI SDK. With a Rust toolchain (https://rustup.rs, Rust 1.80 or newer) on the target platform:
+FMI SDK. With a Rust toolchain (https://rustup.rs, Rust 1.89 or newer) on the target platform:
 
     cd sources            # this directory, extracted from the .fmu (a zip archive)
     cargo build --release -p tcsim-fmu

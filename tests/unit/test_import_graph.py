@@ -23,7 +23,7 @@ from pathlib import Path
 
 import pytest
 
-PACKAGE = Path(__file__).resolve().parents[1] / "python" / "tcsim"
+PACKAGE = Path(__file__).resolve().parents[2] / "python" / "tcsim"
 
 #: (rank, group) of each top-level part of the package; anything not listed is a facade (rank 6).
 LAYERS: dict[str, tuple[int, str]] = {

@@ -12,19 +12,13 @@ import pytest
 
 from tcsim import transient
 
-REPO = Path(__file__).resolve().parents[1]
+pytestmark = pytest.mark.subprocess
 
-
-@pytest.fixture(scope="module")
-def library() -> Path:
-    if shutil.which("cargo") is None or not (REPO / "Cargo.toml").is_file():
-        pytest.skip("needs the source tree and cargo to build the FMU library")
-    subprocess.run(["cargo", "build", "--release", "-q", "-p", "tcsim-fmu"], cwd=REPO, check=True, timeout=900)
-    return REPO / "target" / "release" / "libtcsim_fmu.so"
+REPO = Path(__file__).resolve().parents[2]
 
 
 @pytest.mark.parametrize("model", ["table", "quasi-dynamic", "hrovat-tobler"])
-def test_plain_c_program_runs_a_takeoff(tmp_path, library, model):
+def test_plain_c_program_runs_a_takeoff(tmp_path, fmu_library, model):
     if shutil.which("gcc") is None:
         pytest.skip("needs gcc")
     resources = tmp_path / "resources"
@@ -33,12 +27,22 @@ def test_plain_c_program_runs_a_takeoff(tmp_path, library, model):
     (resources / "model.json").write_text(json.dumps({"causality": "pump-torque", "model": spec, "parameters": []}))
     exe = tmp_path / "takeoff"
     subprocess.run(
-        ["gcc", "-O2", "-Wall", "-Werror", "-o", exe, REPO / "tests" / "c" / "takeoff.c", "-ldl", "-lm"],
+        [
+            "gcc",
+            "-O2",
+            "-Wall",
+            "-Werror",
+            "-o",
+            exe,
+            REPO / "tests" / "integration" / "c" / "takeoff.c",
+            "-ldl",
+            "-lm",
+        ],
         check=True,
         capture_output=True,
         text=True,
     )
-    r = subprocess.run([exe, library, resources.as_uri()], capture_output=True, text=True, timeout=60)
+    r = subprocess.run([exe, fmu_library, resources.as_uri()], capture_output=True, text=True, timeout=60)
     assert r.returncode == 0, r.stderr
     rows = [list(map(float, line.split())) for line in r.stdout.splitlines()]
     assert len(rows) == 50 and rows[-1][0] == pytest.approx(5.0)
@@ -56,7 +60,7 @@ def test_plain_c_program_runs_a_takeoff(tmp_path, library, model):
     assert rows[-1][2] == pytest.approx(ref["turbine_torque_nm"][-1], rel=1e-3)
 
 
-def test_a_failure_is_an_fmi_error_with_a_message(tmp_path, library):
+def test_a_failure_is_an_fmi_error_with_a_message(tmp_path, fmu_library):
     """An inadmissible shape effect: fmi2ExitInitializationMode returns fmi2Error and the logger
     gets the bound; nothing crashes."""
     if shutil.which("gcc") is None:
@@ -66,7 +70,9 @@ def test_a_failure_is_an_fmi_error_with_a_message(tmp_path, library):
     spec = transient.dynamic_model("li-sunden-2016", "hrovat-tobler").with_shape_effects(0.3, 0.0).spec
     (resources / "model.json").write_text(json.dumps({"model": spec, "parameters": []}))
     exe = tmp_path / "takeoff"
-    subprocess.run(["gcc", "-O2", "-o", exe, REPO / "tests" / "c" / "takeoff.c", "-ldl", "-lm"], check=True)
-    r = subprocess.run([exe, library, resources.as_uri()], capture_output=True, text=True, timeout=60)
+    subprocess.run(
+        ["gcc", "-O2", "-o", exe, REPO / "tests" / "integration" / "c" / "takeoff.c", "-ldl", "-lm"], check=True
+    )
+    r = subprocess.run([exe, fmu_library, resources.as_uri()], capture_output=True, text=True, timeout=60)
     assert r.returncode == 1
     assert "geometry.pump_shape_effect_m2" in r.stderr and "|S| <" in r.stderr

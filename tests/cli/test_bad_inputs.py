@@ -10,7 +10,7 @@ import pytest
 from conftest import C1_CF, C1_SR, C1_TR
 
 BUNDLED = (
-    Path(__file__).resolve().parents[1] / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
+    Path(__file__).resolve().parents[2] / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
 ).read_text()
 
 

@@ -5,8 +5,6 @@ bundled data."""
 from __future__ import annotations
 
 import importlib
-import os
-import shutil
 from pathlib import Path
 
 import pytest
@@ -16,7 +14,7 @@ from tcsim import transient as tr
 from tcsim.cli import main
 from tcsim.io import fmu as fmu_io
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 MEASUREMENT = REPO / "tests" / "golden" / "data" / "takeoff_measurement.csv"
 
 #: Dotted names of README.md and docs/*.md (modules and the names in them).
@@ -140,30 +138,12 @@ def test_cli_fit_shapes(tmp_path):
     assert (tmp_path / "shape_fit.json").is_file() and (tmp_path / "shape_sweep.csv").is_file()
 
 
-@pytest.mark.skipif(not hasattr(tcsim._core, "launch_runs"), reason="the core has no vehicle plant")
 def test_cli_launch(tmp_path):
     run("launch", "--model", "table", "--out", tmp_path)
     assert (tmp_path / "summary.csv").is_file() and (tmp_path / "table.csv").is_file()
 
 
-def _fmu_library() -> Path | None:
-    env = os.environ.get(fmu_io.LIBRARY_ENV)
-    if env:
-        return Path(env.split(os.pathsep)[0])
-    for profile in ("release", "debug"):
-        lib = REPO / "target" / profile / fmu_io.LIBRARY_FILE
-        if lib.is_file():
-            return lib
-    return None
-
-
-def test_cli_export_fmu(tmp_path, monkeypatch):
-    lib = _fmu_library()
-    if lib is None:
-        pytest.skip(
-            "the FMU library is not built: run 'cargo build --release -p tcsim-fmu' (or set TCSIM_FMU_LIBRARY)"
-            + ("" if shutil.which("cargo") else "; cargo is not on PATH")
-        )
-    monkeypatch.setenv(fmu_io.LIBRARY_ENV, str(lib))
+def test_cli_export_fmu(tmp_path, monkeypatch, fmu_library):
+    monkeypatch.setenv(fmu_io.LIBRARY_ENV, str(fmu_library))
     run("export-fmu", "li-sunden-2016", "--model", "table", "--out", tmp_path / "table.fmu")
     assert (tmp_path / "table.fmu").is_file()

@@ -34,10 +34,6 @@ from tcsim.simulation.launch import LAUNCH_COLUMNS, SWEEP_SPAN_S, run_launch, se
 from tcsim.simulation.scenarios import Scenario, brake_release_time, flip_flop, part_pedal
 from tcsim.simulation.transient import SolverError
 
-HAS_CORE = hasattr(tcsim._core, "launch_runs")
-needs_core = pytest.mark.skipif(not HAS_CORE, reason="tcsim._core.launch_runs (the vehicle plant) is not built yet")
-
-
 # ---------------------------------------------------------------------------------------------
 # scenarios
 
@@ -518,7 +514,6 @@ def flip_flop_runs():
     return {name: run.frame for name, run in run_launch(veh, flip_flop(), select_models(veh, [])).items()}
 
 
-@needs_core
 def test_vehicle_stands_still_while_braked(flip_flop_runs):
     for name, f in flip_flop_runs.items():
         braked = f[f.time_s < 5.0]
@@ -526,7 +521,6 @@ def test_vehicle_stands_still_while_braked(flip_flop_runs):
         assert (f.gear[f.time_s < 5.0] == 1).all()
 
 
-@needs_core
 def test_stall_phase_table_and_quasi_dynamic_agree_then_dynamic_models_start_lower(flip_flop_runs):
     table, qd = flip_flop_runs["table"], flip_flop_runs["quasi-dynamic"]
     t = np.linspace(1.0, 4.9, 40)
@@ -546,7 +540,6 @@ def test_sweep_scenario_ends_after_the_release():
     assert sweep_scenario(flip_flop(hold_s=1.0, end_time_s=2.0)).end_time_s == 2.0
 
 
-@needs_core
 def test_larger_shape_effects_lower_the_initial_acceleration(tmp_path):
     """Thesis §4.1, figs 4.3–4.6: a larger S deepens the effective-TR dip and lowers the acceleration."""
     result = launch_files(None, "flip-flop", ["table", "quasi-dynamic", "hrovat-tobler"], sweep=True)
@@ -562,7 +555,6 @@ def test_larger_shape_effects_lower_the_initial_acceleration(tmp_path):
     assert "shape_sweep_quasi-dynamic_vehicle_accel.png" in names
 
 
-@needs_core
 def test_cli_launch_end_to_end(cli, tmp_path):
     out = tmp_path / "out"
     r = cli("launch", "--out", out)
@@ -587,7 +579,6 @@ def test_cli_launch_end_to_end(cli, tmp_path):
     assert {"upshift-start", "shift-end", "lockup-engage"} <= set(events.kind)
 
 
-@needs_core
 def test_cli_launch_scenario_file(cli, tmp_path):
     path = tmp_path / "creep.csv"
     t = np.round(np.arange(0, 6.0001, 0.05), 6)
@@ -602,7 +593,6 @@ def test_cli_launch_scenario_file(cli, tmp_path):
     assert f.vehicle_speed_m_s[f.time_s < 1.0].abs().max() < 1e-3
 
 
-@needs_core
 def test_models_rejoin_in_torque_ratio_and_energy_balances(flip_flop_runs):
     """Thesis §3.2.2: after the dip the three models come within 5 % in TR within about 1 s; and the
     engine's work is the kinetic and spring energy plus every modelled loss (1e-3)."""
@@ -618,7 +608,6 @@ def test_models_rejoin_in_torque_ratio_and_energy_balances(flip_flop_runs):
         assert abs(engine - stored - losses) < 1e-3 * engine, name
 
 
-@needs_core
 def test_part_pedal_launch_is_gentler(flip_flop_runs):
     veh = load_vehicle()
     part = run_launch(veh, part_pedal(), select_models(veh, ["table"]))["table"].frame
@@ -631,7 +620,6 @@ def test_part_pedal_launch_is_gentler(flip_flop_runs):
     assert 0.0 < window(part) < window(full)
 
 
-@needs_core
 def test_logged_engine_torque_is_replayed(tmp_path, cli, flip_flop_runs):
     """Thesis §3.5.2.2: the engine model replaced by a logged engine torque. Replaying the engine
     torque of the table model's own run reproduces its launch."""

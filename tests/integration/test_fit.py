@@ -22,7 +22,7 @@ from tcsim.errors import InputError, TcsimWarning
 from tcsim.models.characteristic import Characteristic
 from tcsim.models.converter import load_converter
 
-SHARED_TABLES = Path(__file__).resolve().parent / "data" / "converters"
+SHARED_TABLES = Path(__file__).resolve().parents[1] / "data" / "converters"
 
 
 @pytest.fixture(scope="module")

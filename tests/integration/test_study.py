@@ -20,7 +20,7 @@ from tcsim.errors import InputError
 from tcsim.models.converter import load_converter
 from tcsim.models.steady import characterise_hrovat_tobler
 
-REFERENCE_TOML = Path(__file__).resolve().parent / "data" / "converters" / "li_sunden_2016_appendix_d.toml"
+REFERENCE_TOML = Path(__file__).resolve().parents[1] / "data" / "converters" / "li_sunden_2016_appendix_d.toml"
 N_SR = 19  # SR 0 to 0.9 in steps of 0.05
 
 

@@ -1,8 +1,7 @@
 """FMI 2.0 Co-Simulation FMUs of the converter models (tcsim.fmu, crates/tcsim-fmu), run with FMPy.
 
-The FMU's library is built once per session with ``cargo build --release -p tcsim-fmu`` (or taken
-from ``$TCSIM_FMU_LIBRARY``). Without cargo and without a built library the tests are skipped,
-except on CI (``CI`` set), where they fail.
+The FMU's library is the one the build made (``cargo build --release -p tcsim-fmu``, in the README's
+test command) or ``$TCSIM_FMU_LIBRARY``: the ``fmu_library`` fixture of ``conftest.py``.
 
 The reference of the co-simulation is the transient engine driven by the same inputs, the run
 ``tcsim replay`` makes: ``transient.simulate(model, PumpTorqueTurbineSpeed(t, tp, wt))`` with the
@@ -15,7 +14,6 @@ import json
 import os
 import resource
 import shutil
-import subprocess
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree
@@ -31,7 +29,7 @@ from tcsim.errors import InputError  # noqa: E402
 from tcsim.io import fmu as tfmu  # noqa: E402
 from tcsim.transient import PumpTorqueTurbineSpeed, Speeds, dynamic_model, isolated_takeoff, simulate  # noqa: E402
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 CONVERTER = "li-sunden-2016"
 MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
 STOP_S = 2.0
@@ -48,27 +46,6 @@ EXPECTED_SIGNALS = {
 
 # ---------------------------------------------------------------------------------------------
 # fixtures
-
-
-@pytest.fixture(scope="session")
-def fmu_library() -> Path:
-    """The FMU library: $TCSIM_FMU_LIBRARY, else built (or brought up to date) with cargo."""
-    env = os.environ.get(tfmu.LIBRARY_ENV)
-    if env:
-        return Path(env.split(os.pathsep)[0])
-    root = tfmu.source_root() or (REPO if (REPO / "crates" / "tcsim-fmu" / "Cargo.toml").is_file() else None)
-    if root is not None and shutil.which("cargo"):
-        p = subprocess.run(
-            ["cargo", "build", "--release", "-p", "tcsim-fmu"], cwd=root, capture_output=True, text=True, timeout=1800
-        )
-        assert p.returncode == 0, p.stderr[-3000:]
-        return root / "target" / "release" / tfmu.LIBRARY_FILE
-    for profile in ("release", "debug"):
-        if root is not None and (lib := root / "target" / profile / tfmu.LIBRARY_FILE).is_file():
-            return lib
-    if os.environ.get("CI"):
-        pytest.fail("the FMU library cannot be found or built (no cargo) on CI")
-    pytest.skip("the FMU library cannot be found or built (no cargo, no target/*/libtcsim_fmu.so)")
 
 
 @pytest.fixture(scope="session")

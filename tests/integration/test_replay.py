@@ -18,7 +18,7 @@ from tcsim.analysis.replay import error_metrics, metric_windows, parse_initial
 from tcsim.errors import InputError
 from tcsim.simulation import transient as runs
 
-BUNDLED_TOML = Path(__file__).resolve().parents[1] / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
+BUNDLED_TOML = Path(__file__).resolve().parents[2] / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
 STATOR_RELEASE_S = 2.37  # Hrovat & Tobler, isolated take-off of transient.isolated_takeoff()
 MODEL_COLUMNS = [
     "time_s",

@@ -15,7 +15,7 @@ import tomli_w
 from tcsim.errors import InputError
 from tcsim.models.vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, bundled_vehicle_names, load_vehicle, parse_vehicle
 
-REPO = Path(__file__).resolve().parents[1]
+REPO = Path(__file__).resolve().parents[2]
 BUNDLED = REPO / "python" / "tcsim" / "data" / "vehicles" / "midsize-awd-8at.toml"
 CONVERTER_TOML = REPO / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
 
