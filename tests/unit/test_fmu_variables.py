@@ -12,10 +12,10 @@ from xml.etree import ElementTree
 import pytest
 
 from tcsim import _core
-from tcsim import fmu as tfmu
-from tcsim.transient import dynamic_model
+from tcsim.io import fmu as tfmu
+from tcsim.models.dynamic import dynamic_model
 
-REFERENCE = Path(__file__).parent / "data" / "fmu"
+REFERENCE = Path(__file__).resolve().parents[1] / "data" / "fmu"
 CONVERTER = "li-sunden-2016"
 MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
 CAUSALITIES = ("pump-torque", "speeds")
