@@ -5,7 +5,7 @@
 //! run time.
 //!
 //! The model and its parameters come from `resources/model.json`, written by `tcsim export-fmu`
-//! (`python/tcsim/fmu.py`). The variables (value references, names, start values, states,
+//! (`python/tcsim/io/fmu.py`). The variables (value references, names, start values, states,
 //! parameters, event indicators) are in one table, [`variables`], from which `tcsim export-fmu`
 //! also writes `modelDescription.xml`. Every entry point catches panics: none crosses the C boundary; a
 //! failure returns `fmi2Error` with its message through the logger callback.

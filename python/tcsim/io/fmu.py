@@ -498,11 +498,8 @@ def _check_model(model: DynamicModel, causality: str) -> None:
     effect beyond the mass-matrix bound, ...) is an input error now, not an fmi2Error later."""
     t = [0.0, 1e-3]
     start = {v["name"]: [v["start"]] * 2 for v in fmu_variables(model, causality) if v["causality"] == "input"}
-    drive: Drive
-    if causality == "speeds":
-        drive = Speeds(t, start["pump_speed_rad_s"], start["turbine_speed_rad_s"])
-    else:
-        drive = PumpTorqueTurbineSpeed(t, start["pump_torque_nm"], start["turbine_speed_rad_s"])
+    first, second = (start[name] for name in CAUSALITIES[causality])  # the table's start values
+    drive: Drive = (Speeds if causality == "speeds" else PumpTorqueTurbineSpeed)(t, first, second)
     try:
         simulate(model, drive)
     except SolverError:
