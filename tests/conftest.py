@@ -92,7 +92,7 @@ def c1_csv(tmp_path) -> Path:
 
 @pytest.fixture(scope="session")
 def fmu_library() -> Path:
-    """The FMU library that the build made (``cargo build --release -p tcsim-fmu``, part of the
+    """The FMU library that the build made (``cargo build --release --workspace``, part of the
     README's test command) or ``$TCSIM_FMU_LIBRARY``; no test builds it. A missing library, or one
     older than the Rust sources, fails the test with what to run."""
     with warnings.catch_warnings():

@@ -1,6 +1,6 @@
 """FMI 2.0 Co-Simulation FMUs of the converter models (tcsim.fmu, crates/tcsim-fmu), run with FMPy.
 
-The FMU's library is the one the build made (``cargo build --release -p tcsim-fmu``, in the README's
+The FMU's library is the one the build made (``cargo build --release --workspace``, in the README's
 test command) or ``$TCSIM_FMU_LIBRARY``: the ``fmu_library`` fixture of ``conftest.py``.
 
 The reference of the co-simulation is the transient engine driven by the same inputs, the run
