@@ -161,7 +161,7 @@ BAD = {
         _item("engine", "full_load_torque_nm", 2, math.inf),
         ["[engine].full_load_torque_nm[2]", "finite"],
     ),
-    "text for a number": (_set("body", "mass_kg", "1930"), ["[body].mass_kg", "'1930'", "a number, not a string"]),
+    "text for a number": (_set("body", "mass_kg", "1930"), ["[body].mass_kg", '"1930"', "a number, not a string"]),
     "float for min_gear": (_set("lockup", "min_gear", 3.0), ["[lockup].min_gear", "an integer, not a float (3.0)"]),
     "full-load speed not increasing": (_repeat_speed, ["[engine].full_load_speed_rad_s[3]", "strictly increasing"]),
     "full-load arrays mismatched": (

@@ -49,11 +49,13 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import numpy as np
+import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
+from . import _core
 from .converter import Converter, load_converter
 from .converter import bundled_names as bundled_converter_names
-from .errors import InputError
+from .errors import InputError, from_core
 
 #: The bundled vehicle used when none is named.
 DEFAULT_VEHICLE = "midsize-awd-8at"
@@ -203,6 +205,8 @@ class Vehicle:
     description: str | None = None
     converter_spec: str = ""
     sources: dict[str, str] = field(default_factory=dict)
+    #: The vehicle as the core read and validated it (what ``_core.launch_runs`` takes).
+    core: Any = None
 
     @property
     def sections(self) -> dict[str, _Section]:
@@ -398,8 +402,19 @@ def _load_named_converter(spec: str, path: str) -> Converter:
     return load_converter(candidate)
 
 
+def _core_vehicle(text: str, path: str) -> Any:
+    try:
+        return _core.read_vehicle(text, path)
+    except _core.CoreInputError as e:
+        raise from_core(e, path) from None
+
+
 def parse_vehicle(data: dict[str, Any], path: str) -> Vehicle:
     """Validate a parsed TOML document (``path`` names it in messages and anchors the converter)."""
+    return _build(data, path, _core_vehicle(tomli_w.dumps(data), path))
+
+
+def _build(data: dict[str, Any], path: str, core: Any) -> Vehicle:
     try:
         doc = VehicleFile.model_validate(data)
     except ValidationError as err:
@@ -424,6 +439,7 @@ def parse_vehicle(data: dict[str, Any], path: str) -> Vehicle:
         doc.description,
         doc.converter,
         dict(doc.sources),
+        core,
     )
 
 
@@ -432,11 +448,8 @@ def read_vehicle_toml(path: Path) -> Vehicle:
         text = Path(path).read_text(encoding="utf-8")
     except (OSError, UnicodeDecodeError) as e:
         raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as e:
-        raise InputError(str(path), "(syntax)", str(e), "valid TOML") from None
-    return parse_vehicle(data, str(path))
+    core = _core_vehicle(text, str(path))
+    return _build(tomllib.loads(text), str(path), core)
 
 
 def _bundled_dir():
