@@ -16,8 +16,8 @@ Not part of the test suite. Run: ``python3 bench/bench_launch.py`` (tcsim instal
   the core's, finite-difference Jacobian), same samples. Median of ``SCIPY_REPEATS``.
 * **Agreement** is checked before any ratio is printed, in two scenarios: the flip-flop launch above
   and ``coast_and_brake()`` (the core's coasting test: full pedal 5.05–8.0 s, pedal off, coasting,
-  brake ramped to 0.6 over 20–20.5 s and held to the end at 40 s, no stop speed; upshifts on the pedal lift, lock-up, then
-  downshifts that open the lock-up clutch, and the brake re-holding the stopped axles). Checked: the
+  brake ramped to 0.6 over 20–20.5 s and held to the end at 40 s, no stop speed; upshifts on the pedal lift,
+  lock-up, then downshifts that open the lock-up clutch, and the brake re-holding the stopped axles). Checked: the
   same converter table and inertias on both sides; the same event kinds, in the same order, with the
   same gears; event times within 1e-3 s (so the time to 100 km/h too); the speed traces on the
   common 0.01 s samples within 0.01 m/s (the maximum difference is printed).
@@ -37,7 +37,9 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(__file__))
 import scipy_vehicle as ref  # noqa: E402
 import tcsim._core as core  # noqa: E402
-from tcsim.transient import dynamic_model  # noqa: E402
+from tcsim.models.dynamic import dynamic_model  # noqa: E402
+from tcsim.models.vehicle import load_vehicle  # noqa: E402
+from tcsim.simulation.scenarios import flip_flop  # noqa: E402
 from timing import median_and_fastest  # noqa: E402
 
 CONVERTER = "li-sunden-2016-fitted"
@@ -120,7 +122,10 @@ def agreement(ours: tuple, theirs: dict, label: str, stops: bool) -> dict:
 
 def print_agreement(agree: dict) -> None:
     for m, a in agree.items():
-        line = f"  {m:<6} {a['events']} events, same kinds, order and gears; max event-time difference {a['dt_events']:.2e} s"
+        line = (
+            f"  {m:<6} {a['events']} events, same kinds, order and gears; "
+            f"max event-time difference {a['dt_events']:.2e} s"
+        )
         if a["stop_ours"] is not None:
             line += (
                 f"; 100 km/h at {a['stop_ours']:.5f} s (tcsim) vs {a['stop_theirs']:.5f} s (SciPy), "
@@ -137,12 +142,7 @@ def print_agreement(agree: dict) -> None:
 
 
 def bundled_timing():
-    """The three models on the bundled vehicle (informational), when this tcsim has one."""
-    try:
-        from tcsim.launch import flip_flop
-        from tcsim.vehicle import load_vehicle
-    except ImportError:
-        return None
+    """The three models on the bundled vehicle (informational)."""
     v = load_vehicle()
     specs = [dynamic_model(v.converter, m).spec for m in MODELS]
     vd, sd = v.core, flip_flop().core_spec()

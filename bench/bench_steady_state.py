@@ -20,9 +20,9 @@ import numpy as np
 from scipy.optimize import brentq
 
 import tcsim
-from tcsim.steady import coupling_point, hrovat_tobler_steady_state
+from tcsim.models.steady import coupling_point, hrovat_tobler_steady_state
 
-N = 1_000_000
+N = 1_000_000  # points of the batched tcsim run
 N_REF = 2_000
 REPEATS = 7
 

@@ -28,7 +28,9 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(__file__))
 import scipy_reference as ref  # noqa: E402
-from tcsim.transient import dynamic_model, isolated_takeoff, simulate, simulate_batch  # noqa: E402
+from tcsim.models.drives import isolated_takeoff  # noqa: E402
+from tcsim.models.dynamic import dynamic_model  # noqa: E402
+from tcsim.simulation.transient import simulate, simulate_batch  # noqa: E402
 from timing import median_and_fastest  # noqa: E402
 
 REPEATS = 50
@@ -73,16 +75,20 @@ def main() -> None:
     ours = simulate(model, drive, times_s=TIMES)
     t_ours = median_time(lambda: simulate(model, drive, times_s=TIMES), REPEATS)
     print(
-        f"tcsim (diffsol BDF), Python API: {t_ours * 1e3:.3f} ms per run (median of {REPEATS}); events {[(round(e.time_s, 5), e.kind) for e in ours.events]}"
+        f"tcsim (diffsol BDF), Python API: {t_ours * 1e3:.3f} ms per run (median of {REPEATS}); "
+        f"events {[(round(e.time_s, 5), e.kind) for e in ours.events]}"
     )
 
     best = None
     for method in ("LSODA", "Radau"):
         theirs = ref.simulate(params, scenario, method=method, rtol=1e-6, t_eval=TIMES)
         check_agreement(ours, theirs, method)
-        t = median_time(lambda: ref.simulate(params, scenario, method=method, rtol=1e-6, t_eval=TIMES), SCIPY_REPEATS)
+        t = median_time(
+            lambda method=method: ref.simulate(params, scenario, method=method, rtol=1e-6, t_eval=TIMES), SCIPY_REPEATS
+        )
         print(
-            f"SciPy solve_ivp {method:5s}: {t * 1e3:8.2f} ms per run (median of {SCIPY_REPEATS}), {t / t_ours:6.1f}× tcsim's time; agrees (events < 1e-4 s, final state < 1e-4)"
+            f"SciPy solve_ivp {method:5s}: {t * 1e3:8.2f} ms per run (median of {SCIPY_REPEATS}), "
+            f"{t / t_ours:6.1f}× tcsim's time; agrees (events < 1e-4 s, final state < 1e-4)"
         )
         best = t if best is None else min(best, t)
 
@@ -92,13 +98,15 @@ def main() -> None:
     t_batch = time.perf_counter() - t0
     released = sum(any(e.kind == "stator-release" for e in r.events) for r in results)
     print(
-        f"batch: {BATCH} take-offs in {t_batch:.2f} s on {os.cpu_count()} cores ({t_batch / BATCH * 1e6:.0f} µs per run); "
+        f"batch: {BATCH} take-offs in {t_batch:.2f} s on {os.cpu_count()} cores "
+        f"({t_batch / BATCH * 1e6:.0f} µs per run); "
         f"{released} released the stator"
     )
 
     speedup = best / t_ours
     print(
-        f"\nspeed-up over the faster SciPy method: {speedup:.0f}× (target ≥ 50×); per run {t_ours * 1e3:.3f} ms (target ≤ 1 ms); "
+        f"\nspeed-up over the faster SciPy method: {speedup:.0f}× (target ≥ 50×); "
+        f"per run {t_ours * 1e3:.3f} ms (target ≤ 1 ms); "
         f"batch {t_batch:.2f} s (target < 10 s)"
     )
     ok = speedup >= 50 and t_ours <= 1e-3 and t_batch < 10

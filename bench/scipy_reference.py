@@ -401,9 +401,9 @@ def _self_check(p, sc):
     for sigma in (1, -1):
         u = np.array([150.0, 90.0, 20.0, 0.03 * sigma]) * (1 + 0.1 * rng.standard_normal(4))
         F, ploss = m.forces(u, sigma)
-        err_f = rel(_fd(lambda v: m.forces(v, sigma)[0], u, h), m.jacobian(u, sigma))
+        err_f = rel(_fd(lambda v, sigma=sigma: m.forces(v, sigma)[0], u, h), m.jacobian(u, sigma))
         err_mode = max(
-            rel(_fd(lambda x: md.rhs(0.5, x), u[md.free], h[md.free]), md.jac(0.5, u[md.free]))
+            rel(_fd(lambda x, md=md: md.rhs(0.5, x), u[md.free], h[md.free]), md.jac(0.5, u[md.free]))
             for md in (m.mode(st, sg) for st in (LOCKED, FREE) for sg in (sigma, 0))
         )
         print(
@@ -443,7 +443,8 @@ def main():
                 )
             )
             print(
-                "  final (rtol 1e-8): wp {:.6f} wt {:.6f} ws {:.6f} rad/s, Q {:.8f} m3/s; Tt {:.4f} Ts {:.4f} N m".format(
+                "  final (rtol 1e-8): wp {:.6f} wt {:.6f} ws {:.6f} rad/s, Q {:.8f} m3/s; "
+                "Tt {:.4f} Ts {:.4f} N m".format(
                     *(fine[k][-1] for k in STATE), fine["turbine_torque_nm"][-1], fine["stator_torque_nm"][-1]
                 )
             )

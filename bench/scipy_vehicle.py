@@ -37,8 +37,8 @@ that slip, signed at the handover, falls below 0.5 rad/s. The lock-up clutch ram
 over ``engage_time_s`` (a time root): it locks at once within 0.5 rad/s ("lockup-lock"), else it is
 armed with the sign of the slip ("lockup-applied") and locks when the slip closes. A locked clutch
 that breaks away ("lockup-slip") slips at full capacity for 0.1 s, then locks at once within
-0.5 rad/s or is armed with the sign of the slip ("lockup-slipping"). It opens ("lockup-release") below 0.7 × its engage speed and on
-a downshift. Braked axles that have (nearly) stopped are held again ("brake-hold").
+0.5 rad/s or is armed with the sign of the slip ("lockup-slipping"). It opens ("lockup-release") below 0.7 × its
+engage speed and on a downshift. Braked axles that have (nearly) stopped are held again ("brake-hold").
 
 The vehicle's values are not written down here: :func:`sedan_params` takes them from the core's
 reading of the vehicle file (``tcsim._core.read_vehicle(...).to_dict()``), the same file the core's
@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import bisect
 import math
+import time
 import tomllib
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -62,7 +63,7 @@ from tcsim import _core
 REPO = Path(__file__).resolve().parents[1]
 CONVERTER = REPO / "python/tcsim/data/converters/li-sunden-2016.toml"
 
-G = 9.81
+G = 9.81  # standard gravity, m/s²
 # Regularisation scales of vehicle.rs
 CLUTCH_SLIP_RAD_S = 0.2  # tanh(slip/0.2) of the lock-up and shift clutches
 SYNC_SLIP_RAD_S = 0.5  # a synchronising clutch locks below this slip
@@ -73,8 +74,10 @@ HOLD_SPEED_RAD_S = 0.005  # braked axles are held again below this axle and whee
 ROLL_SPEED_M_S = 0.01  # tanh(v/0.01) of the rolling resistance
 SLIP_SPEED_M_S = 0.5  # v₀ of the tyre slip κ = (rω − v)/√(v² + v₀²)
 
+# state coordinates: pump, turbine, gearbox-output, front and rear axle speeds, vehicle speed, front and rear
+# shaft twists, the fast and boost parts of the engine torque build-up
 WP, WT, WO, WF, WR, V, TF, TR_, QF, QB = range(10)
-N = 10
+N = 10  # number of state coordinates
 OPEN, ENGAGING, LOCKED = 0, 1, 2
 MAX_EVENTS = 200
 
@@ -296,21 +299,22 @@ class Mode:
         self.mdiag = np.array(
             [veh.Ip + veh.Ie, veh.It + i_gear, veh.I_out, veh.I_axle[0], veh.I_axle[1], veh.m, 1.0, 1.0, 1.0, 1.0]
         )
-        # generalised coordinates u = P x, in the core's order of columns
-        rep = [None] * N
+        # generalised coordinates u = P x, in the core's order of columns; coord_of[c] is (the column of
+        # u that carries state c, the factor), e.g. the turbine speed as the output speed × the gear ratio
+        coord_of = [None] * N
         cols = []
 
         def own(c):
-            rep[c] = (len(cols), 1.0)
+            coord_of[c] = (len(cols), 1.0)
             cols.append(c)
 
         own(WO)
         if shift:
             own(WT)
         else:
-            rep[WT] = (rep[WO][0], veh.ratios[gear])
+            coord_of[WT] = (coord_of[WO][0], veh.ratios[gear])
         if lockup == LOCKED:
-            rep[WP] = rep[WT]
+            coord_of[WP] = coord_of[WT]
         else:
             own(WP)
         if not st.wheels_held:
@@ -320,7 +324,7 @@ class Mode:
             own(c)
         self.n = len(cols)
         P = np.zeros((N, self.n))
-        for c, r in enumerate(rep):
+        for c, r in enumerate(coord_of):
             if r is not None:
                 P[c, r[0]] = r[1]
         self.P = P
@@ -736,8 +740,6 @@ def _result(rows, events, nfev, segments) -> dict:
 
 
 def main():
-    import time
-
     params = sedan_params()
     for label, sc in (
         ("flip-flop to 100 km/h", flip_flop(1.0, 30.0, 100.0 / 3.6)),

@@ -1,4 +1,6 @@
-"""Shared fixtures: paths, a CLI runner that checks the error contract."""
+"""Shared fixtures: paths, the command line in-process and as a subprocess, the FMU library, and
+the markers that say what a test is (from its folder: ``unit``, ``integration``, ``cli``,
+``golden``; ``fmu`` for tests that load the FMU library, ``subprocess`` for tests that start one)."""
 
 from __future__ import annotations
 
@@ -14,6 +16,8 @@ from pathlib import Path
 import pytest
 
 from tcsim.cli import main
+from tcsim.errors import TcsimWarning
+from tcsim.io import fmu as fmu_io
 
 REPO = Path(__file__).resolve().parents[1]
 CONVERTER_DATA = REPO / "tests" / "data" / "converters"  # published tables (tests/data/README.md)
@@ -84,3 +88,29 @@ def c1_csv(tmp_path) -> Path:
     rows = "\n".join(f"{s},{t},{c!r}" for s, t, c in zip(C1_SR, C1_TR, C1_CF))
     p.write_text("# Li & Sundén (2016) Table C.1\nspeed_ratio,torque_ratio,capacity_factor_nm_s2\n" + rows + "\n")
     return p
+
+
+@pytest.fixture(scope="session")
+def fmu_library() -> Path:
+    """The FMU library that the build made (``cargo build --release -p tcsim-fmu``, part of the
+    README's test command) or ``$TCSIM_FMU_LIBRARY``; no test builds it. A missing library, or one
+    older than the Rust sources, fails the test with what to run."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", TcsimWarning)  # a stale library
+        try:
+            return fmu_io.find_libraries(build=False)[0]
+        except (fmu_io.FmuLibraryError, TcsimWarning) as e:
+            pytest.fail(f"{e} (the README's test command builds it)")
+
+
+FOLDER_MARKERS = {"unit", "integration", "cli", "golden"}
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """Mark each test by its folder, and ``fmu`` where it uses the FMU library."""
+    for item in items:
+        folder = item.path.relative_to(REPO / "tests").parts[0]
+        if folder in FOLDER_MARKERS:
+            item.add_marker(folder)
+        if "fmu_library" in getattr(item, "fixturenames", ()):
+            item.add_marker("fmu")

@@ -16,10 +16,14 @@ Tiers:
 
 from __future__ import annotations
 
-from .converter import Characteristic, Converter, bundled_names, load_converter
 from .errors import InputError, TcsimWarning
-from .steady import coupling_point, hrovat_tobler_steady_state
-from .transient import dynamic_model, simulate, simulate_batch
+from .models import steady as _steady
+from .models.characteristic import Characteristic
+from .models.converter import Converter, bundled_names, load_converter
+from .models.dynamic import dynamic_model
+from .models.steady import coupling_point, hrovat_tobler_steady_state
+from .simulation.transient import simulate, simulate_batch
+from .units import DEFAULT_PUMP_SPEED_RPM
 
 __all__ = [
     "Characteristic",
@@ -37,9 +41,9 @@ __all__ = [
 ]
 
 
-def characterise(converter, model: str = "hrovat-tobler", pump_speed_rpm: float = 2000.0, speed_ratio=None):
+def characterise(
+    converter, model: str = "hrovat-tobler", pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio=None
+):
     """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`)."""
-    from . import steady
-
     conv = converter if isinstance(converter, Converter) else load_converter(converter)
-    return steady.characterise(conv, model, pump_speed_rpm, speed_ratio)
+    return _steady.characterise(conv, model, pump_speed_rpm, speed_ratio)

@@ -1,188 +1,21 @@
-"""Steady-state characteristics: one function per model.
-
-* :func:`characterise_table`: the look-up-table model, Li & Sundén (2016) eqs 2.8–2.9.
-* :func:`characterise_hrovat_tobler`: the closed-form steady state of Hrovat & Tobler (1985),
-  Li & Sundén (2016) eqs 2.12–2.25 with zero left-hand sides, one-way stator clutch included.
-* :func:`characterise_quasi_dynamic`: the quasi-dynamic model, whose steady state is its table
-  by construction (tcsim physics notes §5, property 2).
-
-Each returns a :class:`pandas.DataFrame` with the columns of ``characteristic.csv``
-(``conventions.md``). Speeds are in rad/s in the core; ``pump_speed_rpm`` is for people.
-"""
+"""``tcsim.steady``: steady-state characteristics per model, kept as a facade of :mod:`tcsim.models.steady`."""
 
 from __future__ import annotations
 
-import numpy as np
-import pandas as pd
+from .models.steady import (
+    characterise,
+    characterise_hrovat_tobler,
+    characterise_quasi_dynamic,
+    characterise_table,
+    coupling_point,
+    hrovat_tobler_steady_state,
+)
 
-from . import _core
-from .converter import RAD_S_PER_RPM, Converter
-from .errors import InputError, from_core
-
-STATOR_MODES = {0: "locked", 1: "free-wheeling", 2: "no-flow", -1: "no-steady-state"}
-DEFAULT_PUMP_SPEED_RPM = 2000.0
-
-
-def _derived(df: pd.DataFrame) -> pd.DataFrame:
-    """Add CF, K-factor and efficiency from torques and speeds."""
-    wp = df["pump_speed_rad_s"].to_numpy()
-    cf = df["pump_torque_nm"].to_numpy() / wp**2
-    df["capacity_factor_nm_s2"] = cf
-    with np.errstate(divide="ignore", invalid="ignore"):
-        df["k_factor_rpm_per_sqrt_nm"] = _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(cf))
-    df["efficiency"] = df["torque_ratio"] * df["speed_ratio"]
-    return df
-
-
-def _check_speed(pump_speed_rpm: float) -> float:
-    if not (np.isfinite(pump_speed_rpm) and pump_speed_rpm > 0):
-        raise InputError("command line", "--pump-speed-rpm", pump_speed_rpm, "a finite, positive pump speed in rpm")
-    return pump_speed_rpm * RAD_S_PER_RPM
-
-
-def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
-    """A sweep over the table's own range that contains every table point."""
-    sr = conv.characteristic.speed_ratio
-    return np.unique(np.concatenate([np.linspace(sr[0], sr[-1], n), sr]))
-
-
-def characterise_table(
-    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
-) -> pd.DataFrame:
-    """Steady state of the table model at a fixed pump speed over ``speed_ratio``.
-
-    Inside the table TR and CF are interpolated linearly; outside it the end values are held and
-    the ``extrapolated`` column says so (``docs/models.md``).
-    """
-    conv.require("table")
-    wp = _check_speed(pump_speed_rpm)
-    sr = table_speed_ratios(conv) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
-    pump = np.full(sr.shape, wp)
-    try:
-        out = _core.table_steady_states(*conv.characteristic.arrays(), pump, np.ascontiguousarray(sr * wp))
-    except _core.CoreInputError as e:
-        raise from_core(e, conv.path) from None
-    df = pd.DataFrame(
-        {
-            "speed_ratio": sr,
-            "torque_ratio": out["torque_ratio"],
-            "pump_speed_rad_s": pump,
-            "turbine_speed_rad_s": sr * wp,
-            "pump_torque_nm": out["pump_torque_nm"],
-            "turbine_torque_nm": out["turbine_torque_nm"],
-            "stator_torque_nm": out["stator_torque_nm"],
-            "extrapolated": out["extrapolated"],
-        }
-    )
-    return _order(_derived(df))
-
-
-def characterise_quasi_dynamic(
-    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
-) -> pd.DataFrame:
-    """The quasi-dynamic model at steady state is its table, for any shape effect."""
-    conv.require("quasi-dynamic")
-    return characterise_table(conv, pump_speed_rpm, speed_ratio)
-
-
-def hrovat_tobler_steady_state(
-    geometry: np.ndarray, pump_speed_rad_s, turbine_speed_rad_s, strict: bool = True
-) -> dict[str, np.ndarray]:
-    """Closed-form steady states, batched in the core (GIL released).
-
-    ``geometry`` is one row of the fifteen core parameters (``tcsim._core.ht_parameter_names()``,
-    angles in radians) or one row per point. Returns flow, stator speed, the three torques
-    (pump and stator external, turbine delivered) and the stator mode per point.
-    """
-    geometry = np.ascontiguousarray(np.atleast_2d(geometry), dtype=float)
-    wp = np.ascontiguousarray(pump_speed_rad_s, dtype=float).reshape(-1)
-    wt = np.ascontiguousarray(turbine_speed_rad_s, dtype=float).reshape(-1)
-    return _core.ht_steady_states(geometry, wp, wt, strict)
-
-
-def coupling_point(conv: Converter) -> float | None:
-    """Speed ratio where the Hrovat & Tobler stator clutch releases, or None below SR = 1."""
-    return _core.ht_coupling_point(conv.core_geometry())
-
-
-def characterise_hrovat_tobler(
-    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
-) -> pd.DataFrame:
-    """Closed-form steady state over SR 0–1 with the one-way clutch, coupling point included."""
-    conv.require("hrovat-tobler")
-    wp = _check_speed(pump_speed_rpm)
-    if speed_ratio is None:
-        sr = np.linspace(0.0, 1.0, 101)
-        cp = coupling_point(conv)
-        if cp is not None:
-            sr = np.unique(np.append(sr, cp))
-    else:
-        sr = np.asarray(speed_ratio, dtype=float)
-    bad = np.flatnonzero((sr < 0) | (sr > 1) | ~np.isfinite(sr))
-    if bad.size:
-        raise InputError(
-            "command line",
-            "speed ratio",
-            float(sr[bad[0]]),
-            "0 to 1 for the hrovat-tobler model (reverse rotation and overrun are not modelled yet)",
-        )
-    pump = np.full(sr.shape, wp)
-    try:
-        out = hrovat_tobler_steady_state(conv.core_geometry(), pump, sr * wp)
-    except _core.CoreInputError as e:
-        raise from_core(e, conv.path, "[geometry] at ") from None
-    tr = np.where(
-        out["stator_mode"] == 2,
-        1.0,
-        out["turbine_torque_nm"] / np.where(out["pump_torque_nm"] == 0, 1.0, out["pump_torque_nm"]),
-    )
-    df = pd.DataFrame(
-        {
-            "speed_ratio": sr,
-            "torque_ratio": tr,
-            "pump_speed_rad_s": pump,
-            "turbine_speed_rad_s": sr * wp,
-            "pump_torque_nm": out["pump_torque_nm"],
-            "turbine_torque_nm": out["turbine_torque_nm"],
-            "stator_torque_nm": out["stator_torque_nm"],
-            "flow_m3_s": out["flow_m3_s"],
-            "stator_speed_rad_s": out["stator_speed_rad_s"],
-            "stator_mode": [STATOR_MODES[int(m)] for m in out["stator_mode"]],
-        }
-    )
-    return _order(_derived(df))
-
-
-CHARACTERISE = {
-    "table": characterise_table,
-    "hrovat-tobler": characterise_hrovat_tobler,
-    "quasi-dynamic": characterise_quasi_dynamic,
-}
-
-_FIRST = [
-    "speed_ratio",
-    "torque_ratio",
-    "capacity_factor_nm_s2",
-    "k_factor_rpm_per_sqrt_nm",
-    "efficiency",
-    "pump_speed_rad_s",
-    "turbine_speed_rad_s",
-    "pump_torque_nm",
-    "turbine_torque_nm",
-    "stator_torque_nm",
+__all__ = [
+    "characterise",
+    "characterise_hrovat_tobler",
+    "characterise_quasi_dynamic",
+    "characterise_table",
+    "coupling_point",
+    "hrovat_tobler_steady_state",
 ]
-
-
-def _order(df: pd.DataFrame) -> pd.DataFrame:
-    return df[_FIRST + [c for c in df.columns if c not in _FIRST]]
-
-
-def characterise(
-    conv: Converter,
-    model: str = "hrovat-tobler",
-    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
-    speed_ratio: np.ndarray | None = None,
-) -> pd.DataFrame:
-    """Steady-state characteristic of ``conv`` with ``model`` (``table``, ``hrovat-tobler``, ``quasi-dynamic``)."""
-    conv.require(model)
-    return CHARACTERISE[model](conv, pump_speed_rpm, speed_ratio)

@@ -568,6 +568,12 @@ fn py_value<'py>(py: Python<'py>, v: &toml::Value) -> PyResult<Bound<'py, PyAny>
     })
 }
 
+/// The sections of a vehicle file that hold the vehicle's values, in file order.
+#[pyfunction]
+fn vehicle_sections() -> Vec<&'static str> {
+    tcsim_core::vehicle::file::SECTIONS.to_vec()
+}
+
 /// Read a vehicle file's `text` (`file` names it in messages): the one parse and validation of a
 /// vehicle. Raises CoreInputError whose field is named as the file writes it (`[body].grade_percent`,
 /// `[gearbox].ratios[3]`, `(syntax)` with line and column).
@@ -755,7 +761,7 @@ fn steady_torque_ratio<'py>(
 
 /// The engine's drag torque in the vehicle plant, N·m, at engine speed `speed_rad_s` (rad/s):
 /// `drag_torque_nm·tanh(ω/1 rad/s) + drag_nm_s_per_rad·ω`, opposing rotation (zero at rest).
-/// Replaces `tcsim.vehicle.EngineSection.drag_at`, which lacks the tanh.
+/// (The drag of the former Python vehicle schema, which lacked the tanh, is gone with that schema.)
 #[pyfunction]
 fn vehicle_engine_drag_nm(speed_rad_s: f64, drag_torque_nm: f64, drag_nm_s_per_rad: f64) -> f64 {
     engine_drag_nm(speed_rad_s, drag_torque_nm, drag_nm_s_per_rad)
@@ -786,6 +792,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(launch_columns, m)?)?;
     m.add_function(wrap_pyfunction!(launch_runs, m)?)?;
     m.add_function(wrap_pyfunction!(read_vehicle, m)?)?;
+    m.add_function(wrap_pyfunction!(vehicle_sections, m)?)?;
     m.add_class::<PyVehicle>()?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
     Ok(())

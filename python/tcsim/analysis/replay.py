@@ -1,0 +1,383 @@
+"""``tcsim replay``: an isolated converter driven by measured signals, compared with the measurement.
+
+This is the thesis's "mode 2" (Li & Sundén 2016, §3.1.2, §3.4, §3.5.2.1): the converter alone,
+fed with measured inputs instead of a vehicle model, so that the models' outputs can be compared
+with the measured ones without feedback errors from the rest of a driveline.
+
+::
+
+    tcsim replay CONVERTER MEASUREMENT [--model M ...] [--out DIR] [--drive pump-torque|speeds]
+                 [--channel TARGET=COLUMN ...] [--initial NAME=VALUE ...] [--window S]
+                 [--metrics-window S]
+
+Input channels
+--------------
+The measurement is a CSV, Parquet, MATLAB ``.mat`` (v5, v7.3) or ASAM MDF4 (``.mf4``/``.mdf``)
+file, read by :func:`tcsim.measurement.read_measurement`. Channels are found by their canonical,
+unit-suffixed names (``time_s``, ``pump_torque_nm``, ``pump_speed_rad_s``, ``turbine_speed_rad_s``,
+``turbine_torque_nm``), by the same quantity with another unit suffix (``time_ms``,
+``turbine_speed_rpm``, ``pump_torque_knm``, ...; converted), or through an explicit mapping
+``--channel TARGET=COLUMN`` (repeatable, e.g. ``--channel pump_torque_nm=EngTrq``). MDF4 channel
+units decide the conversion when present. Missing channels, NaN, time going backwards and values
+that look like the wrong unit (a speed column in rpm named ``*_rad_s``) are input errors (exit 2).
+
+Drives
+------
+``--drive pump-torque`` (default; drive (a), the thesis's and VSIM's causality): inputs
+``time_s``, ``pump_torque_nm``, ``turbine_speed_rad_s``; the models compute the pump speed and the
+turbine torque. Measured ``pump_speed_rad_s`` and ``turbine_torque_nm``, when present, are the
+reference outputs.
+
+``--drive speeds`` (drive (b)): inputs ``time_s``, ``pump_speed_rad_s``, ``turbine_speed_rad_s``;
+the models compute the pump and turbine torques. Measured ``pump_torque_nm`` and
+``turbine_torque_nm``, when present, are the reference outputs.
+
+A channel mapped with ``--channel`` that a model also outputs (for example
+``--channel flow_m3_s=Q``) is compared as well.
+
+Models
+------
+``--model`` is repeatable: ``table``, ``hrovat-tobler``, ``quasi-dynamic``. By default every
+model the converter has the sections for is run (and a model whose transient sections are missing,
+such as ``[inertia]``, is left out; if none is left, the first one's error is reported). An
+explicitly requested model whose sections are missing is an input error.
+
+Initial state
+-------------
+By default each model starts from the steady state consistent with the first input sample.
+``--initial NAME=VALUE`` (repeatable) overrides one coordinate, SI units: ``pump_speed_rad_s``,
+``turbine_speed_rad_s``, ``stator_speed_rad_s``, ``flow_m3_s``; the others stay consistent with
+the first sample. A coordinate prescribed by the drive (the turbine speed in drive (a), both
+speeds in drive (b)) or absent from a model is not a state and is ignored, with a warning.
+
+Derivative window
+-----------------
+A prescribed speed enters the equations with its derivative (the inertia and shape-effect
+terms). ``--window S`` (default :data:`tcsim.models.drives.DERIVATIVE_WINDOW_S`, 0.04 s) sets the
+smoothing of that derivative: at each sample, the slope of the straight line fitted by least
+squares to all samples within ±S/2 (at least the neighbouring samples; a first-order
+Savitzky–Golay filter on non-uniform samples). ``--window 0`` gives the central difference.
+The *same* local least-squares slope, with the same window, differentiates the measured speeds
+for the measured effective torques below (:func:`tcsim.analysis.effective.smoothed_rate`).
+
+Outputs (in DIR, default ``replay``; written all at once, nothing on error)
+---------------------------------------------------------------------------
+* ``<model>.csv`` per model, sampled at the measurement's time stamps, all the columns of
+  :meth:`tcsim.transient.TransientResult.frame`: at least ``time_s``, ``pump_speed_rad_s``,
+  ``turbine_speed_rad_s``, ``pump_torque_nm``, ``turbine_torque_nm``, ``speed_ratio``,
+  ``torque_ratio`` and the inertia, fluid, transferred and effective torques; the dynamic models add
+  ``flow_m3_s``, Hrovat & Tobler also ``stator_speed_rad_s``.
+* ``events.csv``: ``model, time_s, kind, stator_locked, flow_direction`` (stator release and lock,
+  flow reaching zero and restarting).
+* ``measurement.csv``: the measured channels in SI, with the measured effective torques where the
+  measurement allows them.
+* ``metrics.csv`` when the measurement has reference outputs: one row per model × channel × window
+  with ``model, channel, window, window_start_s, window_end_s, rmse, nrmse, max_abs_error,
+  max_abs_error_time_s, n``. ``window`` is ``all`` for the whole record, else the number of a
+  consecutive window of ``--metrics-window`` seconds (default 1 s; the last one may be shorter).
+  The error is simulated − measured; RMSE = √mean(error²); NRMSE = RMSE / (max − min of the
+  measured channel in the window), NaN when that range is zero; ``n`` is the number of samples.
+* Plots (PNG): ``inputs.png`` (the input signals, thesis figures 3.11/3.12); per reference output
+  ``pump_speed.png`` and ``turbine_torque.png`` (drive (a), figures 3.14 and 3.13) or
+  ``pump_torque.png`` and ``turbine_torque.png`` (drive (b)); ``effective_pump_torque.png`` (figure
+  3.16) and ``effective_turbine_torque.png`` (figure 3.17). The measurement is drawn where it has
+  the channel, else only the model curves are.
+
+Effective torques (thesis eqs 3.1–3.4)
+--------------------------------------
+The torque that reaches the fluid, and the torque that leaves it, without the component inertias:
+
+* effective pump input torque ``T_p − I_p·ω̇_p`` (eq 3.3), measured when the measurement has
+  ``pump_torque_nm`` and ``pump_speed_rad_s``;
+* effective turbine output torque ``T_t + I_t·ω̇_t`` (eq 3.4), measured when it has
+  ``turbine_torque_nm`` (the turbine speed is always an input).
+
+``I_p``, ``I_t`` are the converter's ``[inertia]``; ``ω̇`` is the smoothed derivative of the measured
+speed (see *Derivative window*). The models report ``effective_pump_torque_nm`` and
+``effective_turbine_torque_nm`` from their own states. Both are compared in ``metrics.csv`` as
+channels ``effective_pump_torque_nm`` and ``effective_turbine_torque_nm``.
+
+Errors: anything wrong in the command line, the converter or the measurement is an
+:class:`~tcsim.errors.InputError` (exit 2); a solver failure is a
+:class:`~tcsim.transient.SolverError` (exit 1).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from ..errors import InputError, TcsimWarning
+from ..models import drives
+from ..models.converter import Converter
+from ..models.drives import DERIVATIVE_WINDOW_S, Drive
+from ..models.dynamic import DynamicModel, select_models
+from ..models.measurement import Measurement
+from ..simulation import transient
+from .effective import measured_effective_torques
+
+#: Default width of the consecutive metric windows, s.
+METRICS_WINDOW_S = 1.0
+#: Keys of ``--initial``.
+INITIAL_KEYS: tuple[str, ...] = ("pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s")
+METRIC_COLUMNS = [
+    "model",
+    "channel",
+    "window",
+    "window_start_s",
+    "window_end_s",
+    "rmse",
+    "nrmse",
+    "max_abs_error",
+    "max_abs_error_time_s",
+    "n",
+]
+EVENT_COLUMNS = ["model", "time_s", "kind", "stator_locked", "flow_direction"]
+
+
+@dataclass(frozen=True)
+class DriveKind:
+    """A drive of ``--drive``: its input channels (after time) and the outputs it leaves to the model."""
+
+    name: str
+    inputs: tuple[str, str]
+    outputs: tuple[str, str]
+    cls: type
+
+    def make(self, meas: Measurement, window_s: float) -> Drive:
+        a, b = (meas.channels[c] for c in self.inputs)
+        return self.cls(meas.time_s, a, b, derivative_window_s=window_s)
+
+
+DRIVES: dict[str, DriveKind] = {
+    "pump-torque": DriveKind(
+        "pump-torque",
+        ("pump_torque_nm", "turbine_speed_rad_s"),
+        ("pump_speed_rad_s", "turbine_torque_nm"),
+        drives.PumpTorqueTurbineSpeed,
+    ),
+    "speeds": DriveKind(
+        "speeds", ("pump_speed_rad_s", "turbine_speed_rad_s"), ("pump_torque_nm", "turbine_torque_nm"), drives.Speeds
+    ),
+}
+
+
+# ---------------------------------------------------------------------------------------------
+# command-line items
+
+
+def drive_kind(name: str) -> DriveKind:
+    """The drive named on the command line."""
+    if name not in DRIVES:
+        raise InputError("command line", "--drive", name, f"one of {', '.join(DRIVES)}")
+    return DRIVES[name]
+
+
+def parse_initial(items: Sequence[str]) -> dict[str, float]:
+    """``["pump_speed_rad_s=150", ...]`` -> ``{"pump_speed_rad_s": 150.0}``; finite values, known keys."""
+    expected = f"NAME=VALUE with NAME one of {', '.join(INITIAL_KEYS)} (each at most once) and VALUE a finite number"
+    out: dict[str, float] = {}
+    for item in items:
+        key, sep, text = (part.strip() for part in item.partition("="))
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        if not sep or key not in INITIAL_KEYS or key in out or not math.isfinite(value):
+            raise InputError("command line", "--initial", item, expected)
+        out[key] = value
+    return out
+
+
+def check_window(option: str, value: float, positive: bool) -> float:
+    ok = math.isfinite(value) and (value > 0 if positive else value >= 0)
+    if not ok:
+        raise InputError(
+            "command line", option, value, f"a finite {'positive' if positive else 'non-negative'} number of seconds"
+        )
+    return float(value)
+
+
+# ---------------------------------------------------------------------------------------------
+# runs
+
+
+def _warn_ignored_initial(initial: dict[str, float], drive: DriveKind, models: Sequence[DynamicModel]) -> None:
+    for key in initial:
+        if key in drive.inputs:
+            warnings.warn(f"--initial {key} is ignored: drive {drive.name} prescribes it", TcsimWarning, stacklevel=3)
+    lacking = {"table": ("stator_speed_rad_s", "flow_m3_s"), "quasi-dynamic": ("stator_speed_rad_s",)}
+    for m in models:
+        for key in set(initial) & set(lacking.get(m.name, ())):
+            warnings.warn(
+                f"--initial {key} is ignored by the {m.name} model (it has no such state)", TcsimWarning, stacklevel=3
+            )
+
+
+def run_models(
+    models: Sequence[DynamicModel], drive: Drive, initial: dict[str, float] | None = None
+) -> dict[str, transient.TransientResult]:
+    """Each model under the drive, sampled at the drive's time stamps. An error about the initial
+    state is reported against ``--initial``."""
+    results = {}
+    for m in models:
+        try:
+            results[m.name] = transient.simulate(m, drive, initial=initial or None)
+        except InputError as e:
+            if e.field.startswith("initial state"):
+                key = e.field.partition(":")[2].strip() or e.field
+                raise InputError("command line", f"--initial {key}", e.value, e.expected) from None
+            raise
+    return results
+
+
+# ---------------------------------------------------------------------------------------------
+# measured effective torques
+
+
+def reference_channels(meas: Measurement, drive: DriveKind, effective: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """The measured channels to compare with the models: every measured channel that is not an input
+    of the drive (the models output all of them), then the measured effective torques."""
+    refs = {c: v for c, v in meas.channels.items() if c not in drive.inputs}
+    refs.update(effective)
+    return refs
+
+
+# ---------------------------------------------------------------------------------------------
+# metrics (pure)
+
+
+def _stats(time_s: np.ndarray, measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:
+    err = simulated - measured
+    rmse = float(np.sqrt(np.mean(err * err)))
+    span = float(np.max(measured) - np.min(measured))
+    j = int(np.argmax(np.abs(err)))
+    return {
+        "rmse": rmse,
+        "nrmse": rmse / span if span > 0 else math.nan,
+        "max_abs_error": float(abs(err[j])),
+        "max_abs_error_time_s": float(time_s[j]),
+        "n": int(len(err)),
+    }
+
+
+def metric_windows(time_s: np.ndarray, window_s: float | None) -> list[tuple[str, float, float, np.ndarray]]:
+    """("all", start, end, mask) then consecutive windows of ``window_s`` from the first sample:
+    [start, start + window_s), the last one closed at the last sample; empty windows left out."""
+    t = np.asarray(time_s, dtype=float)
+    out = [("all", float(t[0]), float(t[-1]), np.ones(len(t), dtype=bool))]
+    if not window_s or len(t) < 2:
+        return out
+    count = max(1, math.ceil((t[-1] - t[0]) / window_s - 1e-9))
+    k = np.clip(np.floor((t - t[0]) / window_s + 1e-9).astype(int), 0, count - 1)
+    for w in range(count):
+        mask = k == w
+        if mask.any():
+            start = float(t[0] + w * window_s)
+            out.append((str(w + 1), start, float(min(start + window_s, t[-1])), mask))
+    return out
+
+
+def error_metrics(time_s, measured, simulated, window_s: float | None = METRICS_WINDOW_S) -> pd.DataFrame:
+    """Errors of ``simulated`` against ``measured`` (same samples) over the whole record and over
+    consecutive windows of ``window_s``: columns ``window, window_start_s, window_end_s, rmse,
+    nrmse, max_abs_error, max_abs_error_time_s, n``. Error = simulated − measured; NRMSE = RMSE /
+    (max − min of measured in the window), NaN when that is zero."""
+    t, m, s = (np.asarray(a, dtype=float) for a in (time_s, measured, simulated))
+    if not (len(t) == len(m) == len(s)) or len(t) == 0:
+        raise ValueError(f"time, measured and simulated need the same non-zero length ({len(t)}, {len(m)}, {len(s)})")
+    rows = [
+        {"window": name, "window_start_s": a, "window_end_s": b, **_stats(t[mask], m[mask], s[mask])}
+        for name, a, b, mask in metric_windows(t, window_s)
+    ]
+    return pd.DataFrame(rows, columns=METRIC_COLUMNS[2:])
+
+
+def metrics_table(
+    time_s: np.ndarray,
+    results: dict[str, transient.TransientResult],
+    references: dict[str, np.ndarray],
+    window_s: float | None,
+) -> pd.DataFrame:
+    """:func:`error_metrics` for every model × reference channel the model outputs."""
+    parts = []
+    for name, result in results.items():
+        frame = result.frame()
+        for channel, measured in references.items():
+            if channel in frame.columns:
+                df = error_metrics(time_s, measured, frame[channel].to_numpy(), window_s)
+                parts.append(df.assign(model=name, channel=channel))
+    if not parts:
+        return pd.DataFrame(columns=METRIC_COLUMNS)
+    return pd.concat(parts, ignore_index=True)[METRIC_COLUMNS]
+
+
+def events_table(results: dict[str, transient.TransientResult]) -> pd.DataFrame:
+    """All models' events: ``model, time_s, kind, stator_locked, flow_direction``."""
+    rows = [
+        {
+            "model": name,
+            "time_s": e.time_s,
+            "kind": e.kind,
+            "stator_locked": e.stator_locked,
+            "flow_direction": e.flow_direction,
+        }
+        for name, r in results.items()
+        for e in r.events
+    ]
+    return pd.DataFrame(rows, columns=EVENT_COLUMNS)
+
+
+# ---------------------------------------------------------------------------------------------
+# the whole replay
+
+
+@dataclass
+class Replay:
+    """Everything a replay produced (see the module docstring for the files)."""
+
+    converter: str
+    drive: DriveKind
+    measurement: Measurement
+    results: dict[str, transient.TransientResult]
+    measured_effective: dict[str, np.ndarray] = field(default_factory=dict)
+    metrics: pd.DataFrame = field(default_factory=lambda: pd.DataFrame(columns=METRIC_COLUMNS))
+
+    @property
+    def events(self) -> pd.DataFrame:
+        return events_table(self.results)
+
+    def measured_frame(self) -> pd.DataFrame:
+        return self.measurement.to_frame().assign(**self.measured_effective)
+
+
+def replay_measurement(
+    conv: Converter,
+    meas: Measurement,
+    models: Sequence[str] = (),
+    kind: DriveKind = DRIVES["pump-torque"],
+    initial: dict[str, float] | None = None,
+    window_s: float = DERIVATIVE_WINDOW_S,
+    metrics_window_s: float | None = METRICS_WINDOW_S,
+) -> Replay:
+    """Run the replay of a measurement read with the channels of ``kind`` (no files): simulate every
+    model, measure the errors."""
+    window_s = check_window("--window", window_s, positive=False)
+    if metrics_window_s is not None:
+        metrics_window_s = check_window("--metrics-window", metrics_window_s, positive=True)
+    dyn = select_models(conv, models)
+    _warn_ignored_initial(initial or {}, kind, dyn)
+    results = run_models(dyn, kind.make(meas, window_s), initial)
+    inertia = dyn[0].spec["inertia_kg_m2"]
+    effective = {
+        k: v
+        for k, v in measured_effective_torques(meas, inertia[1], inertia[0], window_s).items()
+        if k.startswith("effective_") and k != "effective_torque_ratio"
+    }
+    metrics = metrics_table(meas.time_s, results, reference_channels(meas, kind, effective), metrics_window_s)
+    return Replay(conv.name, kind, meas, results, effective, metrics)

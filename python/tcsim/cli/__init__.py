@@ -1,0 +1,22 @@
+"""The ``tcsim`` command line (typer + rich): :data:`app` and :func:`main`, one module per command.
+
+Each command module is load → compute → write → print; the command functions import the layers
+they use when they run, so that ``tcsim --help`` starts fast.
+"""
+
+from __future__ import annotations
+
+from . import characterise, converters, export_fmu, fit, fit_shapes, launch, replay, study
+from .app import app, main
+
+# registered in the order ``tcsim --help`` lists them
+app.command()(converters.converters)
+app.command()(characterise.characterise)
+app.command()(fit.fit)
+app.command()(study.study)
+app.command()(replay.replay)
+app.command("fit-shapes", help=fit_shapes.HELP)(fit_shapes.fit_shapes)
+app.command(help=launch.HELP)(launch.launch)
+app.command("export-fmu", help=export_fmu.HELP)(export_fmu.export_fmu)
+
+__all__ = ["app", "main"]

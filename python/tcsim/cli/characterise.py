@@ -1,0 +1,46 @@
+"""``tcsim characterise``: the steady-state sweep of one model."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from ..units import DEFAULT_PUMP_SPEED_RPM
+from .app import ModelOpt, OutOpt, stdout
+
+
+def characterise(
+    converter: Annotated[str, typer.Argument(help="bundled name, converter .toml, or table .csv/.vtcc")],
+    model: ModelOpt = "",
+    pump_speed_rpm: Annotated[float, typer.Option(help="fixed pump speed of the sweep")] = DEFAULT_PUMP_SPEED_RPM,
+    out: OutOpt = Path("characteristic"),
+) -> None:
+    """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
+    from ..io.outputs import output_dir
+    from ..io.results import write_frames
+    from ..models.converter import load_converter
+    from ..models.steady import characterise as run
+    from ..models.steady import coupling_point
+    from ..plots.characteristic import plot_characteristic
+
+    conv = load_converter(converter)
+    model = model or ("hrovat-tobler" if "hrovat-tobler" in conv.models else "table")
+    conv.require(model)
+    df = run(conv, model, pump_speed_rpm)
+    cp = coupling_point(conv) if model == "hrovat-tobler" else None
+    with output_dir(out) as stage:
+        write_frames({"characteristic.csv": df}, stage)
+        table = conv.characteristic if model == "hrovat-tobler" else None
+        plot_characteristic(
+            {f"{model} model": df},
+            stage,
+            f"{conv.name}, pump at {pump_speed_rpm:g} rpm",
+            table=table,
+            coupling_point=cp,
+        )
+    msg = f"{model}: {len(df)} points written to {out}/characteristic.csv and plots"
+    if cp is not None:
+        msg += f"; coupling point at SR {cp:.4f}"
+    stdout.print(msg)

@@ -1,0 +1,67 @@
+"""``tcsim fit``: Hrovat & Tobler parameters fitted to a characteristic table."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .app import OutOpt, stdout
+
+
+def fit_command(
+    converter: str, target: str, out: Path, free: str | None, bounds: list[str], speed_ratio_max: float | None
+) -> str:
+    """Fit ``converter``'s [geometry] to the table of ``target``; write ``out``; the line to print."""
+    from ..analysis import fitting
+    from ..errors import InputError
+    from ..io.outputs import output_dir
+    from ..io.results import write_fit_files
+    from ..models.converter import load_converter
+    from ..models.steady import coupling_point
+    from ..plots.characteristic import plot_characteristic
+    from ..reports.fit import report_markdown
+
+    free_names = fitting.check_free(fitting.parse_free(free))
+    user_bounds = fitting.parse_bounds(bounds)
+    start = load_converter(converter)
+    start.require("hrovat-tobler")
+    assert start.geometry is not None  # require() checked it
+    table = fitting.target_table(target)
+    try:
+        result = fitting.fit_hrovat_tobler(start.geometry, table, free_names, user_bounds, speed_ratio_max)
+    except InputError as e:
+        if e.source == "start converter":
+            raise InputError(start.path, e.field, e.value, e.expected) from None
+        raise
+    fitted = fitting.fitted_converter(start, result, table, fitting.target_label(target))
+    with output_dir(out) as stage:
+        write_fit_files(stage, start, fitted, result, table, report_markdown(result, start, []))
+        curves = {
+            "fitted Hrovat & Tobler": fitting.model_curve(fitted),
+            "start Hrovat & Tobler": fitting.model_curve(start),
+        }
+        title = f"Fit to {Path(table.source).name or table.source} (SR 0–{result.speed_ratio_max:g})"
+        plot_characteristic(
+            curves, stage, title, table=table, table_label="Target table", coupling_point=coupling_point(fitted)
+        )
+    return f"{result.one_line()}. Written to {out}/: fitted.toml, fit_report.md, fit_report.json and plots."
+
+
+def fit(
+    converter: Annotated[str, typer.Argument(help="converter whose Hrovat & Tobler parameters are the start point")],
+    target: Annotated[
+        str, typer.Option("--target", help="characteristic table to fit: .csv, .vtcc or converter .toml")
+    ],
+    out: OutOpt = Path("fit"),
+    free: Annotated[
+        str | None, typer.Option(help="comma-separated parameters to free (default: losses and the six angles)")
+    ] = None,
+    bound: Annotated[list[str] | None, typer.Option(help="NAME=LO:HI bounds of a free parameter, repeatable")] = None,
+    speed_ratio_max: Annotated[
+        float | None, typer.Option(help="fit SR from 0 up to this (default: the table's coupling point)")
+    ] = None,
+) -> None:
+    """Fit Hrovat & Tobler parameters to a characteristic table: DIR/fitted.toml, report, plots."""
+    stdout.print(fit_command(converter, target, out, free, bound or [], speed_ratio_max))

@@ -1,0 +1,115 @@
+"""The characteristic table (TR and capacity against SR), validated, in any capacity convention."""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _core
+from ..errors import InputError, TcsimWarning, from_core
+from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
+
+CAPACITY_KEYS = tuple(_core.capacity_conventions())
+
+#: Stall torque at 2000 rpm outside this range (N·m) suggests a capacity read in the wrong
+#: convention (physics notes §1).
+PLAUSIBLE_STALL_TORQUE_NM = (20.0, 2000.0)
+
+
+# --------------------------------------------------------------------------------------------
+# the characteristic table
+
+
+@dataclass(frozen=True)
+class Characteristic:
+    """TR and CF (N·m/(rad/s)²) against SR, validated; ``convention`` is the capacity key read."""
+
+    speed_ratio: np.ndarray
+    torque_ratio: np.ndarray
+    capacity_factor_nm_s2: np.ndarray
+    convention: str = "capacity_factor_nm_s2"
+    source: str = ""
+
+    @classmethod
+    def from_columns(
+        cls,
+        speed_ratio,
+        torque_ratio,
+        capacity,
+        convention: str,
+        source: str,
+        where: str = "",
+        rows: list[int] | None = None,
+    ) -> Characteristic:
+        """Validate and convert a table read in capacity ``convention``.
+
+        ``where`` prefixes field names (``"[characteristic]."`` for TOML); ``rows`` maps each
+        point to its line number in a text file, so that messages name the line.
+        """
+        if convention not in CAPACITY_KEYS:
+            raise InputError(source, f"{where}capacity", convention, f"one of {', '.join(CAPACITY_KEYS)}")
+        sr = np.asarray(speed_ratio, dtype=float)
+        tr = np.asarray(torque_ratio, dtype=float)
+        cap = np.asarray(capacity, dtype=float)
+
+        def name(col: str, i: int) -> str:
+            return f"line {rows[i]}, {col}" if rows is not None else f"{where}{col}[{i}]"
+
+        for col, v in (("speed_ratio", sr), ("torque_ratio", tr), (convention, cap)):
+            bad = np.flatnonzero(~np.isfinite(v))
+            if bad.size:
+                raise InputError(source, name(col, int(bad[0])), float(v[bad[0]]), "a finite number")
+        if not (len(sr) == len(tr) == len(cap)):
+            raise InputError(
+                source,
+                f"{where}torque_ratio",
+                f"{len(tr)} values",
+                f"as many values as speed_ratio ({len(sr)}) and {convention} ({len(cap)})",
+            )
+        if len(sr) < 2:
+            raise InputError(source, f"{where}speed_ratio", f"{len(sr)} points", "at least 2 points")
+        dec = np.flatnonzero(np.diff(sr) <= 0)
+        if dec.size:
+            i = int(dec[0]) + 1
+            raise InputError(
+                source,
+                name("speed_ratio", i),
+                float(sr[i]),
+                f"strictly increasing speed ratio (previous value {sr[i - 1]:g})",
+            )
+        drive = sr < 1.0
+        for col, v in (("torque_ratio", tr), (convention, cap)):
+            bad = np.flatnonzero(drive & (v <= 0))
+            if bad.size:
+                raise InputError(
+                    source, name(col, int(bad[0])), float(v[bad[0]]), "a positive value in drive (speed ratio below 1)"
+                )
+        cf = np.asarray(_core.capacity_to_cf(convention, np.ascontiguousarray(cap)))
+        try:
+            _core.table_check(sr, tr, cf)
+        except _core.CoreInputError as e:  # pragma: no cover - the checks above come first
+            raise from_core(e, source, where) from None
+        return cls(sr, tr, cf, convention, source)
+
+    def stall_torque_nm(self, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM) -> float:
+        """Pump torque at SR = 0 (or the table's first SR ≥ 0) and the given pump speed."""
+        i = int(np.searchsorted(self.speed_ratio, 0.0))
+        i = min(i, len(self.speed_ratio) - 1)
+        return float(self.capacity_factor_nm_s2[i] * (pump_speed_rpm * RAD_S_PER_RPM) ** 2)
+
+    def warn_if_implausible(self) -> None:
+        t = self.stall_torque_nm()
+        lo, hi = PLAUSIBLE_STALL_TORQUE_NM
+        if not lo <= t <= hi:
+            warnings.warn(
+                f"{self.source}: stall torque at 2000 rpm is {t:.4g} N·m with the capacity read as "
+                f"{self.convention}; a passenger-car converter gives {lo:g}–{hi:g} N·m. "
+                "Check the capacity convention.",
+                TcsimWarning,
+                stacklevel=3,
+            )
+
+    def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return self.speed_ratio, self.torque_ratio, self.capacity_factor_nm_s2

@@ -1,0 +1,305 @@
+"""Converter definitions: TOML files validated by pydantic, bundled converters, tables alone.
+
+A converter is a bundled name (``tcsim converters``), a TOML file, or a characteristic table
+alone (CSV or VECTO ``.vtcc``, usable by the ``table`` model and as a fitting target). The
+sections and keys are those of ``conventions.md``; each model needs only its own sections.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from .. import _core
+from ..errors import InputError, from_core
+from .characteristic import CAPACITY_KEYS, Characteristic
+from .tables import read_table
+
+MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
+
+
+# --------------------------------------------------------------------------------------------
+# TOML sections
+
+
+class _Section(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, allow_inf_nan=True, frozen=True)
+
+
+class CharacteristicSection(_Section):
+    speed_ratio: list[float]
+    torque_ratio: list[float]
+    capacity_factor_nm_s2: list[float] | None = None
+    k_factor_rpm_per_sqrt_nm: list[float] | None = None
+    k_factor_rad_s_per_sqrt_nm: list[float] | None = None
+    k_factor_rpm_per_sqrt_lbf_ft: list[float] | None = None
+    capacity_nm_per_rpm2: list[float] | None = None
+    mp1000_nm: list[float] | None = None
+
+    @model_validator(mode="after")
+    def _one_capacity(self):
+        given = [k for k in CAPACITY_KEYS if getattr(self, k) is not None]
+        if len(given) != 1:
+            raise ValueError(f"exactly one capacity key of {', '.join(CAPACITY_KEYS)}; got {given or 'none'}")
+        return self
+
+    def capacity(self) -> tuple[str, list[float]]:
+        key = next(k for k in CAPACITY_KEYS if getattr(self, k) is not None)
+        return key, getattr(self, key)
+
+
+def _positive():
+    return Field(gt=0, allow_inf_nan=False)
+
+
+class InertiaSection(_Section):
+    """Rotating inertias including the fluid carried by each element, kg·m²."""
+
+    pump_kg_m2: float = _positive()
+    turbine_kg_m2: float = _positive()
+    stator_kg_m2: float = _positive()
+
+
+def _angle():
+    return Field(gt=-90.0, lt=90.0, allow_inf_nan=False)
+
+
+def _loss():
+    return Field(ge=0.0, allow_inf_nan=False)
+
+
+class GeometrySection(_Section):
+    """Hrovat & Tobler parameters (Li & Sundén 2016, Table 2.2); angles in degrees."""
+
+    flow_area_m2: float = _positive()
+    fluid_density_kg_m3: float = _positive()
+    pump_exit_radius_m: float = _positive()
+    turbine_exit_radius_m: float = _positive()
+    stator_exit_radius_m: float = _positive()
+    pump_exit_angle_deg: float = _angle()
+    turbine_exit_angle_deg: float = _angle()
+    stator_exit_angle_deg: float = _angle()
+    pump_inlet_angle_deg: float = _angle()
+    turbine_inlet_angle_deg: float = _angle()
+    stator_inlet_angle_deg: float = _angle()
+    pump_shock_loss: float = _loss()
+    turbine_shock_loss: float = _loss()
+    stator_shock_loss: float = _loss()
+    friction_loss: float = _loss()
+    fluid_length_m: float = _positive()
+    pump_shape_effect_m2: float = Field(allow_inf_nan=False)
+    turbine_shape_effect_m2: float = Field(allow_inf_nan=False)
+    stator_shape_effect_m2: float = Field(allow_inf_nan=False)
+
+    def core_row(self) -> np.ndarray:
+        """The fifteen steady-state parameters in the core's order, angles in radians."""
+        return np.array([getattr(self, k) for k in STEADY_KEYS], dtype=float) * STEADY_SCALE
+
+
+class QuasiDynamicSection(_Section):
+    """tcsim's quasi-dynamic model (physics notes §5, docs/transient.md). The density and pump
+    radius set the Euler flow estimate; they default to the [geometry] values."""
+
+    pump_shape_effect_m2: float = Field(allow_inf_nan=False)
+    turbine_shape_effect_m2: float = Field(allow_inf_nan=False)
+    flow_time_constant_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    fluid_density_kg_m3: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    pump_exit_radius_m: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+
+
+#: Geometry keys of the steady state, in the core's parameter order (degrees in files).
+STEADY_KEYS = tuple(k.removesuffix("_rad") + "_deg" if k.endswith("_rad") else k for k in _core.ht_parameter_names())
+STEADY_SCALE = np.array([math.pi / 180.0 if k.endswith("_deg") else 1.0 for k in STEADY_KEYS])
+
+
+class ConverterFile(_Section):
+    name: str
+    source: str
+    description: str | None = None
+    characteristic: CharacteristicSection | None = None
+    inertia: InertiaSection | None = None
+    geometry: GeometrySection | None = None
+    quasi_dynamic: QuasiDynamicSection | None = None
+    #: Where each value comes from: "section.key" -> text ("assumed: ..." where assumed).
+    sources: dict[str, str] = {}
+
+
+_SECTIONS = ("characteristic", "inertia", "geometry", "quasi_dynamic")
+_REQUIRED = {
+    "table": ("characteristic",),
+    "hrovat-tobler": ("geometry",),
+    "quasi-dynamic": ("characteristic",),
+}
+
+
+# --------------------------------------------------------------------------------------------
+# the converter
+
+
+@dataclass(frozen=True)
+class Converter:
+    """A validated converter definition. ``path`` is where it was read from (for messages)."""
+
+    name: str
+    source: str
+    path: str
+    characteristic: Characteristic | None = None
+    inertia: InertiaSection | None = None
+    geometry: GeometrySection | None = None
+    quasi_dynamic: QuasiDynamicSection | None = None
+    description: str | None = None
+    sources: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def models(self) -> tuple[str, ...]:
+        """The models whose sections this converter has."""
+        return tuple(m for m in MODELS if all(getattr(self, s) is not None for s in _REQUIRED[m]))
+
+    def require(self, model: str) -> None:
+        """Raise an InputError unless the converter has the sections ``model`` needs."""
+        if model not in MODELS:
+            raise InputError("command line", "--model", model, f"one of {', '.join(MODELS)}")
+        for section in _REQUIRED[model]:
+            if getattr(self, section) is None:
+                raise InputError(self.path, f"[{section}]", "missing", f"a [{section}] section for the {model} model")
+
+    def core_geometry(self) -> np.ndarray:
+        """The geometry as a (1, 15) array for the core."""
+        self.require("hrovat-tobler")
+        assert self.geometry is not None  # require() checked it
+        return self.geometry.core_row()[None, :]
+
+    def to_toml_dict(self) -> dict[str, Any]:
+        out: dict[str, Any] = {"name": self.name, "source": self.source}
+        if self.description:
+            out["description"] = self.description
+        if self.characteristic is not None:
+            c = self.characteristic
+            out["characteristic"] = {
+                "speed_ratio": c.speed_ratio.tolist(),
+                "torque_ratio": c.torque_ratio.tolist(),
+                "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
+            }
+        for section in ("inertia", "geometry", "quasi_dynamic"):
+            model = getattr(self, section)
+            if model is not None:
+                out[section] = model.model_dump(exclude_none=True)
+        if self.sources:
+            out["sources"] = dict(self.sources)
+        return out
+
+
+def _pydantic_to_input_error(err: ValidationError, path: str) -> InputError:
+    e = err.errors()[0]
+    loc = [str(x) for x in e["loc"]]
+    if loc and loc[0] in _SECTIONS + ("sources",):
+        head = f"[{loc[0]}]"
+        rest = "".join(f"[{x}]" if x.isdigit() else f".{x}" for x in loc[1:])
+        field_name = head + rest
+    else:
+        field_name = ".".join(loc) or "(file)"
+    value = e.get("input", "")
+    msg = e["msg"].removeprefix("Input should be ")
+    if e["type"] == "extra_forbidden":
+        section = f"[{loc[0]}]" if len(loc) > 1 else "the top level"
+        msg = f"a known key of {section} (this key is unknown; conventions.md lists the keys)"
+    elif e["type"] == "missing":
+        value, msg = "missing", "this required key"
+    elif e["type"] == "value_error":
+        msg = msg.removeprefix("Value error, ")
+        value = "" if isinstance(value, dict) else value
+    if isinstance(value, (dict, list)) and len(str(value)) > 60:
+        value = f"{type(value).__name__} of {len(value)}"
+    return InputError(path, field_name, value, msg)
+
+
+def parse_converter(data: dict[str, Any], path: str) -> Converter:
+    """Validate a parsed TOML document."""
+    try:
+        doc = ConverterFile.model_validate(data)
+    except ValidationError as err:
+        raise _pydantic_to_input_error(err, path) from None
+    for key in doc.sources:
+        section, _, name = key.partition(".")
+        model = getattr(doc, section, None) if section in _SECTIONS else None
+        if model is None or name not in type(model).model_fields:
+            raise InputError(path, "[sources]", key, "a key 'section.name' naming a value of this converter")
+    characteristic = None
+    if doc.characteristic is not None:
+        key, values = doc.characteristic.capacity()
+        characteristic = Characteristic.from_columns(
+            doc.characteristic.speed_ratio, doc.characteristic.torque_ratio, values, key, path, "[characteristic]."
+        )
+    if doc.geometry is not None:
+        try:
+            _core.ht_check_geometry(doc.geometry.core_row())
+        except _core.CoreInputError as e:
+            raise from_core(e, path, "[geometry].") from None
+    return Converter(
+        doc.name,
+        doc.source,
+        path,
+        characteristic,
+        doc.inertia,
+        doc.geometry,
+        doc.quasi_dynamic,
+        doc.description,
+        dict(doc.sources),
+    )
+
+
+def read_converter_toml(path: Path) -> Converter:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(str(path), "(syntax)", str(e), "valid TOML") from None
+    conv = parse_converter(data, str(path))
+    if conv.characteristic is not None:
+        conv.characteristic.warn_if_implausible()
+    return conv
+
+
+def _bundled_dir():
+    return resources.files("tcsim") / "data" / "converters"
+
+
+def bundled_names() -> list[str]:
+    return sorted(p.name.removesuffix(".toml") for p in _bundled_dir().iterdir() if p.name.endswith(".toml"))
+
+
+def bundled_converters() -> list[Converter]:
+    return [load_converter(n) for n in bundled_names()]
+
+
+def load_converter(spec: str | Path) -> Converter:
+    """A bundled name, a converter TOML, or a characteristic table (.csv, .vtcc)."""
+    text = str(spec)
+    if isinstance(spec, str) and text in bundled_names():
+        with resources.as_file(_bundled_dir() / f"{text}.toml") as p:
+            return read_converter_toml(Path(p))
+    path = Path(spec)
+    if not path.exists():
+        raise InputError(
+            text,
+            "converter",
+            text,
+            f"a bundled converter ({', '.join(bundled_names())}) or an existing .toml, .csv or .vtcc file",
+        )
+    suffix = path.suffix.lower()
+    if suffix == ".toml":
+        return read_converter_toml(path)
+    if suffix in (".csv", ".vtcc"):
+        table = read_table(path)
+        return Converter(path.stem, f"characteristic table {path.name}", str(path), characteristic=table)
+    raise InputError(text, "file type", suffix or "(none)", "a .toml converter or a .csv/.vtcc characteristic table")

@@ -1,0 +1,97 @@
+"""Drives of the isolated converter (what the transient engine is given against time): pump torque
+and turbine speed (a), both speeds (b), pump torque against a load (c)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+#: Default width of the smoothing window of measured-speed derivatives, s (see docs/transient.md).
+DERIVATIVE_WINDOW_S = 0.04
+
+
+# ---------------------------------------------------------------------------------------------
+# Drives
+
+
+def _arr(x: Any) -> list[float] | float:
+    if np.isscalar(x):
+        return float(x)  # type: ignore[arg-type]  # a real scalar; complex inputs are not drives
+    return np.asarray(x, dtype=float).tolist()
+
+
+@dataclass(frozen=True)
+class PumpTorqueTurbineSpeed:
+    """Drive (a), the thesis/VSIM causality: pump torque and turbine speed given (time series);
+    pump speed and turbine torque come out. The turbine speed's derivative is smoothed over
+    ``derivative_window_s`` (local least-squares slope)."""
+
+    time_s: ArrayLike
+    pump_torque_nm: ArrayLike
+    turbine_speed_rad_s: ArrayLike
+    derivative_window_s: float = DERIVATIVE_WINDOW_S
+
+    def spec(self) -> dict[str, Any]:
+        return {
+            "kind": "pump-torque-turbine-speed",
+            "time_s": _arr(self.time_s),
+            "pump_torque_nm": _arr(self.pump_torque_nm),
+            "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
+            "derivative_window_s": self.derivative_window_s,
+        }
+
+
+@dataclass(frozen=True)
+class Speeds:
+    """Drive (b): pump and turbine speeds given; the torques come out."""
+
+    time_s: ArrayLike
+    pump_speed_rad_s: ArrayLike
+    turbine_speed_rad_s: ArrayLike
+    derivative_window_s: float = DERIVATIVE_WINDOW_S
+
+    def spec(self) -> dict[str, Any]:
+        return {
+            "kind": "speeds",
+            "time_s": _arr(self.time_s),
+            "pump_speed_rad_s": _arr(self.pump_speed_rad_s),
+            "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
+            "derivative_window_s": self.derivative_window_s,
+        }
+
+
+@dataclass(frozen=True)
+class PumpTorqueLoad:
+    """Drive (c): pump torque given; the turbine drives a load inertia against
+    ``load_torque_nm + load_drag_nm_s2·ω_t|ω_t|``. Both speeds come out."""
+
+    time_s: ArrayLike
+    pump_torque_nm: ArrayLike
+    load_inertia_kg_m2: float
+    load_torque_nm: ArrayLike = 0.0
+    load_drag_nm_s2: float = 0.0
+
+    def spec(self) -> dict[str, Any]:
+        return {
+            "kind": "pump-torque-load",
+            "time_s": _arr(self.time_s),
+            "pump_torque_nm": _arr(self.pump_torque_nm),
+            "load_torque_nm": _arr(self.load_torque_nm),
+            "load_inertia_kg_m2": float(self.load_inertia_kg_m2),
+            "load_drag_nm_s2": float(self.load_drag_nm_s2),
+        }
+
+
+Drive = PumpTorqueTurbineSpeed | Speeds | PumpTorqueLoad
+
+
+def isolated_takeoff(tip_out: bool = False) -> PumpTorqueLoad:
+    """The isolated take-off of the tests and benchmarks (drive c), 0–10 s: pump torque 40 N·m,
+    ramped to 250 N·m over 0.1–0.3 s (with ``tip_out``, down to −30 N·m over 5.0–5.1 s); the
+    turbine drives 1.2 kg·m² against 10 N·m and 0.002 N·m/(rad/s)²."""
+    t = [0.0, 0.1, 0.3] + ([5.0, 5.1] if tip_out else []) + [10.0]
+    tp = [40.0, 40.0, 250.0] + ([250.0, -30.0, -30.0] if tip_out else [250.0])
+    return PumpTorqueLoad(np.array(t), np.array(tp), load_inertia_kg_m2=1.2, load_torque_nm=10.0, load_drag_nm_s2=0.002)

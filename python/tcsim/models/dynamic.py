@@ -1,0 +1,174 @@
+"""Dynamic converter models for the transient engine: :class:`DynamicModel` (the core's spec of one
+model of one converter), :func:`dynamic_model`, :func:`resolve_model` and :func:`select_models`.
+See ``docs/transient.md``."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any
+
+import numpy as np
+
+from .. import _core
+from ..errors import InputError
+from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
+from .converter import MODELS, Converter, load_converter
+
+#: Pump speed at which the default quasi-dynamic flow time constant is evaluated (stall), rad/s.
+FLOW_TIME_CONSTANT_PUMP_SPEED_RAD_S = DEFAULT_PUMP_SPEED_RPM * RAD_S_PER_RPM
+
+
+# ---------------------------------------------------------------------------------------------
+# Models
+
+
+@dataclass(frozen=True)
+class DynamicModel:
+    """A converter model ready for the transient engine.
+
+    ``spec`` is the dict the core takes; ``source`` names the converter file for messages.
+    """
+
+    name: str
+    spec: dict[str, Any]
+    source: str
+
+    @property
+    def shape_effect_m2(self) -> tuple[float, ...]:
+        """The shape effects (pump, turbine[, stator]); empty for the table model."""
+        return tuple(self.spec.get("shape_effect_m2", ()))
+
+    def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:
+        """The same model with other shape effects (eqs 2.16–2.18 sign convention)."""
+        if self.name == "table":
+            raise ValueError("the table model has no shape effects")
+        shape = [pump_m2, turbine_m2]
+        if self.name == "hrovat-tobler":
+            shape.append(self.shape_effect_m2[2] if stator_m2 is None else stator_m2)
+        return replace(self, spec={**self.spec, "shape_effect_m2": [float(s) for s in shape]})
+
+
+def _require(conv: Converter, section: str, model: str) -> Any:
+    value = getattr(conv, section)
+    if value is None:
+        raise InputError(conv.path, f"[{section}]", "missing", f"a [{section}] section for the transient {model} model")
+    return value
+
+
+def _table_spec(conv: Converter) -> dict[str, Any]:
+    c = conv.characteristic
+    assert c is not None  # the caller's conv.require(model) checked it
+    return {
+        "speed_ratio": c.speed_ratio.tolist(),
+        "torque_ratio": c.torque_ratio.tolist(),
+        "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
+    }
+
+
+def _inertia(conv: Converter, model: str) -> list[float]:
+    i = _require(conv, "inertia", model)
+    return [i.pump_kg_m2, i.turbine_kg_m2, i.stator_kg_m2]
+
+
+def default_flow_time_constant_s(conv: Converter) -> float:
+    """Default τ_Q of the quasi-dynamic model: the fluid's inertance over the slope of the net head
+    with respect to the flow, ``τ_Q = (ρL_f/A) / |∂F_Q/∂Q|``, for the Hrovat & Tobler geometry at
+    stall (locked stator) and 2000 rpm pump speed (physics notes §5). It scales as 1/ω_p."""
+    g = _require(conv, "geometry", "quasi-dynamic (default flow time constant)")
+    wp = FLOW_TIME_CONSTANT_PUMP_SPEED_RAD_S
+    flow = float(_core.ht_steady_states(conv.core_geometry(), np.array([wp]), np.array([0.0]))["flow_m3_s"][0])
+    rad = math.pi / 180.0
+    tp, tt, ts = (math.tan(getattr(g, f"{e}_exit_angle_deg") * rad) for e in ("pump", "turbine", "stator"))
+    tpp, ttt, tss = (math.tan(getattr(g, f"{e}_inlet_angle_deg") * rad) for e in ("pump", "turbine", "stator"))
+    rp, rs = g.pump_exit_radius_m, g.stator_exit_radius_m
+    q = flow / g.flow_area_m2
+    # ∂/∂q of eq 2.15's right-hand side divided by ρ, at ω_t = ω_s = 0 (dhead/dq and shock/friction)
+    slope = wp * (rp * tp - rs * ts) - (
+        g.pump_shock_loss * (-rs * wp + q * (ts - tpp)) * (ts - tpp)
+        + g.turbine_shock_loss * (rp * wp + q * (tp - ttt)) * (tp - ttt)
+        + g.stator_shock_loss * q * (tt - tss) ** 2
+        + g.friction_loss * (3 + tp * tp + tt * tt + ts * ts) * q
+    )
+    return g.fluid_length_m / abs(slope)
+
+
+def dynamic_model(converter: Converter | str, model: str = "hrovat-tobler") -> DynamicModel:
+    """The transient model ``model`` of a converter (a :class:`Converter`, bundled name or file).
+
+    * ``table``: [characteristic] and [inertia];
+    * ``hrovat-tobler``: [geometry] (with fluid length and shape effects) and [inertia];
+    * ``quasi-dynamic``: [characteristic], [inertia] and [quasi_dynamic]; the fluid density and
+      pump radius come from [quasi_dynamic] or else [geometry], and τ_Q from
+      ``flow_time_constant_s`` or else :func:`default_flow_time_constant_s`.
+    """
+    conv = converter if isinstance(converter, Converter) else load_converter(converter)
+    conv.require(model)
+    spec: dict[str, Any] = {"kind": model, "inertia_kg_m2": _inertia(conv, model)}
+    if model == "table":
+        spec.update(_table_spec(conv))
+    elif model == "hrovat-tobler":
+        g = conv.geometry
+        assert g is not None  # conv.require(model) checked it
+        spec.update(
+            geometry=conv.core_geometry()[0].tolist(),
+            fluid_length_m=g.fluid_length_m,
+            shape_effect_m2=[g.pump_shape_effect_m2, g.turbine_shape_effect_m2, g.stator_shape_effect_m2],
+        )
+    else:
+        qd = _require(conv, "quasi_dynamic", model)
+        spec.update(_table_spec(conv))
+        spec["shape_effect_m2"] = [qd.pump_shape_effect_m2, qd.turbine_shape_effect_m2]
+        for key in ("fluid_density_kg_m3", "pump_exit_radius_m"):
+            value = getattr(qd, key, None)
+            if value is None:
+                value = getattr(_require(conv, "geometry", f"quasi-dynamic ({key} is not in [quasi_dynamic])"), key)
+            spec[key] = value
+        tau = qd.flow_time_constant_s
+        spec["flow_time_constant_s"] = tau if tau is not None else default_flow_time_constant_s(conv)
+    return DynamicModel(model, spec, conv.path)
+
+
+def resolve_model(
+    converter: Converter | str | DynamicModel | None,
+    model: str | DynamicModel,
+    allowed: Sequence[str] = MODELS,
+    why: str = "",
+) -> DynamicModel:
+    """A :class:`DynamicModel` given directly (as ``model``, or as ``converter``), or the model named
+    ``model`` of ``converter`` (a :class:`Converter`, bundled name or file). A model outside
+    ``allowed`` is an InputError on ``--model`` (``why`` explains the restriction)."""
+    expected = f"one of {', '.join(allowed)}{why}"
+    if isinstance(model, DynamicModel):
+        m = model
+    elif isinstance(converter, DynamicModel):
+        m = converter
+    else:
+        if model not in allowed:
+            raise InputError("command line", "--model", model, expected)
+        if converter is None:
+            raise InputError("command line", "converter", "none", "a converter (or a DynamicModel as the model)")
+        m = dynamic_model(converter, model)
+    if m.name not in allowed:
+        raise InputError("command line", "--model", m.name, expected)
+    return m
+
+
+def select_models(converter: Any, requested: Sequence[str]) -> list[DynamicModel]:
+    """The transient models to run: those requested (each must be buildable), or by default every
+    model of ``converter.models`` whose transient sections are present (at least one)."""
+    for name in requested:
+        if name not in MODELS:
+            raise InputError("command line", "--model", name, f"one of {', '.join(MODELS)}")
+    if requested:
+        return [dynamic_model(converter, m) for m in dict.fromkeys(requested)]
+    models, first_error = [], None
+    for name in converter.models:
+        try:
+            models.append(dynamic_model(converter, name))
+        except InputError as e:
+            first_error = first_error or e
+    if not models:
+        raise first_error or InputError(converter.path, "(models)", "none", f"sections for one of {', '.join(MODELS)}")
+    return models

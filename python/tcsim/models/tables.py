@@ -1,0 +1,123 @@
+"""Characteristic tables from text files: tcsim CSV (six capacity conventions) and VECTO .vtcc.
+
+CSV: a header with ``speed_ratio``, ``torque_ratio`` and exactly one capacity column
+(``capacity_factor_nm_s2``, ``k_factor_rpm_per_sqrt_nm``, ``k_factor_rad_s_per_sqrt_nm``,
+``k_factor_rpm_per_sqrt_lbf_ft``, ``capacity_nm_per_rpm2`` or ``mp1000_nm``); lines starting
+with ``#`` are comments.
+
+VECTO ``.vtcc`` (VECTO's torque-converter characteristic): a header such as
+``Speed Ratio, Torque Ratio,MP1000`` and three columns, speed ratio, torque ratio and the input
+torque at 1000 rpm input speed in N·m (negative in overrun); ``#`` starts a comment.
+"""
+
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+from ..errors import InputError
+from .characteristic import CAPACITY_KEYS, Characteristic
+
+
+def _rows(path: Path) -> list[tuple[int, list[str]]]:
+    """Non-empty, non-comment rows with their 1-based line numbers."""
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 text file ({e})") from None
+    out = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        stripped = line.strip()
+        if not stripped or stripped.startswith("#"):
+            continue
+        out.append((lineno, [c.strip() for c in next(csv.reader([stripped]))]))
+    if not out:
+        raise InputError(str(path), "(file)", "no data", "a header line and at least two rows")
+    return out
+
+
+def _number(path: Path, lineno: int, column: str, text: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise InputError(str(path), f"line {lineno}, {column}", text, "a number") from None
+
+
+def _columns(path: Path, rows, names: list[str]):
+    cols: dict[str, list[float]] = {n: [] for n in names}
+    lines = []
+    for lineno, cells in rows:
+        if len(cells) != len(names):
+            raise InputError(
+                str(path),
+                f"line {lineno}",
+                ",".join(cells),
+                f"{len(names)} comma-separated values ({', '.join(names)})",
+            )
+        for n, c in zip(names, cells):
+            cols[n].append(_number(path, lineno, n, c))
+        lines.append(lineno)
+    return cols, lines
+
+
+def read_table_csv(path: Path) -> Characteristic:
+    rows = _rows(path)
+    header_line, header = rows[0]
+    for required in ("speed_ratio", "torque_ratio"):
+        if required not in header:
+            raise InputError(str(path), f"line {header_line} (header)", ",".join(header), f"a {required} column")
+    capacity = [h for h in header if h in CAPACITY_KEYS]
+    unknown = [h for h in header if h not in CAPACITY_KEYS and h not in ("speed_ratio", "torque_ratio")]
+    if unknown:
+        raise InputError(
+            str(path),
+            f"line {header_line} (header)",
+            unknown[0],
+            f"only speed_ratio, torque_ratio and one capacity column of {', '.join(CAPACITY_KEYS)}",
+        )
+    if len(capacity) != 1:
+        raise InputError(
+            str(path),
+            f"line {header_line} (header)",
+            ",".join(header),
+            f"exactly one capacity column of {', '.join(CAPACITY_KEYS)}",
+        )
+    cols, lines = _columns(path, rows[1:], header)
+    table = Characteristic.from_columns(
+        cols["speed_ratio"], cols["torque_ratio"], cols[capacity[0]], capacity[0], str(path), rows=lines
+    )
+    table.warn_if_implausible()
+    return table
+
+
+def read_vtcc(path: Path) -> Characteristic:
+    rows = _rows(path)
+    header_line, header = rows[0]
+    names = ["speed_ratio", "torque_ratio", "mp1000_nm"]
+    try:
+        [float(c) for c in header]
+        data = rows  # no header line
+    except ValueError:
+        low = [h.lower() for h in header]
+        if len(header) != 3 or "speed" not in low[0] or "torque" not in low[1]:
+            raise InputError(
+                str(path),
+                f"line {header_line} (header)",
+                ",".join(header),
+                "the VECTO header 'Speed Ratio, Torque Ratio, MP1000'",
+            ) from None
+        data = rows[1:]
+    cols, lines = _columns(path, data, names)
+    table = Characteristic.from_columns(
+        cols["speed_ratio"], cols["torque_ratio"], cols["mp1000_nm"], "mp1000_nm", str(path), rows=lines
+    )
+    table.warn_if_implausible()
+    return table
+
+
+def read_table(path: str | Path) -> Characteristic:
+    """Read a characteristic table, CSV or VECTO .vtcc by extension."""
+    path = Path(path)
+    if path.suffix.lower() == ".vtcc":
+        return read_vtcc(path)
+    return read_table_csv(path)

@@ -1,0 +1,69 @@
+"""Figures: steady-state characteristics (thesis figures 3.3, 3.4, C.1, C.2)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from ..models.characteristic import Characteristic
+from .common import plt
+
+QUANTITIES = {
+    "torque_ratio": ("Torque ratio [-]", "torque_ratio.png"),
+    "capacity_factor_nm_s2": ("Capacity factor [N·m/(rad/s)²]", "capacity_factor.png"),
+    "k_factor_rpm_per_sqrt_nm": ("K-factor [rpm/√(N·m)]", "k_factor.png"),
+    "efficiency": ("Efficiency [-]", "efficiency.png"),
+}
+
+
+def table_columns(table: Characteristic) -> pd.DataFrame:
+    sr, tr, cf = table.arrays()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        k = _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(cf))
+    return pd.DataFrame(
+        {
+            "speed_ratio": sr,
+            "torque_ratio": tr,
+            "capacity_factor_nm_s2": cf,
+            "k_factor_rpm_per_sqrt_nm": k,
+            "efficiency": tr * sr,
+        }
+    )
+
+
+def plot_characteristic(
+    curves: dict[str, pd.DataFrame],
+    out_dir: Path,
+    title: str,
+    table: Characteristic | None = None,
+    table_label: str = "Manufacturer table",
+    coupling_point: float | None = None,
+) -> list[Path]:
+    """One PNG per quantity against SR; model curves as lines, the table as markers beside them."""
+    ref = table_columns(table) if table is not None else None
+    paths = []
+    for column, (label, filename) in QUANTITIES.items():
+        fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+        for name, df in curves.items():
+            y = df[column].to_numpy(dtype=float)
+            ax.plot(df["speed_ratio"], np.where(np.isfinite(y), y, np.nan), label=name)
+        if ref is not None:
+            y = ref[column].to_numpy(dtype=float)
+            ax.plot(
+                ref["speed_ratio"], np.where(np.isfinite(y), y, np.nan), "o", mfc="none", color="k", label=table_label
+            )
+        if coupling_point is not None:
+            ax.axvline(coupling_point, color="0.6", ls=":", lw=1, label=f"coupling point SR {coupling_point:.3f}")
+        ax.set_xlabel("Speed ratio [-]")
+        ax.set_ylabel(label)
+        ax.set_title(title)
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize="small")
+        path = out_dir / filename
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+        paths.append(path)
+    return paths

@@ -1,0 +1,105 @@
+"""What the commands print: the launch and replay tables (rich), the study's line, and the progress
+display of long runs (on stderr, silent when stderr is not a terminal)."""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from rich.console import Console, Group
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, SpinnerColumn, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from ..analysis.launch import Launch
+from ..analysis.replay import Replay
+from ..analysis.study import StudyDefinition
+from .format import fmt_number
+
+
+@contextlib.contextmanager
+def progress_display(enabled: bool) -> Iterator[Progress]:
+    """A rich progress display on stderr; silent when stderr is not a terminal."""
+    console = Console(stderr=True)
+    with Progress(
+        SpinnerColumn(),
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+        disable=not (enabled and console.is_terminal),
+    ) as progress:
+        yield progress
+
+
+def launch_report(result: Launch, out: Path) -> Group:
+    """A rich table of the launch summary and where the files are."""
+    s = result.scenario
+    table = Table(
+        title=f"launch of {result.vehicle.name} ({result.vehicle.converter.name}), scenario {s.name}, "
+        f"brake release at {s.brake_release_time_s:g} s"
+    )
+    for col in (
+        "model",
+        "0–50 km/h [s]",
+        "0–100 km/h [s]",
+        "peak accel [m/s²]",
+        "mean accel first 0.5 s [m/s²]",
+        "min eff. TR first 0.5 s",
+    ):
+        table.add_column(col)
+    reached = {"missing": "not reached"}
+    for _, r in result.summary.iterrows():
+        table.add_row(
+            r["model"],
+            fmt_number(r["time_0_50_km_h_s"], ".2f", **reached),
+            fmt_number(r["time_0_100_km_h_s"], ".2f", **reached),
+            fmt_number(r["peak_accel_m_s2"], ".2f", **reached),
+            fmt_number(r["mean_accel_first_0_5_s_m_s2"], ".2f", **reached),
+            fmt_number(r["min_effective_torque_ratio_first_0_5_s"], ".3f", **reached),
+        )
+    lines = [
+        f"compute {result.compute_s * 1e3:.0f} ms for {len(result.runs)} models"
+        + (f", sweep {result.sweep_compute_s * 1e3:.0f} ms" if result.sweep is not None else ""),
+        f"written to {out}/: summary.csv, {', '.join(f'{m}.csv' for m in result.runs)}, timeseries.csv, "
+        f"events.csv, scenario.csv{', shape_sweep*.csv' if result.sweep is not None else ''} and plots",
+    ]
+    return Group(table, *lines)
+
+
+def replay_report(replay: Replay, out: Path) -> Group:
+    """A short rich summary: per model the events and the turbine-torque RMSE, then where the files are."""
+    table = Table(
+        title=f"replay of {replay.measurement.source} on {replay.converter}, drive {replay.drive.name}, "
+        f"{len(replay.measurement.time_s)} samples"
+    )
+    for col in ("model", "events", "turbine torque RMSE [N·m]", "NRMSE"):
+        table.add_column(col)
+    metrics = replay.metrics
+    rows = metrics[(metrics["channel"] == "turbine_torque_nm") & (metrics["window"] == "all")]
+    for name, result in replay.results.items():
+        events = ", ".join(f"{e.kind} {e.time_s:.3f} s" for e in result.events) or "none"
+        row = rows[rows["model"] == name]
+        rmse, nrmse = (f"{row[c].iloc[0]:.4g}" for c in ("rmse", "nrmse")) if len(row) else ("n/a", "n/a")
+        table.add_row(name, events, rmse, nrmse)
+    return Group(
+        table,
+        f"written to {out}/: {', '.join(f'{m}.csv' for m in replay.results)}, events.csv, "
+        f"measurement.csv{', metrics.csv' if len(metrics) else ''} and plots",
+    )
+
+
+def study_line(df: pd.DataFrame, definition: StudyDefinition, out: Path) -> str:
+    """The one line ``tcsim study`` prints."""
+    n_values = df.groupby("parameter", sort=False)["parameter_value"].nunique().sum()
+    solved = int(np.isfinite(df["torque_ratio"]).sum())
+    free = int(df["stator_mode"].isin(["free-wheeling", "no-flow"]).sum())
+    return (
+        f"study: {len(definition.parameters)} parameters, {n_values} values, {len(df)} points "
+        f"({solved} with a steady state, {free} of them past the coupling point) written to {out}/study.csv "
+        f"and {len(definition.parameters)} figures"
+    )

@@ -1,0 +1,146 @@
+"""Transient simulation of an isolated converter: models, drives, one-line and batch runs.
+
+The engine is the Rust core's (:mod:`tcsim._core`): diffsol's BDF solver on the models in
+mass-matrix form, with root finding for the stator one-way clutch and for flow reversal.
+See ``docs/transient.md`` for the equations, events and conventions.
+
+API tiers (after FMPy):
+
+* one line: :func:`simulate` (a converter, a model name and a drive → :class:`TransientResult`);
+* reusable objects: :func:`dynamic_model` → :class:`DynamicModel` (with
+  :meth:`DynamicModel.with_shape_effects` for sweeps), drives :class:`PumpTorqueTurbineSpeed`,
+  :class:`Speeds`, :class:`PumpTorqueLoad`;
+* batch: :func:`simulate_batch`, N models × one drive, one model × N drives, or N pairs, with the
+  GIL released and one worker per core;
+* raw: ``tcsim._core.transient_runs`` with the dicts of :meth:`DynamicModel.spec` and ``Drive.spec``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from ..errors import InputError, core_value
+from ..models.converter import Converter
+from ..models.drives import Drive
+from ..models.dynamic import DynamicModel, dynamic_model
+
+COLUMNS: tuple[str, ...] = tuple(_core.transient_columns())
+
+
+class SolverError(RuntimeError):
+    """The solver failed (not the user's fault): the message gives the time and the state."""
+
+
+# ---------------------------------------------------------------------------------------------
+# Runs
+
+
+@dataclass(frozen=True)
+class Event:
+    time_s: float
+    kind: str  # stator-release, stator-lock, flow-zero, flow-start
+    stator_locked: bool
+    flow_direction: float  # after the event: +1, −1, 0 (held at zero)
+
+
+@dataclass
+class TransientResult:
+    """Columns of a run (SI, names per conventions.md; see :data:`COLUMNS`) and its events."""
+
+    model: str
+    columns: dict[str, np.ndarray]
+    events: list[Event] = field(default_factory=list)
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        return self.columns[name]
+
+    def frame(self) -> pd.DataFrame:
+        """The columns as a DataFrame, without the all-NaN columns of coordinates the model lacks."""
+        df = pd.DataFrame(self.columns)
+        return df.loc[:, df.notna().any() | (df.columns == "time_s")]
+
+
+def _options(rtol: float | None, **extra) -> dict[str, Any]:
+    o = dict(extra)
+    if rtol is not None:
+        o["rtol"] = rtol
+    return o
+
+
+def _unpack(entry, model: DynamicModel, index: int | None) -> TransientResult:
+    status = entry[0]
+    where = "" if index is None else f" (run {index})"
+    if status == "ok":
+        _, cols, events = entry
+        return TransientResult(model.name, dict(cols), [Event(*e) for e in events])
+    if status == "input":
+        _, _msg, fld, value, expected = entry
+        raise InputError(model.source, fld + where, core_value(value), expected)
+    raise SolverError(f"{model.name}{where}: {entry[1]}")
+
+
+def _initial(initial: dict[str, float] | None) -> dict[str, float] | None:
+    allowed = {"pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s"}
+    if initial:
+        bad = set(initial) - allowed
+        if bad:
+            raise InputError(
+                "initial state", sorted(bad)[0], initial[sorted(bad)[0]], f"one of {', '.join(sorted(allowed))}"
+            )
+    return initial
+
+
+def simulate(
+    converter: Converter | str | DynamicModel,
+    drive: Drive,
+    model: str = "hrovat-tobler",
+    times_s: Sequence[float] | None = None,
+    initial: dict[str, float] | None = None,
+    rtol: float | None = None,
+    **solver_options,
+) -> TransientResult:
+    """Run one model under one drive; samples at ``times_s`` (default: the drive's time stamps).
+
+    The initial state is the steady state consistent with the first input sample (drive c: with
+    the turbine at rest) unless ``initial`` gives ``pump_speed_rad_s``, ``turbine_speed_rad_s``,
+    ``stator_speed_rad_s`` or ``flow_m3_s``.
+    """
+    m = converter if isinstance(converter, DynamicModel) else dynamic_model(converter, model)
+    return simulate_batch([m], [drive], times_s, initial, rtol, threads=1, **solver_options)[0]
+
+
+def simulate_batch(
+    models: Sequence[DynamicModel],
+    drives: Sequence[Drive],
+    times_s: Sequence[float] | None = None,
+    initial: dict[str, float] | None = None,
+    rtol: float | None = None,
+    threads: int = 0,
+    **solver_options,
+) -> list[TransientResult]:
+    """Run ``models[i]`` under ``drives[i]``; a sequence of length one is broadcast. The runs go to
+    the core in one call, which releases the GIL and uses ``threads`` workers (0: all cores).
+    Raises :class:`InputError` or :class:`SolverError` for the first run that fails."""
+    specs = []
+    for d in drives:
+        s = d.spec()
+        if times_s is not None:
+            s["output_time_s"] = np.asarray(times_s, dtype=float).tolist()
+        specs.append(s)
+    try:
+        raw = _core.transient_runs(
+            [m.spec for m in models], specs, _initial(initial), _options(rtol, **solver_options), threads
+        )
+    except _core.CoreInputError as e:
+        _msg, fld, value, expected = e.args
+        raise InputError(
+            models[0].source if len(models) == 1 else "model or drive", fld, core_value(value), expected
+        ) from None
+    n = len(raw)
+    return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None) for i, r in enumerate(raw)]
