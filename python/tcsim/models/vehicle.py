@@ -155,7 +155,11 @@ def read_vehicle_text(text: str, path: str) -> Vehicle:
 
 def parse_vehicle(data: dict[str, Any], path: str) -> Vehicle:
     """A parsed TOML document (written back as TOML and read by the core)."""
-    return read_vehicle_text(tomli_w.dumps(data), path)
+    try:
+        text = tomli_w.dumps(data)
+    except TypeError as e:  # a value TOML cannot hold (None, an object)
+        raise InputError(path, "(file)", type(e).__name__, f"a TOML document ({e})") from None
+    return read_vehicle_text(text, path)
 
 
 def read_vehicle_toml(path: Path) -> Vehicle:

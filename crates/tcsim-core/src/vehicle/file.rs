@@ -429,7 +429,7 @@ fn show(v: &toml::Value) -> String {
                 format!("an array of {} values", a.len())
             }
         }
-        toml::Value::Table(t) => format!("a table of {} keys", t.len()),
+        toml::Value::Table(t) => format!("a table of {} key{}", t.len(), if t.len() == 1 { "" } else { "s" }),
     }
 }
 
@@ -619,7 +619,7 @@ mod tests {
         assert_eq!(e.field, "[engine].inertia_kgm2");
         assert!(e.expected.contains("a known key of [engine]: inertia_kg_m2,"), "{e}");
         let e = error(&format!("{SEDAN}\n[turbo]\nlag_s = 1.0\n"));
-        assert_eq!((e.field.as_str(), e.value.as_str()), ("[turbo]", "a table of 1 keys"));
+        assert_eq!((e.field.as_str(), e.value.as_str()), ("[turbo]", "a table of 1 key"));
         assert!(e.expected.contains("the top level"), "{e}");
         let e = error(&edited("body", "mass_kg", ""));
         assert_eq!(

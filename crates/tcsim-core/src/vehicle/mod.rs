@@ -21,8 +21,8 @@
 //! kinetic energy it removes is booked as a clutch loss, so the energy balance closes exactly.
 //! Equations and parameters: docs/vehicle.md.
 //!
-//! * [`file`]: the vehicle file's schema (TOML), read once into the parameters, errors named as
-//!   the file names its fields.
+//! * [`file`](mod@file): the vehicle file's schema (TOML), read once into the parameters, errors
+//!   named as the file names its fields.
 //! * [`parameters`]: the vehicle's parameters and scenario, with their one validation.
 //! * [`components`]: the physics of engine, gearbox, lock-up, driveline, tyres, body and brake.
 //! * [`modes`]: the discrete state (gear, shift, lock-up, brake hold) and the event kinds.
