@@ -75,3 +75,28 @@ def launch_runs(
     options: dict[str, Any] | None = None,
     threads: int = 0,
 ) -> list[_RunEntry]: ...
+
+# The FMU's variable table (crates/tcsim-fmu/src/variables.rs, bound in crates/tcsim-py/src/fmu.rs)
+
+#: ``modelIdentifier`` of the FMU.
+FMU_MODEL_IDENTIFIER: str
+#: Value reference of the first tunable parameter.
+FMU_FIRST_PARAMETER_VR: int
+
+def fmu_variables(spec: dict[str, Any], causality: str) -> list[dict[str, Any]]:
+    """The FMU's variables of a model specification (its ``kind`` is the model) under a causality,
+    in ``<ModelVariables>`` order: ``vr``, ``name``, ``causality``, ``variability``, ``initial``,
+    ``unit``, ``display_unit``, ``description``, ``start``, ``start_text``, ``derivative_of``,
+    ``dependencies``, ``key``, ``index``."""
+
+def fmu_signals() -> list[dict[str, Any]]:
+    """The signals by value reference: ``vr``, ``name``, ``unit``, ``description``, ``models``, ``state``."""
+
+def fmu_causalities() -> list[tuple[str, list[str]]]:
+    """The ``--causality`` choices with the names of their two inputs."""
+
+def fmu_event_indicators(model: str) -> int:
+    """``numberOfEventIndicators`` of the FMU of a model kind."""
+
+def fmu_units() -> list[tuple[str, list[tuple[str, int]], list[tuple[str, str]]]]:
+    """``<UnitDefinitions>``: name, SI base-unit exponents, display units with their factors as text."""

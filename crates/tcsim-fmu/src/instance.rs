@@ -7,39 +7,17 @@ use tcsim_core::converter::dynamics::FLOW;
 use tcsim_core::converter::spec::{build_model, ModelSpec};
 use tcsim_core::engine::converter_events::{Mode, Sample};
 use tcsim_core::engine::isolated::{initial_mode, initial_state, Drive, InitialState};
-use tcsim_core::engine::mode_view::{ModeView, EVENT_INDICATORS};
+use tcsim_core::engine::mode_view::ModeView;
 use tcsim_core::engine::options::SolverOptions;
 use tcsim_core::engine::outputs::{row, COLUMNS};
 use tcsim_core::engine::signal::Signal;
 use tcsim_core::engine::stepper::{Causality, Stepper};
 use tcsim_core::CoreResult;
 
-/// Value references of the signals, fixed whatever the causality; 12 and 13 are the rates of the
-/// speed inputs (Model Exchange), 20 + c the derivative of state coordinate c.
-pub const SIGNALS: [&str; 14] = [
-    "pump_torque_nm",
-    "pump_speed_rad_s",
-    "turbine_speed_rad_s",
-    "turbine_torque_nm",
-    "speed_ratio",
-    "torque_ratio",
-    "flow_m3_s",
-    "stator_speed_rad_s",
-    "stator_torque_nm",
-    "effective_pump_torque_nm",
-    "effective_turbine_torque_nm",
-    "effective_torque_ratio",
-    "pump_accel_rad_s2",
-    "turbine_accel_rad_s2",
-];
-/// Value reference of the derivative of coordinate 0 (pump speed); + 2 stator speed, + 3 flow.
-pub const FIRST_DERIVATIVE: u32 = 20;
-/// Value reference of the first parameter.
-pub const FIRST_PARAMETER: u32 = 100;
-/// Start-value parameters: 30 `start_from_steady_state` (1: the steady state consistent with the
-/// inputs, as `tcsim replay`; 0: the values below), 31 `initial_pump_speed_rad_s`,
-/// 32 `initial_stator_speed_rad_s`, 33 `initial_flow_m3_s`.
-pub const START_PARAMETERS: std::ops::Range<u32> = 30..34;
+use crate::variables::{
+    self, causality_of, is_derivative, is_input, signal_name, start_parameter, vr, Model, FIRST_DERIVATIVE,
+    FIRST_PARAMETER, RATES, SIGNALS, SIGNAL_SLOTS, START_PARAMETERS,
+};
 
 /// A parameter: the spec entry `model[key]` (scalar) or `model[key][index]`.
 #[derive(Debug, Clone)]
@@ -71,9 +49,10 @@ impl Configuration {
     pub fn parse(text: &str) -> Result<Self, String> {
         let doc: Value = serde_json::from_str(text).map_err(|e| format!("model.json: {e}"))?;
         let causality = match doc.get("causality").and_then(Value::as_str) {
-            Some("pump-torque") | None => Causality::PumpTorqueTurbineSpeed,
-            Some("speeds") => Causality::Speeds,
-            Some(other) => return Err(format!("model.json: causality {other:?}: expected pump-torque or speeds")),
+            None => Causality::PumpTorqueTurbineSpeed,
+            Some(name) => {
+                causality_of(name).ok_or(format!("model.json: causality {name:?}: expected pump-torque or speeds"))?
+            }
         };
         let model = doc.get("model").and_then(Value::as_object).cloned().ok_or("model.json: no \"model\" object")?;
         let mut parameters = Vec::new();
@@ -127,13 +106,13 @@ pub struct Instance {
     pub options: SolverOptions,
     pub start_time: f64,
     /// Signal values by value reference (inputs as set, outputs as computed).
-    pub signals: [f64; 14],
+    pub signals: [f64; SIGNAL_SLOTS],
     /// Input rates given with `fmi2SetRealInputDerivatives` for the coming step.
-    rates: [Option<f64>; 14],
+    rates: [Option<f64>; SIGNAL_SLOTS],
     /// Model Exchange: the model, all coordinates, the mode and the time.
     me: Option<ModelExchange>,
-    /// Values of the start-value parameters (value references 30–33).
-    start: [f64; 4],
+    /// Values of the start-value parameters ([`START_PARAMETERS`], value references 30–33).
+    start: [f64; START_PARAMETERS.len()],
     /// Inputs at the previous communication point, for the rate estimate.
     previous: Option<(f64, [f64; 2])>,
     stepper: Option<Stepper<Box<dyn ConverterDynamics + Send>>>,
@@ -146,20 +125,24 @@ pub struct Instance {
 
 impl Instance {
     pub fn new(config: Configuration) -> Self {
-        let mut signals = [f64::NAN; 14];
-        signals[0] = 50.0;
-        signals[1] = 150.0;
-        signals[2] = 0.0;
-        signals[12] = 0.0;
-        signals[13] = 0.0;
+        // the start values of the table: the inputs' (whatever the causality) and the rates'
+        let mut signals = [f64::NAN; SIGNAL_SLOTS];
+        for s in &SIGNALS {
+            if let Some(start) = s.start {
+                signals[s.vr as usize] = start;
+            }
+        }
+        for r in &RATES {
+            signals[r.vr as usize] = variables::RATE_START;
+        }
         Self {
             config,
             options: SolverOptions::default(),
             start_time: 0.0,
             signals,
-            rates: [None; 14],
+            rates: [None; SIGNAL_SLOTS],
             me: None,
-            start: [1.0, 150.0, 0.0, 0.05],
+            start: START_PARAMETERS.map(|s| s.start),
             previous: None,
             stepper: None,
             rebuild: false,
@@ -170,15 +153,12 @@ impl Instance {
 
     /// The value references of the two inputs.
     pub fn input_refs(&self) -> [usize; 2] {
-        match self.config.causality {
-            Causality::PumpTorqueTurbineSpeed => [0, 2],
-            Causality::Speeds => [1, 2],
-        }
+        variables::inputs(self.config.causality).map(|vr| vr as usize)
     }
 
     /// Value references that may be set: the two inputs, and for Model Exchange their rates.
     fn settable(&self, vr: usize) -> bool {
-        self.input_refs().contains(&vr) || vr == 13 || (vr == 12 && self.config.causality == Causality::Speeds)
+        is_input(self.config.causality, vr as u32)
     }
 
     fn inputs(&self) -> [f64; 2] {
@@ -191,11 +171,10 @@ impl Instance {
     }
 
     pub fn get(&mut self, vr: u32) -> Option<f64> {
-        if START_PARAMETERS.contains(&vr) {
-            return Some(self.start[(vr - START_PARAMETERS.start) as usize]);
+        if let Some(i) = start_parameter(vr) {
+            return Some(self.start[i]);
         }
-        let derivative = (FIRST_DERIVATIVE..FIRST_DERIVATIVE + 4).contains(&vr);
-        let output = derivative || ((vr as usize) < SIGNALS.len() && !self.settable(vr as usize));
+        let output = is_derivative(vr) || ((vr as usize) < SIGNAL_SLOTS && !self.settable(vr as usize));
         if self.initializing && output {
             // in initialisation mode the outputs are the steady state for the inputs set so far
             let _ = self.initialize();
@@ -203,7 +182,7 @@ impl Instance {
         if self.me.is_some() {
             return self.me_get(vr);
         }
-        if (vr as usize) < SIGNALS.len() {
+        if (vr as usize) < SIGNAL_SLOTS {
             return Some(self.signals[vr as usize]);
         }
         let i = vr.checked_sub(FIRST_PARAMETER)? as usize;
@@ -213,22 +192,22 @@ impl Instance {
     /// Set a value; inputs any time, parameters before or between steps (tunable). Outputs are
     /// not settable.
     pub fn set(&mut self, vr: u32, value: f64) -> Result<(), String> {
-        if START_PARAMETERS.contains(&vr) {
+        if let Some(i) = start_parameter(vr) {
             if self.stepper.is_some() || (self.me.is_some() && !self.initializing) {
                 return Err("the start-value parameters are fixed after initialisation".into());
             }
             if !value.is_finite() {
                 return Err(format!("start-value parameter {vr} = {value}: expected a finite value"));
             }
-            self.start[(vr - START_PARAMETERS.start) as usize] = value;
+            self.start[i] = value;
             return Ok(());
         }
-        if (vr as usize) < SIGNALS.len() {
+        if let Some(name) = signal_name(vr) {
             if !self.settable(vr as usize) {
-                return Err(format!("{} is an output and cannot be set", SIGNALS[vr as usize]));
+                return Err(format!("{name} is an output and cannot be set"));
             }
             if !value.is_finite() {
-                return Err(format!("{} = {value}: expected a finite value", SIGNALS[vr as usize]));
+                return Err(format!("{name} = {value}: expected a finite value"));
             }
             self.signals[vr as usize] = value;
             return Ok(());
@@ -265,9 +244,10 @@ impl Instance {
         let Some(stepper) = &self.stepper else { return };
         let r = row(&stepper.model, sample);
         let inputs = self.input_refs();
-        for (vr, name) in SIGNALS.iter().enumerate() {
+        for s in &SIGNALS {
+            let vr = s.vr as usize;
             if !inputs.contains(&vr) {
-                if let Some(c) = COLUMNS.iter().position(|c| c == name) {
+                if let Some(c) = COLUMNS.iter().position(|c| *c == s.name) {
                     self.signals[vr] = r[c];
                 }
             }
@@ -317,7 +297,7 @@ impl Instance {
         }
         let sample = stepper.do_step(h, start, end).map_err(|e| e.to_string())?;
         self.previous = Some((t, start));
-        self.rates = [None; 14];
+        self.rates = [None; SIGNAL_SLOTS];
         self.publish(&sample);
         Ok(())
     }
@@ -402,15 +382,16 @@ pub struct ModelExchange {
 impl Instance {
     /// The initial state the start-value parameters ask for (none: the steady state).
     fn initial(&self) -> InitialState {
-        if self.start[0] != 0.0 {
+        let start = |vr: u32| start_parameter(vr).map_or(f64::NAN, |i| self.start[i]);
+        if start(vr::START_FROM_STEADY_STATE) != 0.0 {
             return InitialState::default();
         }
-        let pump = if self.config.causality == Causality::PumpTorqueTurbineSpeed { Some(self.start[1]) } else { None };
+        let pump_given = variables::inputs(self.config.causality).contains(&vr::PUMP_SPEED);
         InitialState {
-            pump_speed_rad_s: pump,
+            pump_speed_rad_s: (!pump_given).then(|| start(vr::INITIAL_PUMP_SPEED)),
             turbine_speed_rad_s: None,
-            stator_speed_rad_s: Some(self.start[2]),
-            flow_m3_s: Some(self.start[3]),
+            stator_speed_rad_s: Some(start(vr::INITIAL_STATOR_SPEED)),
+            flow_m3_s: Some(start(vr::INITIAL_FLOW)),
         }
     }
 
@@ -419,15 +400,16 @@ impl Instance {
         let line = |name: &str, value: f64, rate: f64| {
             Signal::new(name, vec![t, t + 1.0], vec![value, value + rate], 0.0).map_err(|e| e.to_string())
         };
-        let s = &self.signals;
+        let s = |vr: u32| self.signals[vr as usize];
+        let turbine = line("turbine_speed_rad_s", s(vr::TURBINE_SPEED), s(vr::TURBINE_ACCEL))?;
         Ok(match self.config.causality {
             Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
-                pump_torque_nm: Signal::constant(s[0]),
-                turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])?,
+                pump_torque_nm: Signal::constant(s(vr::PUMP_TORQUE)),
+                turbine_speed_rad_s: turbine,
             },
             Causality::Speeds => Drive::Speeds {
-                pump_speed_rad_s: line("pump_speed_rad_s", s[1], s[12])?,
-                turbine_speed_rad_s: line("turbine_speed_rad_s", s[2], s[13])?,
+                pump_speed_rad_s: line("pump_speed_rad_s", s(vr::PUMP_SPEED), s(vr::PUMP_ACCEL))?,
+                turbine_speed_rad_s: turbine,
             },
         })
     }
@@ -446,9 +428,14 @@ impl Instance {
     /// The number of continuous states and of event indicators.
     pub fn me_sizes(&self) -> (usize, usize) {
         match &self.me {
-            Some(me) => (me.coordinates.len(), if me.model.has_stator_clutch() { EVENT_INDICATORS } else { 0 }),
+            Some(me) => (me.coordinates.len(), self.model_kind().map_or(0, Model::event_indicators)),
             None => (0, 0),
         }
+    }
+
+    /// The model of the configuration (by its `kind`).
+    fn model_kind(&self) -> Option<Model> {
+        self.config.model.get("kind").and_then(Value::as_str).and_then(Model::from_kind)
     }
 
     fn me_state(&self) -> Result<&ModelExchange, String> {
@@ -532,20 +519,20 @@ impl Instance {
 
     fn me_get(&mut self, vr: u32) -> Option<f64> {
         let me = self.me.as_ref()?;
-        if (FIRST_DERIVATIVE..FIRST_DERIVATIVE + 4).contains(&vr) {
+        if is_derivative(vr) {
             let drive = self.me_drive(me.time_s).ok()?;
             return Some(
                 ModeView::new(&me.model, &drive, me.mode).rates(&me.u, me.time_s)[(vr - FIRST_DERIVATIVE) as usize],
             );
         }
-        if (vr as usize) < SIGNALS.len() {
+        if let Some(name) = signal_name(vr) {
             if self.settable(vr as usize) {
                 return Some(self.signals[vr as usize]);
             }
             let drive = self.me_drive(me.time_s).ok()?;
             let sample = ModeView::new(&me.model, &drive, me.mode).sample(&me.u, me.time_s);
             let r = row(&me.model, &sample);
-            return COLUMNS.iter().position(|c| *c == SIGNALS[vr as usize]).map(|c| r[c]);
+            return COLUMNS.iter().position(|c| *c == name).map(|c| r[c]);
         }
         let i = vr.checked_sub(FIRST_PARAMETER)? as usize;
         self.config.parameters.get(i).map(|p| p.value)
@@ -555,6 +542,56 @@ impl Instance {
 #[cfg(test)]
 mod me_tests {
     use super::*;
+
+    /// A model specification of each kind (JSON).
+    fn spec(model: Model) -> String {
+        let table = r#""speed_ratio": [0.0, 0.5, 1.0], "torque_ratio": [2.1, 1.4, 1.0],
+            "capacity_factor_nm_s2": [0.0032, 0.003, 0.0002]"#;
+        let inertia = r#""inertia_kg_m2": [0.109, 0.056, 0.01]"#;
+        match model {
+            Model::Table => format!(r#"{{"kind": "table", {inertia}, {table}}}"#),
+            Model::QuasiDynamic => format!(
+                r#"{{"kind": "quasi-dynamic", {inertia}, {table}, "shape_effect_m2": [-0.00569, 0.00134],
+                    "fluid_density_kg_m3": 870.0, "pump_exit_radius_m": 0.12, "flow_time_constant_s": 0.05}}"#
+            ),
+            Model::HrovatTobler => format!(
+                r#"{{"kind": "hrovat-tobler", {inertia}, "fluid_length_m": 0.2914,
+                    "shape_effect_m2": [-0.00569, 0.00134, 0.0009], "geometry": {:?}}}"#,
+                tcsim_core::converter::hrovat_tobler::HtGeometry::appendix_d().values
+            ),
+        }
+    }
+
+    /// The table's states and event indicators are the engine's: the continuous states of Model
+    /// Exchange, the derivatives' value references and the stator clutch.
+    #[test]
+    fn the_variable_table_agrees_with_the_engine() {
+        for model in Model::ALL {
+            for (name, causality, _) in variables::CAUSALITIES {
+                let text = format!(r#"{{"causality": "{name}", "model": {}, "parameters": []}}"#, spec(model));
+                let mut inst = Instance::new(Configuration::parse(&text).unwrap());
+                assert_eq!(inst.config.causality, causality);
+                inst.model_exchange = true;
+                inst.initialize().unwrap();
+                let me = inst.me.as_ref().unwrap();
+                let table: Vec<usize> = variables::states(model, causality).iter().map(|&(_, c)| c).collect();
+                assert_eq!(me.coordinates, table, "{model:?} {name}");
+                assert_eq!(me.model.has_stator_clutch(), model.event_indicators() > 0, "{model:?}");
+                assert_eq!(inst.me_sizes(), (table.len(), model.event_indicators()));
+                for (s, c) in variables::states(model, causality) {
+                    let der = inst.get(FIRST_DERIVATIVE + c as u32).unwrap();
+                    assert!(der.is_finite(), "der({}) = {der}", s.name);
+                }
+                // every declared variable can be read, every input set
+                for v in variables::variables(model, causality, &[]) {
+                    assert!(inst.get(v.vr).is_some(), "{model:?} {name}: {}", v.name);
+                    if v.causality == "input" {
+                        inst.set(v.vr, v.start.unwrap()).unwrap();
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn model_exchange_states_derivatives_and_events() {

@@ -5,7 +5,9 @@
 //! run time.
 //!
 //! The model and its parameters come from `resources/model.json`, written by `tcsim export-fmu`
-//! (`python/tcsim/fmu.py`). Every entry point catches panics: none crosses the C boundary; a
+//! (`python/tcsim/io/fmu.py`). The variables (value references, names, start values, states,
+//! parameters, event indicators) are in one table, [`variables`], from which `tcsim export-fmu`
+//! also writes `modelDescription.xml`. Every entry point catches panics: none crosses the C boundary; a
 //! failure returns `fmi2Error` with its message through the logger callback.
 
 // The `unsafe extern "C"` functions are the FMI 2.0 C API, called by the host with the pointers
@@ -14,11 +16,13 @@
 #![allow(clippy::missing_safety_doc)]
 
 mod instance;
+pub mod variables;
 
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-pub use instance::{Configuration, Instance, FIRST_PARAMETER, SIGNALS};
+pub use instance::{Configuration, Instance};
+pub use variables::{FIRST_PARAMETER, MODEL_IDENTIFIER, SIGNALS};
 
 type Status = c_int;
 const OK: Status = 0;

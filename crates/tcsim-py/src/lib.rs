@@ -5,6 +5,8 @@
 //! expected)`. A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
 //! Python.
 
+mod fmu;
+
 use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
@@ -795,5 +797,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vehicle_sections, m)?)?;
     m.add_class::<PyVehicle>()?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
+    fmu::register(m)?;
     Ok(())
 }

@@ -8,9 +8,10 @@ no Python inside.
 
 The FMU is a zip archive:
 
-* ``modelDescription.xml`` (:func:`model_description_xml`): the signals with fixed value references
-  (:data:`SIGNALS`), the converter's parameters as tunable parameters (value references from
-  :data:`FIRST_PARAMETER_VR`), units, descriptions and the model structure;
+* ``modelDescription.xml`` (:func:`model_description_xml`), written from the FMU's variable table
+  (``crates/tcsim-fmu/src/variables.rs``, read through :func:`fmu_variables`): the signals with
+  fixed value references (:data:`SIGNALS`), the converter's parameters as tunable parameters
+  (value references from :data:`FIRST_PARAMETER_VR`), units, descriptions and the model structure;
 * ``resources/model.json``: the model specification (:attr:`tcsim.transient.DynamicModel.spec`),
   the causality and the parameter list, read by the library at ``fmi2Instantiate``;
 * ``binaries/linux64/tcsim_converter.so``: the Rust library ``crates/tcsim-fmu`` (a ``cdylib`` over
@@ -60,8 +61,9 @@ from ..models.drives import Drive, PumpTorqueTurbineSpeed, Speeds
 from ..models.dynamic import DynamicModel, resolve_model
 from ..simulation.transient import SolverError, simulate
 
-#: ``modelIdentifier`` of the FMU: the binary is ``binaries/<platform>/tcsim_converter.<ext>``.
-MODEL_IDENTIFIER = "tcsim_converter"
+#: ``modelIdentifier`` of the FMU: the binary is ``binaries/<platform>/tcsim_converter.<ext>``
+#: (owned by the FMU crate's variable table).
+MODEL_IDENTIFIER: str = _core.FMU_MODEL_IDENTIFIER
 #: Environment variable naming the library to package (overrides the source tree's build).
 LIBRARY_ENV = "TCSIM_FMU_LIBRARY"
 #: File name of the library that ``cargo build -p tcsim-fmu`` makes on Linux.
@@ -75,31 +77,9 @@ PLATFORM_LIBRARIES: dict[str, tuple[str, str]] = {
 #: FMI platform directory of a library by its suffix.
 PLATFORM_OF_SUFFIX = {".so": "linux64", ".dll": "win64", ".dylib": "darwin64"}
 #: Value reference of the first parameter; parameter i has ``FIRST_PARAMETER_VR + i``.
-FIRST_PARAMETER_VR = 100
+FIRST_PARAMETER_VR: int = _core.FMU_FIRST_PARAMETER_VR
 #: ``--causality`` choices: the two inputs of each.
-CAUSALITIES: dict[str, tuple[str, str]] = {
-    "pump-torque": ("pump_torque_nm", "turbine_speed_rad_s"),
-    "speeds": ("pump_speed_rad_s", "turbine_speed_rad_s"),
-}
-#: Start values of the inputs (a part-load stall: 50 N·m at the pump, or the pump at 150 rad/s).
-INPUT_START: dict[str, float] = {"pump_torque_nm": 50.0, "pump_speed_rad_s": 150.0, "turbine_speed_rad_s": 0.0}
-#: Rates of the speed inputs (value references 12, 13), for Model Exchange: optional inputs, zero
-#: when not connected. Co-Simulation takes the rates from fmi2SetRealInputDerivatives or from the
-#: last communication interval instead.
-RATE_INPUTS: dict[str, tuple[int, str, str]] = {
-    "pump_speed_rad_s": (12, "pump_accel_rad_s2", "Rate of the pump speed input (Model Exchange; 0 if not connected)"),
-    "turbine_speed_rad_s": (
-        13,
-        "turbine_accel_rad_s2",
-        "Rate of the turbine speed input (Model Exchange; 0 if not connected)",
-    ),
-}
-#: Value reference of the derivative of state coordinate c (0 pump speed, 2 stator speed, 3 flow).
-FIRST_DERIVATIVE = 20
-#: The models' continuous states in Model Exchange: signal name and coordinate.
-_STATES = (("pump_speed_rad_s", 0), ("stator_speed_rad_s", 2), ("flow_m3_s", 3))
-#: Event indicators in Model Exchange: the stator clutch and the flow direction (Hrovat & Tobler).
-EVENT_INDICATORS = {"hrovat-tobler": 3}
+CAUSALITIES: dict[str, tuple[str, str]] = {name: (a, b) for name, (a, b) in _core.fmu_causalities()}
 
 
 class FmuLibraryError(RuntimeError):
@@ -107,59 +87,7 @@ class FmuLibraryError(RuntimeError):
 
 
 # ---------------------------------------------------------------------------------------------
-# Units
-
-
-@dataclass(frozen=True)
-class Unit:
-    name: str
-    base: dict[str, int]
-    display: tuple[tuple[str, float], ...] = ()
-
-
-#: ``<UnitDefinitions>``: FMI unit names (``N.m``, ``rad/s``, ...) with their SI base-unit exponents.
-UNITS: tuple[Unit, ...] = (
-    Unit("N.m", {"kg": 1, "m": 2, "s": -2}),
-    Unit("rad/s", {"s": -1, "rad": 1}, (("rpm", 30.0 / math.pi),)),
-    Unit("m3/s", {"m": 3, "s": -1}),
-    Unit("rad/s2", {"s": -2, "rad": 1}),
-    Unit("m3/s2", {"m": 3, "s": -2}),
-    Unit("kg.m2", {"kg": 1, "m": 2}),
-    Unit("N.m.s2/rad2", {"kg": 1, "m": 2, "rad": -2}),
-    Unit("m", {"m": 1}),
-    Unit("m2", {"m": 2}),
-    Unit("kg/m3", {"kg": 1, "m": -3}),
-    Unit("rad", {"rad": 1}, (("deg", 180.0 / math.pi),)),
-    Unit("s", {"s": 1}),
-    Unit("1", {}),
-)
-
-# unit-suffix conventions (conventions.md) -> FMI unit; the longest suffix that matches wins
-_SUFFIX_UNITS: tuple[tuple[str, str], ...] = (
-    ("_nm_s2", "N.m.s2/rad2"),
-    ("_kg_m2", "kg.m2"),
-    ("_kg_m3", "kg/m3"),
-    ("_m3_s", "m3/s"),
-    ("_rad_s", "rad/s"),
-    ("_nm", "N.m"),
-    ("_m2", "m2"),
-    ("_rad", "rad"),
-    ("_m", "m"),
-    ("_s", "s"),
-)
-
-
-def unit_of(name: str) -> str:
-    """The FMI unit of a unit-suffixed name (``pump_exit_radius_m`` -> ``m``); ``1`` without suffix."""
-    base = re.sub(r"\[\d+\]$", "", name)
-    for suffix, unit in _SUFFIX_UNITS:
-        if base.endswith(suffix):
-            return unit
-    return "1"
-
-
-# ---------------------------------------------------------------------------------------------
-# Signals
+# The variable table (crates/tcsim-fmu/src/variables.rs, through tcsim._core)
 
 
 @dataclass(frozen=True)
@@ -177,54 +105,9 @@ class Signal:
 
 
 #: The signals in value-reference order; the same value reference whatever the causality.
-SIGNALS: tuple[Signal, ...] = (
-    Signal(0, "pump_torque_nm", "N.m", "Torque on the pump (engine torque at the converter input)"),
-    Signal(1, "pump_speed_rad_s", "rad/s", "Pump (impeller) speed", state=True),
-    Signal(2, "turbine_speed_rad_s", "rad/s", "Turbine speed (transmission input speed)"),
-    Signal(3, "turbine_torque_nm", "N.m", "Torque delivered by the turbine to the transmission (positive in drive)"),
-    Signal(4, "speed_ratio", "1", "Speed ratio SR = turbine speed / pump speed"),
-    Signal(5, "torque_ratio", "1", "Torque ratio TR = turbine torque / pump torque"),
-    Signal(6, "flow_m3_s", "m3/s", "Volume flow through the torus", ("hrovat-tobler", "quasi-dynamic"), state=True),
-    Signal(
-        7,
-        "stator_speed_rad_s",
-        "rad/s",
-        "Stator speed (zero while the one-way clutch holds it)",
-        ("hrovat-tobler",),
-        state=True,
-    ),
-    Signal(8, "stator_torque_nm", "N.m", "Torque of the stator one-way clutch on the stator"),
-    Signal(9, "effective_pump_torque_nm", "N.m", "Effective pump input torque T_p - I_p dw_p/dt (LS16 eq 3.3)"),
-    Signal(10, "effective_turbine_torque_nm", "N.m", "Effective turbine output torque T_t + I_t dw_t/dt (LS16 eq 3.4)"),
-    Signal(11, "effective_torque_ratio", "1", "Effective torque ratio: effective turbine / effective pump torque"),
+SIGNALS: tuple[Signal, ...] = tuple(
+    Signal(s["vr"], s["name"], s["unit"], s["description"], tuple(s["models"]), s["state"]) for s in _core.fmu_signals()
 )
-
-
-def model_signals(model: str) -> list[Signal]:
-    """The signals of a model, in value-reference order."""
-    return [s for s in SIGNALS if model in s.models]
-
-
-# ---------------------------------------------------------------------------------------------
-# Parameters
-
-_TRIPLE = ("pump", "turbine", "stator")
-_GEOMETRY_DESCRIPTIONS = {
-    "flow_area_m2": "Flow area A of the torus",
-    "fluid_density_kg_m3": "Fluid density",
-    "pump_exit_radius_m": "Pump exit radius",
-    "turbine_exit_radius_m": "Turbine exit radius",
-    "stator_exit_radius_m": "Stator exit radius",
-    "pump_shock_loss": "Shock loss coefficient at the pump inlet",
-    "turbine_shock_loss": "Shock loss coefficient at the turbine inlet",
-    "stator_shock_loss": "Shock loss coefficient at the stator inlet",
-    "friction_loss": "Friction loss coefficient",
-}
-_TABLE_KEYS = {
-    "speed_ratio": "speed ratio SR",
-    "torque_ratio": "torque ratio TR",
-    "capacity_factor_nm_s2": "capacity factor CF = pump torque / pump speed^2",
-}
 
 
 @dataclass(frozen=True)
@@ -244,65 +127,35 @@ class Parameter:
         return {"name": self.name, "key": self.key, "index": self.index}
 
 
-def _name_and_description(key: str, index: int | None, size: int) -> tuple[str, str]:
-    if key == "inertia_kg_m2" and index is not None and size == 3:
-        return f"{_TRIPLE[index]}_inertia_kg_m2", f"Moment of inertia of the {_TRIPLE[index]}"
-    if key == "shape_effect_m2" and index is not None and size <= 3:
-        return (
-            f"{_TRIPLE[index]}_shape_effect_m2",
-            f"Shape effect S of the {_TRIPLE[index]} (signed, LS16 eqs 2.16-2.18)",
-        )
-    if key == "geometry" and index is not None:
-        names = _core.ht_parameter_names()
-        if size == len(names):
-            name = names[index]
-            if name.endswith("_angle_rad"):
-                blade, where = name.removesuffix("_angle_rad").split("_")
-                return name, f"Blade angle at the {blade} {where}"
-            return name, _GEOMETRY_DESCRIPTIONS.get(name, name.replace("_", " "))
-    if key in _TABLE_KEYS and index is not None:
-        return f"table_{key}[{index + 1}]", f"Characteristic table, row {index + 1}: {_TABLE_KEYS[key]}"
-    described = {
-        "fluid_length_m": "Mean length L_f of the fluid path around the torus",
-        "fluid_density_kg_m3": "Fluid density (flow estimate of the quasi-dynamic model)",
-        "pump_exit_radius_m": "Pump exit radius (flow estimate of the quasi-dynamic model)",
-        "flow_time_constant_s": "Time constant tau_Q of the flow lag (quasi-dynamic model)",
-    }
-    if index is None:
-        return key, described.get(key, key.replace("_", " "))
-    return f"{key}[{index + 1}]", f"{key.replace('_', ' ')}, element {index + 1}"
+def _check_causality(causality: str) -> tuple[str, str]:
+    if causality not in CAUSALITIES:
+        raise InputError("command line", "--causality", causality, f"one of {', '.join(CAUSALITIES)}")
+    return CAUSALITIES[causality]
 
 
-def _number(value: Any) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool)
+def fmu_variables(model: DynamicModel, causality: str = "pump-torque") -> list[dict[str, Any]]:
+    """The FMU's variables (:func:`tcsim._core.fmu_variables`) in ``<ModelVariables>`` order; a
+    parameter that is not a finite number is an :class:`~tcsim.errors.InputError`."""
+    _check_causality(causality)
+    variables = _core.fmu_variables(model.spec, causality)
+    for v in variables:
+        if v["key"] is not None and not math.isfinite(v["start"]):
+            raise InputError(model.source, v["name"], v["start"], "a finite number")
+    return variables
 
 
 def fmu_parameters(model: DynamicModel) -> list[Parameter]:
     """Every numeric entry of the model's spec (scalars, and each element of the arrays) as a
     parameter, in the spec's key order, with value references from :data:`FIRST_PARAMETER_VR`."""
-    out: list[Parameter] = []
-    for key, value in model.spec.items():
-        if _number(value):
-            items: list[tuple[int | None, Any]] = [(None, value)]
-        elif isinstance(value, (list, tuple)) and value and all(_number(v) for v in value):
-            items = list(enumerate(value))
-        else:
-            continue  # "kind" and anything else that is not a number
-        for index, v in items:
-            name, description = _name_and_description(key, index, len(items))
-            if not math.isfinite(float(v)):
-                raise InputError(model.source, name, float(v), "a finite number")
-            out.append(
-                Parameter(FIRST_PARAMETER_VR + len(out), name, key, index or 0, float(v), unit_of(name), description)
-            )
-    names = [p.name for p in out]
-    if len(set(names)) != len(names):
-        raise ValueError(f"parameter names are not unique: {names}")
-    return out
+    return [
+        Parameter(v["vr"], v["name"], v["key"], v["index"], v["start"], v["unit"], v["description"])
+        for v in fmu_variables(model)
+        if v["key"] is not None
+    ]
 
 
 # ---------------------------------------------------------------------------------------------
-# modelDescription.xml
+# modelDescription.xml, written from the variable table only
 
 
 def _version() -> str:
@@ -312,52 +165,23 @@ def _version() -> str:
         return "0+unknown"
 
 
-def _xml_real(value: float) -> str:
-    """A real as modelDescription.xml writes it (Python's shortest round-trip form)."""
-    return repr(float(value))
-
-
-def _check_causality(causality: str) -> tuple[str, str]:
-    if causality not in CAUSALITIES:
-        raise InputError("command line", "--causality", causality, f"one of {', '.join(CAUSALITIES)}")
-    return CAUSALITIES[causality]
-
-
-class _Variables:
-    """``<ModelVariables>`` being written: the lines, and each variable's 1-based index by name."""
-
-    def __init__(self) -> None:
-        self.lines: list[str] = []
-        self.index: dict[str, int] = {}
-
-    def add(self, name: str, vr: int, description: str, attrs: str, real: str) -> None:
-        self.index[name] = len(self.index) + 1
-        q = quoteattr
-        self.lines.append(f"    <!-- index {self.index[name]} -->")
-        self.lines.append(
-            f'    <ScalarVariable name={q(name)} valueReference="{vr}" description={q(description)} {attrs}>'
-        )
-        self.lines.append(f"      <Real {real}/>")
-        self.lines.append("    </ScalarVariable>")
-
-
-def _header_lines(
-    model: DynamicModel, inputs: tuple[str, str], outputs: list[Signal], name: str, guid: str, stamp: str
-):
-    """From the XML declaration to the capabilities of Model Exchange and Co-Simulation."""
-    version = _version()
+def _header(
+    model: DynamicModel, causality: str, variables: list[dict[str, Any]], name: str, guid: str, stamp: str
+) -> list[str]:
+    """``<fmiModelDescription ...>`` with the Model Exchange and Co-Simulation capabilities."""
+    a, version, stem = quoteattr, _version(), Path(model.source).stem
+    outputs = ", ".join(v["name"] for v in variables if v["causality"] == "output")
     description = (
-        f"Torque converter {Path(model.source).stem}, {model.name} model (tcsim {version}). Inputs "
-        f"{', '.join(inputs)}; outputs {', '.join(s.name for s in outputs)}. Starts from the steady "
+        f"Torque converter {stem}, {model.name} model (tcsim {version}). Inputs "
+        f"{', '.join(CAUSALITIES[causality])}; outputs {outputs}. Starts from the steady "
         "state consistent with the inputs."
     )
-    a = quoteattr
     return [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="2.0" modelName={a(name)} guid={a(guid)}',
         f"  description={a(description)}",
         f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
-        f'  variableNamingConvention="flat" numberOfEventIndicators="{EVENT_INDICATORS.get(model.name, 0)}">',
+        f'  variableNamingConvention="flat" numberOfEventIndicators="{_core.fmu_event_indicators(model.name)}">',
         f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
         ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
         f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
@@ -366,105 +190,54 @@ def _header_lines(
     ]
 
 
-def _unit_lines() -> list[str]:
-    """``<UnitDefinitions>`` of :data:`UNITS`."""
+def _unit_definitions() -> list[str]:
+    """``<UnitDefinitions>`` of :func:`tcsim._core.fmu_units`."""
     lines = ["  <UnitDefinitions>"]
-    for u in UNITS:
-        base = " ".join(f'{k}="{v}"' for k, v in u.base.items())
-        lines.append(f"    <Unit name={quoteattr(u.name)}>")
-        lines.append(f"      <BaseUnit {base}/>" if base else "      <BaseUnit/>")
-        for name, factor in u.display:
-            lines.append(f'      <DisplayUnit name={quoteattr(name)} factor="{_xml_real(factor)}"/>')
+    for name, base, display in _core.fmu_units():
+        exponents = " ".join(f'{k}="{v}"' for k, v in base)
+        lines.append(f"    <Unit name={quoteattr(name)}>")
+        lines.append(f"      <BaseUnit {exponents}/>" if exponents else "      <BaseUnit/>")
+        lines += [f'      <DisplayUnit name={quoteattr(d)} factor="{factor}"/>' for d, factor in display]
         lines.append("    </Unit>")
-    lines.append("  </UnitDefinitions>")
-    return lines
+    return [*lines, "  </UnitDefinitions>"]
 
 
-def _signal_variables(v: _Variables, signals: list[Signal], inputs: tuple[str, str]) -> None:
-    """The signals (inputs with their start values, outputs), then the rates of the speed inputs."""
-    for s in signals:
-        if s.name in inputs:
-            v.add(
-                s.name,
-                s.vr,
-                s.description,
-                'causality="input" variability="continuous"',
-                f'unit="{s.unit}" start="{_xml_real(INPUT_START[s.name])}"',
-            )
-        else:
-            v.add(
-                s.name,
-                s.vr,
-                s.description,
-                'causality="output" variability="continuous" initial="calculated"',
-                f'unit="{s.unit}"',
-            )
-    for name in inputs:
-        if name in RATE_INPUTS:
-            vr, rate, text = RATE_INPUTS[name]
-            v.add(rate, vr, text, 'causality="input" variability="continuous"', 'unit="rad/s2" start="0"')
+def _model_variables(variables: list[dict[str, Any]], index: dict[int, int]) -> list[str]:
+    """``<ModelVariables>``: one ``<ScalarVariable>`` per row of the table (``index``: the 1-based
+    index of each value reference)."""
+    a = quoteattr
+    lines = ["  <ModelVariables>"]
+    for v in variables:
+        attrs = f'causality="{v["causality"]}" variability="{v["variability"]}"'
+        attrs += f' initial="{v["initial"]}"' if v["initial"] else ""
+        real = f"unit={a(v['unit'])}"
+        real += f" displayUnit={a(v['display_unit'])}" if v["display_unit"] else ""
+        real += f' start="{v["start_text"]}"' if v["start_text"] is not None else ""
+        real += f' derivative="{index[v["derivative_of"]]}"' if v["derivative_of"] is not None else ""
+        lines.append(f"    <!-- index {index[v['vr']]} -->")
+        head = f'name={a(v["name"])} valueReference="{v["vr"]}" description={a(v["description"])}'
+        lines.append(f"    <ScalarVariable {head} {attrs}>")
+        lines += [f"      <Real {real}/>", "    </ScalarVariable>"]
+    return [*lines, "  </ModelVariables>"]
 
 
-def _start_variables(v: _Variables, inputs: tuple[str, str]) -> None:
-    """``start_from_steady_state`` and the ``initial_*`` values of the states that are not inputs."""
-    v.add(
-        "start_from_steady_state",
-        30,
-        "1: start at the steady state consistent with the inputs (as tcsim replay); 0: at the initial_* values",
-        'causality="parameter" variability="fixed" initial="exact"',
-        'unit="1" start="1"',
-    )
-    for name, vr, unit, start in (
-        ("pump_speed_rad_s", 31, "rad/s", 150.0),
-        ("stator_speed_rad_s", 32, "rad/s", 0.0),
-        ("flow_m3_s", 33, "m3/s", 0.05),
-    ):
-        if name in v.index and name not in inputs:
-            v.add(
-                f"initial_{name}",
-                vr,
-                f"Initial {name.replace('_', ' ').rsplit(' ', 2)[0]} when start_from_steady_state = 0",
-                'causality="parameter" variability="fixed" initial="exact"',
-                f'unit="{unit}" start="{_xml_real(start)}"',
-            )
-
-
-def _derivative_variables(v: _Variables, inputs: tuple[str, str]) -> list[str]:
-    """``der(x)`` of each continuous state that is not an input (Model Exchange); their names."""
-    derivatives = []
-    for name, c in [(name, c) for name, c in _STATES if name in v.index and name not in inputs]:
-        der = f"der({name})"
-        unit = "m3/s2" if c == 3 else "rad/s2"
-        v.add(
-            der,
-            FIRST_DERIVATIVE + c,
-            f"Time derivative of {name}",
-            'causality="local" variability="continuous" initial="calculated"',
-            f'unit="{unit}" derivative="{v.index[name]}"',
-        )
-        derivatives.append(der)
-    return derivatives
-
-
-def _structure_lines(
-    index: dict[str, int], inputs: tuple[str, str], outputs: list[Signal], derivatives: list[str]
-) -> list[str]:
-    """``<ModelStructure>``: outputs with their dependencies, derivatives, initial unknowns."""
-    both = " ".join(str(index[n]) for n in inputs)
+def _model_structure(variables: list[dict[str, Any]], index: dict[int, int]) -> list[str]:
+    """``<ModelStructure>``: the outputs with their direct dependencies, the derivatives, and the
+    initial unknowns (every variable the FMU calculates)."""
     lines = ["  <ModelStructure>", "    <Outputs>"]
-    for s in outputs:
-        # a state (pump speed, flow, stator speed) does not depend directly on the inputs
-        lines.append(f'      <Unknown index="{index[s.name]}" dependencies="{"" if s.state else both}"/>')
+    for v in variables:
+        if v["causality"] == "output":
+            depends = " ".join(str(index[vr]) for vr in v["dependencies"])
+            lines.append(f'      <Unknown index="{index[v["vr"]]}" dependencies="{depends}"/>')
     lines.append("    </Outputs>")
+    derivatives = [v for v in variables if v["derivative_of"] is not None]
     if derivatives:
         lines.append("    <Derivatives>")
-        lines += [f'      <Unknown index="{index[der]}"/>' for der in derivatives]
+        lines += [f'      <Unknown index="{index[v["vr"]]}"/>' for v in derivatives]
         lines.append("    </Derivatives>")
     lines.append("    <InitialUnknowns>")
-    for name in sorted([s.name for s in outputs] + derivatives, key=lambda n: index[n]):
-        lines.append(f'      <Unknown index="{index[name]}"/>')
-    lines += ["    </InitialUnknowns>", "  </ModelStructure>"]
-    return lines
+    lines += [f'      <Unknown index="{index[v["vr"]]}"/>' for v in variables if v["initial"] == "calculated"]
+    return [*lines, "    </InitialUnknowns>", "  </ModelStructure>"]
 
 
 def model_description_xml(
@@ -475,32 +248,23 @@ def model_description_xml(
     generation_time: datetime | None = None,
 ) -> str:
     """The ``modelDescription.xml`` (FMI 2.0, Co-Simulation and Model Exchange) of a model under a
-    causality."""
-    inputs = _check_causality(causality)
-    signals = model_signals(model.name)
-    outputs = [s for s in signals if s.name not in inputs]
+    causality, written from the FMU's variable table (:func:`fmu_variables`)."""
+    variables = fmu_variables(model, causality)
+    index = {v["vr"]: i for i, v in enumerate(variables, start=1)}
     name = model_name or f"tcsim {Path(model.source).stem} {model.name}"
+    guid = guid or "{" + str(uuid.uuid4()) + "}"
     stamp = (generation_time or datetime.now(UTC)).strftime("%Y-%m-%dT%H:%M:%SZ")
-    lines = _header_lines(model, inputs, outputs, name, guid or "{" + str(uuid.uuid4()) + "}", stamp)
-    lines += _unit_lines()
-    lines.append('  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>')
-    v = _Variables()
-    _signal_variables(v, signals, inputs)
-    _start_variables(v, inputs)
-    derivatives = _derivative_variables(v, inputs)
-    for p in fmu_parameters(model):
-        display = ' displayUnit="deg"' if p.unit == "rad" else ""
-        v.add(
-            p.name,
-            p.vr,
-            p.description,
-            'causality="parameter" variability="tunable"',
-            f'unit="{p.unit}"{display} start="{_xml_real(p.value)}"',
-        )
-    lines += ["  <ModelVariables>", *v.lines, "  </ModelVariables>"]
-    lines += _structure_lines(v.index, inputs, outputs, derivatives)
-    lines += ["</fmiModelDescription>", ""]
-    return "\n".join(lines)
+    return "\n".join(
+        [
+            *_header(model, causality, variables, name, guid, stamp),
+            *_unit_definitions(),
+            '  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>',
+            *_model_variables(variables, index),
+            *_model_structure(variables, index),
+            "</fmiModelDescription>",
+            "",
+        ]
+    )
 
 
 def model_json(model: DynamicModel, causality: str = "pump-torque") -> dict[str, Any]:
@@ -733,11 +497,9 @@ def _check_model(model: DynamicModel, causality: str) -> None:
     """A short run from the default inputs' steady state, so that an inadmissible model (a shape
     effect beyond the mass-matrix bound, ...) is an input error now, not an fmi2Error later."""
     t = [0.0, 1e-3]
-    drive: Drive
-    if causality == "speeds":
-        drive = Speeds(t, [INPUT_START["pump_speed_rad_s"]] * 2, [INPUT_START["turbine_speed_rad_s"]] * 2)
-    else:
-        drive = PumpTorqueTurbineSpeed(t, [INPUT_START["pump_torque_nm"]] * 2, [INPUT_START["turbine_speed_rad_s"]] * 2)
+    start = {v["name"]: [v["start"]] * 2 for v in fmu_variables(model, causality) if v["causality"] == "input"}
+    first, second = (start[name] for name in CAUSALITIES[causality])  # the table's start values
+    drive: Drive = (Speeds if causality == "speeds" else PumpTorqueTurbineSpeed)(t, first, second)
     try:
         simulate(model, drive)
     except SolverError:
