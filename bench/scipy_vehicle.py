@@ -40,7 +40,10 @@ that breaks away ("lockup-slip") slips at full capacity for 0.1 s, then locks at
 0.5 rad/s or is armed with the sign of the slip ("lockup-slipping"). It opens ("lockup-release") below 0.7 × its
 engage speed and on a downshift. Braked axles that have (nearly) stopped are held again ("brake-hold").
 
-Run: ``python3 bench/scipy_vehicle.py`` (needs only NumPy and SciPy; prints the events).
+The vehicle's values are not written down here: :func:`sedan_params` takes them from the core's
+reading of the vehicle file (``tcsim._core.read_vehicle(...).to_dict()``), the same file the core's
+tests read. Run: ``python3 bench/scipy_vehicle.py`` (NumPy, SciPy and the built ``tcsim._core``;
+prints the events).
 """
 
 from __future__ import annotations
@@ -55,7 +58,10 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import solve_ivp
 
-CONVERTER = Path(__file__).resolve().parents[1] / "python/tcsim/data/converters/li-sunden-2016.toml"
+from tcsim import _core
+
+REPO = Path(__file__).resolve().parents[1]
+CONVERTER = REPO / "python/tcsim/data/converters/li-sunden-2016.toml"
 
 G = 9.81  # standard gravity, m/s²
 # Regularisation scales of vehicle.rs
@@ -77,66 +83,18 @@ MAX_EVENTS = 200
 
 RPM = math.pi / 30.0
 
-#: ``sedan()`` of ``crates/tcsim-core/tests/vehicle.rs``, with the section and key names that
-#: tcsim's binding reads (``vehicle_from`` in ``crates/tcsim-py/src/lib.rs``), so the same dict
-#: drives both implementations.
-SEDAN = {
-    "engine": {
-        "inertia_kg_m2": 0.20,
-        "idle_speed_rad_s": 750.0 * RPM,
-        "full_load_speed_rad_s": [r * RPM for r in (600.0, 1000.0, 1500.0, 2200.0, 4800.0, 5700.0, 6500.0)],
-        "full_load_torque_nm": [120.0, 200.0, 300.0, 400.0, 400.0, 350.0, 280.0],
-        "drag_torque_nm": 15.0,
-        "drag_nm_s_per_rad": 0.05,
-        "fast_time_constant_s": 0.06,
-        "boost_time_constant_s": 0.8,
-        "boost_fraction": 0.4,
-        "idle_governor_gain_nm_s_per_rad": 10.0,
-    },
-    "gearbox": {
-        "ratios": [5.25, 3.03, 1.95, 1.46, 1.22, 1.0, 0.81, 0.67],
-        "efficiencies": [0.95, 0.96, 0.97, 0.97, 0.97, 0.98, 0.97, 0.97],
-        "input_inertia_kg_m2": [0.05] * 8,
-        "output_inertia_kg_m2": 0.05,
-        "shift_clutch_capacity_nm": 800.0,
-        "shift_handover_s": 0.25,
-        "upshift_speed_zero_pedal_m_s": [4.0, 7.0, 10.0, 13.0, 16.0, 19.0, 22.0],
-        "upshift_speed_full_pedal_m_s": [13.0, 22.0, 34.0, 46.0, 56.0, 66.0, 76.0],
-        "downshift_speed_zero_pedal_m_s": [2.0, 4.5, 7.0, 10.0, 13.0, 16.0, 19.0],
-        "downshift_speed_full_pedal_m_s": [9.0, 16.0, 26.0, 37.0, 47.0, 57.0, 66.0],
-    },
-    "lockup": {
-        "capacity_nm": 600.0,
-        "static_to_kinetic": 1.2,
-        "engage_time_s": 0.5,
-        "min_gear": 3,
-        "engage_speed_zero_pedal_m_s": 12.0,
-        "engage_speed_full_pedal_m_s": 25.0,
-    },
-    "driveline": {
-        "final_drive_ratio": 3.33,
-        "front_shaft_stiffness_nm_per_rad": 6000.0,
-        "rear_shaft_stiffness_nm_per_rad": 9000.0,
-        "front_shaft_damping_nm_s_per_rad": 30.0,
-        "rear_shaft_damping_nm_s_per_rad": 40.0,
-        "front_axle_inertia_kg_m2": 2.2,
-        "rear_axle_inertia_kg_m2": 2.2,
-    },
-    "tyres": {
-        "rolling_radius_m": 0.345,
-        "friction_coefficient": 1.0,
-        "slip_stiffness": 15.0,
-        "front_load_fraction": 0.57,
-    },
-    "body": {
-        "mass_kg": 2050.0,
-        "drag_area_m2": 0.70,
-        "rolling_resistance": 0.010,
-        "air_density_kg_m3": 1.2,
-        "grade_percent": 0.0,
-    },
-    "brake": {"capacity_nm": 6000.0, "front_fraction": 0.6},
-}
+#: The test sedan of the core's tests (``sedan()`` of ``crates/tcsim-core/tests/vehicle.rs``): one
+#: vehicle file, read by both.
+SEDAN_FILE = REPO / "crates/tcsim-core/tests/data/sedan.toml"
+
+#: The sections of a vehicle file that hold the vehicle's values.
+SECTIONS = ("engine", "gearbox", "lockup", "driveline", "tyres", "body", "brake")
+
+
+def read_vehicle(path: Path = SEDAN_FILE) -> _core.Vehicle:
+    """A vehicle file read and validated by the core (``tcsim._core.read_vehicle``): the object
+    ``launch_runs`` takes; its ``to_dict()`` gives the values this transcription uses."""
+    return _core.read_vehicle(Path(path).read_text(encoding="utf-8"), str(path))
 
 
 def load_table(path=CONVERTER) -> dict:
@@ -153,9 +111,11 @@ def load_table(path=CONVERTER) -> dict:
     }
 
 
-def sedan_params(converter_path=CONVERTER) -> dict:
-    """The sedan vehicle plus ``"converter"``: the table model of ``converter_path``."""
-    return {**{k: dict(v) for k, v in SEDAN.items()}, "converter": load_table(converter_path)}
+def sedan_params(converter_path=CONVERTER, vehicle_path: Path = SEDAN_FILE) -> dict:
+    """The vehicle's sections as the core validated them, plus ``"converter"``: the table model of
+    ``converter_path``. No parameter is written down here."""
+    values = read_vehicle(vehicle_path).to_dict()
+    return {**{k: values[k] for k in SECTIONS}, "converter": load_table(converter_path)}
 
 
 def flip_flop(pedal: float = 1.0, end_time_s: float = 30.0, stop_speed_m_s: float | None = 100.0 / 3.6) -> dict:
@@ -670,7 +630,7 @@ def simulate(
 ) -> dict:
     """Launch from the braked standstill with the table converter model.
 
-    ``params``: :data:`SEDAN`-style sections plus ``"converter"`` (:func:`load_table`);
+    ``params``: a vehicle's sections (:func:`sedan_params`) plus ``"converter"`` (:func:`load_table`);
     ``scenario``: :func:`flip_flop`-style dict. Samples every ``output_step_s`` up to the stop (and
     at the stop), as the core does. Returns arrays ``time_s``, ``vehicle_speed_m_s``,
     ``vehicle_accel_m_s2``, ``pump_speed_rad_s``, ``turbine_speed_rad_s``,

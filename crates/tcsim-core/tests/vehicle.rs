@@ -12,66 +12,10 @@ use tcsim_core::vehicle::parameters::*;
 use tcsim_core::vehicle::plant::LaunchSample;
 use tcsim_core::vehicle::*;
 
+/// The test sedan, read from the vehicle file that the SciPy reference (bench/scipy_vehicle.py)
+/// reads too.
 fn sedan() -> Vehicle {
-    let rpm = std::f64::consts::PI / 30.0;
-    Vehicle {
-        engine: Engine {
-            inertia_kg_m2: 0.20,
-            idle_speed_rad_s: 750.0 * rpm,
-            full_load: Curve::new(
-                "engine.full_load",
-                [600.0, 1000.0, 1500.0, 2200.0, 4800.0, 5700.0, 6500.0].map(|r| r * rpm).to_vec(),
-                vec![120.0, 200.0, 300.0, 400.0, 400.0, 350.0, 280.0],
-            )
-            .unwrap(),
-            drag_torque_nm: 15.0,
-            drag_nm_s_per_rad: 0.05,
-            fast_time_constant_s: 0.06,
-            boost_time_constant_s: 0.8,
-            boost_fraction: 0.4,
-            idle_governor_gain_nm_s_per_rad: 10.0,
-        },
-        gearbox: Gearbox {
-            ratios: vec![5.25, 3.03, 1.95, 1.46, 1.22, 1.0, 0.81, 0.67],
-            efficiencies: vec![0.95, 0.96, 0.97, 0.97, 0.97, 0.98, 0.97, 0.97],
-            input_inertia_kg_m2: vec![0.05; 8],
-            output_inertia_kg_m2: 0.05,
-            shift_clutch_capacity_nm: 800.0,
-            shift_handover_s: 0.25,
-            upshift_speed_zero_pedal_m_s: vec![4.0, 7.0, 10.0, 13.0, 16.0, 19.0, 22.0],
-            upshift_speed_full_pedal_m_s: vec![13.0, 22.0, 34.0, 46.0, 56.0, 66.0, 76.0],
-            downshift_speed_zero_pedal_m_s: vec![2.0, 4.5, 7.0, 10.0, 13.0, 16.0, 19.0],
-            downshift_speed_full_pedal_m_s: vec![9.0, 16.0, 26.0, 37.0, 47.0, 57.0, 66.0],
-        },
-        lockup: Lockup {
-            capacity_nm: 600.0,
-            static_to_kinetic: 1.2,
-            engage_time_s: 0.5,
-            min_gear: 3,
-            engage_speed_zero_pedal_m_s: 12.0,
-            engage_speed_full_pedal_m_s: 25.0,
-        },
-        driveline: Driveline {
-            final_drive_ratio: 3.33,
-            shaft_stiffness_nm_per_rad: [6000.0, 9000.0],
-            shaft_damping_nm_s_per_rad: [30.0, 40.0],
-            axle_inertia_kg_m2: [2.2, 2.2],
-        },
-        tyres: Tyres {
-            rolling_radius_m: 0.345,
-            friction_coefficient: 1.0,
-            slip_stiffness: 15.0,
-            front_load_fraction: 0.57,
-        },
-        body: Body {
-            mass_kg: 2050.0,
-            drag_area_m2: 0.70,
-            rolling_resistance: 0.010,
-            air_density_kg_m3: 1.2,
-            grade_percent: 0.0,
-        },
-        brake: Brake { capacity_nm: 6000.0, front_fraction: 0.6 },
-    }
+    tcsim_core::vehicle::file::read_vehicle(include_str!("data/sedan.toml")).unwrap_or_else(|e| panic!("{e}")).vehicle
 }
 
 fn flip_flop(pedal: f64, end: f64, stop: f64) -> Scenario {

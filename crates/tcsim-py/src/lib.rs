@@ -13,7 +13,7 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::PyDict;
+use pyo3::types::{PyDict, PyList};
 
 use tcsim_core::batch::{
     ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs,
@@ -32,11 +32,10 @@ use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
 use tcsim_core::engine::options::{SolverOptions, TransientError};
 use tcsim_core::engine::signal::Signal;
 use tcsim_core::vehicle::components::engine_drag_nm;
+use tcsim_core::vehicle::file::{read_vehicle as read_vehicle_core, VehicleDocument};
 use tcsim_core::vehicle::launch::simulate_launch;
 use tcsim_core::vehicle::outputs::launch_column_names;
-use tcsim_core::vehicle::parameters::{
-    Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Scenario, Tyres, Vehicle,
-};
+use tcsim_core::vehicle::parameters::Scenario;
 use tcsim_core::CoreError;
 
 pyo3::create_exception!(
@@ -496,84 +495,96 @@ fn transient_runs<'py>(
 // ---------------------------------------------------------------------------------------------
 // Vehicle launch
 
-fn section<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyDict>> {
-    d.get_item(key)?
-        .ok_or_else(|| PyValueError::new_err(format!("missing section {key:?}")))?
-        .cast_into::<PyDict>()
-        .map_err(|_| PyValueError::new_err(format!("{key} must be a dict")))
+/// A vehicle read from its file and validated once by the core (`read_vehicle`): what `launch_runs`
+/// takes. Its getters give the file's top-level values; `to_dict()` the whole file, validated.
+#[pyclass(frozen, name = "Vehicle", module = "tcsim._core")]
+struct PyVehicle {
+    file: String,
+    doc: VehicleDocument,
 }
 
-fn vehicle_from(d: &Bound<'_, PyDict>) -> PyResult<Vehicle> {
-    let e = section(d, "engine")?;
-    let g = section(d, "gearbox")?;
-    let l = section(d, "lockup")?;
-    let dl = section(d, "driveline")?;
-    let ty = section(d, "tyres")?;
-    let b = section(d, "body")?;
-    let br = section(d, "brake")?;
-    Ok(Vehicle {
-        engine: Engine {
-            inertia_kg_m2: item(&e, "inertia_kg_m2")?,
-            idle_speed_rad_s: item(&e, "idle_speed_rad_s")?,
-            full_load: Curve::new(
-                "engine.full_load_speed_rad_s",
-                item(&e, "full_load_speed_rad_s")?,
-                item(&e, "full_load_torque_nm")?,
-            )
-            .map_err(input_error)?,
-            drag_torque_nm: item(&e, "drag_torque_nm")?,
-            drag_nm_s_per_rad: item(&e, "drag_nm_s_per_rad")?,
-            fast_time_constant_s: item(&e, "fast_time_constant_s")?,
-            boost_time_constant_s: item(&e, "boost_time_constant_s")?,
-            boost_fraction: item(&e, "boost_fraction")?,
-            idle_governor_gain_nm_s_per_rad: item(&e, "idle_governor_gain_nm_s_per_rad")?,
-        },
-        gearbox: Gearbox {
-            ratios: item(&g, "ratios")?,
-            efficiencies: item(&g, "efficiencies")?,
-            input_inertia_kg_m2: item(&g, "input_inertia_kg_m2")?,
-            output_inertia_kg_m2: item(&g, "output_inertia_kg_m2")?,
-            shift_clutch_capacity_nm: item(&g, "shift_clutch_capacity_nm")?,
-            shift_handover_s: item(&g, "shift_handover_s")?,
-            upshift_speed_zero_pedal_m_s: item(&g, "upshift_speed_zero_pedal_m_s")?,
-            upshift_speed_full_pedal_m_s: item(&g, "upshift_speed_full_pedal_m_s")?,
-            downshift_speed_zero_pedal_m_s: item(&g, "downshift_speed_zero_pedal_m_s")?,
-            downshift_speed_full_pedal_m_s: item(&g, "downshift_speed_full_pedal_m_s")?,
-        },
-        lockup: Lockup {
-            capacity_nm: item(&l, "capacity_nm")?,
-            static_to_kinetic: item(&l, "static_to_kinetic")?,
-            engage_time_s: item(&l, "engage_time_s")?,
-            min_gear: item(&l, "min_gear")?,
-            engage_speed_zero_pedal_m_s: item(&l, "engage_speed_zero_pedal_m_s")?,
-            engage_speed_full_pedal_m_s: item(&l, "engage_speed_full_pedal_m_s")?,
-        },
-        driveline: Driveline {
-            final_drive_ratio: item(&dl, "final_drive_ratio")?,
-            shaft_stiffness_nm_per_rad: [
-                item(&dl, "front_shaft_stiffness_nm_per_rad")?,
-                item(&dl, "rear_shaft_stiffness_nm_per_rad")?,
-            ],
-            shaft_damping_nm_s_per_rad: [
-                item(&dl, "front_shaft_damping_nm_s_per_rad")?,
-                item(&dl, "rear_shaft_damping_nm_s_per_rad")?,
-            ],
-            axle_inertia_kg_m2: [item(&dl, "front_axle_inertia_kg_m2")?, item(&dl, "rear_axle_inertia_kg_m2")?],
-        },
-        tyres: Tyres {
-            rolling_radius_m: item(&ty, "rolling_radius_m")?,
-            friction_coefficient: item(&ty, "friction_coefficient")?,
-            slip_stiffness: item(&ty, "slip_stiffness")?,
-            front_load_fraction: item(&ty, "front_load_fraction")?,
-        },
-        body: Body {
-            mass_kg: item(&b, "mass_kg")?,
-            drag_area_m2: item(&b, "drag_area_m2")?,
-            rolling_resistance: item(&b, "rolling_resistance")?,
-            air_density_kg_m3: item(&b, "air_density_kg_m3")?,
-            grade_percent: item(&b, "grade_percent")?,
-        },
-        brake: Brake { capacity_nm: item(&br, "capacity_nm")?, front_fraction: item(&br, "front_fraction")? },
+#[pymethods]
+impl PyVehicle {
+    /// The file name used in messages.
+    #[getter]
+    fn file(&self) -> &str {
+        &self.file
+    }
+    #[getter]
+    fn name(&self) -> &str {
+        &self.doc.file.name
+    }
+    #[getter]
+    fn source(&self) -> &str {
+        &self.doc.file.source
+    }
+    #[getter]
+    fn description(&self) -> Option<&str> {
+        self.doc.file.description.as_deref()
+    }
+    /// The `converter` reference as written (a bundled name or a path relative to the file).
+    #[getter]
+    fn converter(&self) -> &str {
+        &self.doc.file.converter
+    }
+    /// `[sources]`: `{"section.key": text}` in file order.
+    #[getter]
+    fn sources<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.doc.file.sources {
+            d.set_item(k, v)?;
+        }
+        Ok(d)
+    }
+    /// The validated file as a dict in file order: top-level values, one dict per section
+    /// (keys as in the file, arrays as lists, `min_gear` an int), `sources` if any.
+    fn to_dict<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
+        let d = PyDict::new(py);
+        for (k, v) in &self.doc.file.to_table() {
+            d.set_item(k, py_value(py, v)?)?;
+        }
+        Ok(d)
+    }
+    fn __repr__(&self) -> String {
+        format!("Vehicle(name={:?}, file={:?})", self.doc.file.name, self.file)
+    }
+}
+
+fn py_value<'py>(py: Python<'py>, v: &toml::Value) -> PyResult<Bound<'py, PyAny>> {
+    Ok(match v {
+        toml::Value::String(s) => s.into_pyobject(py)?.into_any(),
+        toml::Value::Integer(i) => i.into_pyobject(py)?.into_any(),
+        toml::Value::Float(f) => f.into_pyobject(py)?.into_any(),
+        toml::Value::Boolean(b) => b.into_pyobject(py)?.to_owned().into_any(),
+        toml::Value::Datetime(d) => d.to_string().into_pyobject(py)?.into_any(),
+        toml::Value::Array(a) => {
+            PyList::new(py, a.iter().map(|x| py_value(py, x)).collect::<PyResult<Vec<_>>>()?)?.into_any()
+        }
+        toml::Value::Table(t) => {
+            let d = PyDict::new(py);
+            for (k, x) in t {
+                d.set_item(k, py_value(py, x)?)?;
+            }
+            d.into_any()
+        }
+    })
+}
+
+/// The sections of a vehicle file that hold the vehicle's values, in file order.
+#[pyfunction]
+fn vehicle_sections() -> Vec<&'static str> {
+    tcsim_core::vehicle::file::SECTIONS.to_vec()
+}
+
+/// Read a vehicle file's `text` (`file` names it in messages): the one parse and validation of a
+/// vehicle. Raises CoreInputError whose field is named as the file writes it (`[body].grade_percent`,
+/// `[gearbox].ratios[3]`, `(syntax)` with line and column).
+#[pyfunction]
+fn read_vehicle(text: &str, file: &str) -> PyResult<PyVehicle> {
+    guard(|| {
+        let doc = read_vehicle_core(text)
+            .map_err(|e| CoreInputError::new_err((format!("{file}: {e}"), e.field, e.value, e.expected)))?;
+        Ok(PyVehicle { file: file.to_string(), doc })
     })
 }
 
@@ -599,7 +610,8 @@ fn launch_columns() -> Vec<&'static str> {
     launch_column_names()
 }
 
-/// Launch runs: each model dict (as for transient_runs) in the same vehicle and scenario, from the
+/// Launch runs: each model dict (as for transient_runs) in the same vehicle (a `Vehicle` from
+/// `read_vehicle`, validated there) and scenario, from the
 /// braked standstill, GIL released, `threads` workers. `options` takes the solver options of
 /// transient_runs and `output_step_s` (default 0.01). Entries as transient_runs': ("ok", columns,
 /// [(time_s, kind, gear)]), ("input", message, field, value, expected) or ("solver", message).
@@ -608,14 +620,13 @@ fn launch_columns() -> Vec<&'static str> {
 fn launch_runs<'py>(
     py: Python<'py>,
     models: Vec<Bound<'py, PyDict>>,
-    vehicle: Bound<'py, PyDict>,
+    vehicle: Bound<'py, PyVehicle>,
     scenario: Bound<'py, PyDict>,
     options: Option<Bound<'py, PyDict>>,
     threads: usize,
 ) -> PyResult<Vec<Py<PyAny>>> {
     guard(|| {
-        let v = vehicle_from(&vehicle)?;
-        v.validate().map_err(input_error)?;
+        let v = vehicle.get().doc.vehicle.clone();
         let sc = scenario_from(&scenario)?;
         let solver = options_from(options.as_ref())?;
         let step: f64 = match options.as_ref() {
@@ -752,7 +763,7 @@ fn steady_torque_ratio<'py>(
 
 /// The engine's drag torque in the vehicle plant, N·m, at engine speed `speed_rad_s` (rad/s):
 /// `drag_torque_nm·tanh(ω/1 rad/s) + drag_nm_s_per_rad·ω`, opposing rotation (zero at rest).
-/// Replaces `tcsim.vehicle.EngineSection.drag_at`, which lacks the tanh.
+/// (The drag of the former Python vehicle schema, which lacked the tanh, is gone with that schema.)
 #[pyfunction]
 fn vehicle_engine_drag_nm(speed_rad_s: f64, drag_torque_nm: f64, drag_nm_s_per_rad: f64) -> f64 {
     engine_drag_nm(speed_rad_s, drag_torque_nm, drag_nm_s_per_rad)
@@ -782,6 +793,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smoothed_rate, m)?)?;
     m.add_function(wrap_pyfunction!(launch_columns, m)?)?;
     m.add_function(wrap_pyfunction!(launch_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(read_vehicle, m)?)?;
+    m.add_function(wrap_pyfunction!(vehicle_sections, m)?)?;
+    m.add_class::<PyVehicle>()?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
     fmu::register(m)?;
     Ok(())

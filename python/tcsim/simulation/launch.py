@@ -104,7 +104,7 @@ def run_launch(
             "(python3 -m pip install .) from a source tree that has it"
         )
     try:
-        raw = _core.launch_runs([m.spec for m in models], vehicle.core_spec(), scenario.core_spec(), options, threads)
+        raw = _core.launch_runs([m.spec for m in models], vehicle.core, scenario.core_spec(), options, threads)
     except _core.CoreInputError as e:
         _msg, fld, value, expected = e.args
         only = models[0] if len(models) == 1 else None

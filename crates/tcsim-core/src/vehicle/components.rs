@@ -102,8 +102,7 @@ mod tests {
         Engine {
             inertia_kg_m2: 0.2,
             idle_speed_rad_s: 78.5,
-            full_load: Curve::new("full_load", vec![60.0, 230.0, 500.0, 700.0], vec![150.0, 400.0, 400.0, 280.0])
-                .unwrap(),
+            full_load: Curve::new("x", "y", vec![60.0, 230.0, 500.0, 700.0], vec![150.0, 400.0, 400.0, 280.0]).unwrap(),
             drag_torque_nm: 15.0,
             drag_nm_s_per_rad: 0.05,
             fast_time_constant_s: 0.06,
@@ -115,9 +114,9 @@ mod tests {
 
     #[test]
     fn curve_interpolates_holds_ends_and_refuses_bad_tables() {
-        let c = Curve::new("c", vec![0.0, 1.0, 3.0], vec![0.0, 2.0, 6.0]).unwrap();
+        let c = Curve::new("c", "d", vec![0.0, 1.0, 3.0], vec![0.0, 2.0, 6.0]).unwrap();
         assert_eq!((c.at(-1.0), c.at(0.5), c.at(2.0), c.at(9.0)), (0.0, 1.0, 4.0, 6.0));
-        assert_eq!(Curve::new("c", vec![0.0, 1.0, 1.0], vec![0.0; 3]).unwrap_err().field, "c[2]");
+        assert_eq!(Curve::new("c", "d", vec![0.0, 1.0, 1.0], vec![0.0; 3]).unwrap_err().field, "c[2]");
     }
 
     #[test]
@@ -135,7 +134,7 @@ mod tests {
         assert!(e.drag(100.0) > 15.0 && e.drag(0.0) == 0.0 && e.drag(-100.0) < 0.0);
         let mut bad = engine();
         bad.boost_fraction = 1.5;
-        assert_eq!(bad.validate().unwrap_err().field, "engine.boost_fraction");
+        assert_eq!(bad.validate().unwrap_err().field, "[engine].boost_fraction");
     }
 
     #[test]
@@ -156,13 +155,13 @@ mod tests {
         assert_eq!((g.upshift_speed(0, 0.5), g.upshift_speed(1, 1.0), g.downshift_speed(2, 0.0)), (8.0, 24.0, 5.0));
         let mut bad = g.clone();
         bad.downshift_speed_full_pedal_m_s[1] = 30.0;
-        assert_eq!(bad.validate().unwrap_err().field, "gearbox.downshift_speed_full_pedal_m_s[1]");
+        assert_eq!(bad.validate().unwrap_err().field, "[gearbox].downshift_speed_full_pedal_m_s[1]");
         let mut bad = g.clone();
         bad.efficiencies.pop();
-        assert_eq!(bad.validate().unwrap_err().field, "gearbox.efficiencies");
+        assert_eq!(bad.validate().unwrap_err().field, "[gearbox].efficiencies");
         let mut bad = g;
         bad.ratios[1] = -2.0;
-        assert_eq!(bad.validate().unwrap_err().field, "gearbox.ratios[1]");
+        assert_eq!(bad.validate().unwrap_err().field, "[gearbox].ratios[1]");
     }
 
     #[test]
@@ -178,7 +177,7 @@ mod tests {
         assert_eq!(l.engage_speed(0.0), 12.0);
         assert_eq!(l.engage_speed(2.0), 25.0);
         let bad = Lockup { static_to_kinetic: 0.9, ..l };
-        assert_eq!(bad.validate().unwrap_err().field, "lockup.static_to_kinetic");
+        assert_eq!(bad.validate(8).unwrap_err().field, "[lockup].static_to_kinetic");
     }
 
     #[test]

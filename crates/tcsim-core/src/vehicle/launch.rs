@@ -44,7 +44,7 @@ pub fn initial_state(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario) 
     if balance(lo)? <= 0.0 || balance(hi)? >= 0.0 {
         return Err(match &sc.engine_torque_nm {
             Some(log) => CoreError::new("engine_torque_nm[0]", log.value(0.0), "a positive logged engine torque at the start that the stalled converter can absorb"),
-            None => CoreError::new("engine.idle_speed_rad_s", v.engine.idle_speed_rad_s, "an idle governor and full-load curve that can hold the stalled converter (no engine speed balances them)"),
+            None => CoreError::new("[engine].idle_speed_rad_s", v.engine.idle_speed_rad_s, "an idle governor and full-load curve that can hold the stalled converter (no engine speed balances them)"),
         }
         .into());
     }

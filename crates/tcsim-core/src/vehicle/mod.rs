@@ -21,7 +21,9 @@
 //! kinetic energy it removes is booked as a clutch loss, so the energy balance closes exactly.
 //! Equations and parameters: docs/vehicle.md.
 //!
-//! * [`parameters`]: the vehicle's parameters and scenario, with their validation.
+//! * [`file`](mod@file): the vehicle file's schema (TOML), read once into the parameters, errors
+//!   named as the file names its fields.
+//! * [`parameters`]: the vehicle's parameters and scenario, with their one validation.
 //! * [`components`]: the physics of engine, gearbox, lock-up, driveline, tyres, body and brake.
 //! * [`modes`]: the discrete state (gear, shift, lock-up, brake hold) and the event kinds.
 //! * [`plant`]: the plant in one mode (mass matrix, generalised coordinates, forces, roots).
@@ -29,6 +31,7 @@
 //! * [`outputs`]: the output columns of a launch.
 
 pub mod components;
+pub mod file;
 pub mod launch;
 pub mod modes;
 pub mod outputs;
