@@ -4,6 +4,7 @@ Arrays are float64 NumPy arrays; speeds in rad/s, torques in N·m, flows in m³/
 raises :class:`CoreInputError` for input the core refuses (``ValueError`` for wrong shapes).
 """
 
+from collections.abc import Sequence
 from typing import Any, TypeAlias
 
 import numpy as np
@@ -55,3 +56,19 @@ def launch_runs(
     options: dict[str, Any] | None = None,
     threads: int = 0,
 ) -> list[_RunEntry]: ...
+
+# physics owned by the core (one owner per fact)
+def default_flow_time_constant_s(geometry: _ArrayLike, fluid_length_m: float) -> float: ...
+def reference_pump_speed_rpm() -> float: ...
+def reference_pump_speed_rad_s() -> float: ...
+def mass_matrix_bound(
+    geometry: _ArrayLike,
+    fluid_length_m: float,
+    inertia_kg_m2: Sequence[float],
+    shape_effect_m2: Sequence[float],
+) -> dict[str, Any]: ...
+def steady_mode_names() -> dict[int, str]: ...
+def steady_torque_ratio(
+    stator_mode: npt.NDArray[np.int8], pump_torque_nm: _ArrayLike, turbine_torque_nm: _ArrayLike
+) -> _Array: ...
+def vehicle_engine_drag_nm(speed_rad_s: float, drag_torque_nm: float, drag_nm_s_per_rad: float) -> float: ...
