@@ -7,6 +7,7 @@ wrong is a failure of tcsim or of a solver (exit code 1).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 
@@ -43,7 +44,32 @@ def core_value(value: Any) -> Any:
         return value
 
 
-def from_core(exc: Exception, source: str, field_prefix: str = "") -> InputError:
-    """Wrap a ``tcsim._core.CoreInputError`` (args: message, field, value, expected)."""
-    _message, field, value, expected = exc.args
-    return InputError(source, field_prefix + field, core_value(value), expected)
+#: How each input the core names in an error (its ``source``: ``tcsim._core.input_sources()``) is
+#: shown when the caller has no file for it.
+CORE_SOURCE_NAMES: dict[str, str] = {
+    "converter": "converter",
+    "drive": "drive",
+    "initial": "initial state",
+    "scenario": "scenario",
+    "vehicle": "vehicle",
+    "options": "solver options",
+}
+
+
+def core_input_error(
+    source: str, field: str, value: Any, expected: str, files: Mapping[str, str], field_prefix: str = ""
+) -> InputError:
+    """The :class:`InputError` of an input error the core attributed to ``source`` (one of
+    :data:`CORE_SOURCE_NAMES`): shown as ``files[source]`` (the file the caller read that input
+    from), else by the input's name."""
+    where = files.get(source) or CORE_SOURCE_NAMES.get(source, source)
+    return InputError(where, field_prefix + field, core_value(value), expected)
+
+
+def from_core(exc: Exception, files: Mapping[str, str] | str, field_prefix: str = "") -> InputError:
+    """Wrap a ``tcsim._core.CoreInputError`` (args: message, field, value, expected, source).
+    ``files`` maps the core's sources to files (see :func:`core_input_error`); a single name is the
+    converter's file, for the functions that take only converter data."""
+    _message, field, value, expected, source = exc.args
+    files = {"converter": files} if isinstance(files, str) else files
+    return core_input_error(source, field, value, expected, files, field_prefix)
