@@ -69,7 +69,9 @@ def core_input_error(
 def from_core(exc: Exception, files: Mapping[str, str] | str, field_prefix: str = "") -> InputError:
     """Wrap a ``tcsim._core.CoreInputError`` (args: message, field, value, expected, source).
     ``files`` maps the core's sources to files (see :func:`core_input_error`); a single name is the
-    converter's file, for the functions that take only converter data."""
-    _message, field, value, expected, source = exc.args
-    files = {"converter": files} if isinstance(files, str) else files
-    return core_input_error(source, field, value, expected, files, field_prefix)
+    file of the one input the caller passed (a converter's, for the steady-state functions), which
+    the error is then about whatever its source."""
+    _message, field, value, expected = exc.args[:4]
+    if isinstance(files, str):
+        return InputError(files, field_prefix + field, core_value(value), expected)
+    return core_input_error(exc.args[4], field, value, expected, files, field_prefix)
