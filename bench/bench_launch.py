@@ -62,10 +62,11 @@ FASTEST: dict = {}
 
 def tcsim_runs(specs, vehicle, scenario, threads=0):
     out = core.launch_runs(specs, vehicle, scenario, None, threads)
-    for spec, entry in zip(specs, out):
-        if entry[0] != "ok":
-            raise SystemExit(f"tcsim {spec['kind']} failed: {entry}")
-    return out
+    for spec, run in zip(specs, out):
+        if not run.ok:
+            raise SystemExit(f"tcsim {spec['kind']} failed: {run.error}")
+    # (status, columns, [(time_s, kind, gear)]), the shape the comparisons below index
+    return [("ok", run.columns, [(e.time_s, e.kind, e.gear) for e in run.events]) for run in out]
 
 
 def check_same_table(spec: dict, params: dict) -> None:

@@ -4,19 +4,87 @@ Arrays are float64 NumPy arrays; speeds in rad/s, torques in N·m, flows in m³/
 raises :class:`CoreInputError` for input the core refuses (``ValueError`` for wrong shapes).
 """
 
-from typing import Any, TypeAlias
+from collections.abc import Sequence
+from typing import Any, Literal, TypeAlias
 
 import numpy as np
 import numpy.typing as npt
 
 _Array: TypeAlias = npt.NDArray[np.float64]
 _ArrayLike: TypeAlias = npt.ArrayLike
-#: One run of a batch, a tuple tagged by its first item: ("ok", {column: array}, [event tuple]),
-#: ("input", message, field, value, expected) or ("solver", message).
-_RunEntry: TypeAlias = tuple[Any, ...]
+#: The input a core error is about (``input_sources()``).
+InputSourceKey: TypeAlias = Literal["converter", "drive", "initial", "scenario", "vehicle", "options"]
 
 class CoreInputError(ValueError):
-    """Bad input to the tcsim core: args are (message, field, value, expected)."""
+    """Bad input to the tcsim core: args are (message, field, value, expected, source), ``source``
+    an :data:`InputSourceKey`."""
+
+def input_sources() -> list[str]: ...
+
+class RunError:
+    """Why a run of a batch failed: ``kind`` "input" (with source, field, value, expected as in
+    :class:`CoreInputError`) or "solver" (message only)."""
+
+    kind: Literal["input", "solver"]
+    message: str
+    source: InputSourceKey | None
+    field: str | None
+    value: str | None
+    expected: str | None
+    def __init__(
+        self,
+        kind: str,
+        message: str,
+        source: str | None = None,
+        field: str | None = None,
+        value: str | None = None,
+        expected: str | None = None,
+    ) -> None: ...
+
+class TransientEvent:
+    """An event of an isolated run; ``flow_sign`` after it: +1, −1 or 0 (held at zero)."""
+
+    time_s: float
+    kind: str
+    stator_locked: bool
+    flow_sign: float
+    def __init__(self, time_s: float, kind: str, stator_locked: bool, flow_sign: float) -> None: ...
+
+class LaunchEvent:
+    """An event of a launch run (gear shifts, lock-up, converter events) and the gear after it."""
+
+    time_s: float
+    kind: str
+    gear: int
+    def __init__(self, time_s: float, kind: str, gear: int) -> None: ...
+
+class TransientRun:
+    """One run of :func:`transient_runs`: columns and events if ``ok``, else ``error``."""
+
+    ok: bool
+    columns: dict[str, _Array]
+    events: list[TransientEvent]
+    error: RunError | None
+    def __init__(
+        self,
+        columns: dict[str, _Array] | None = None,
+        events: Sequence[TransientEvent] = (),
+        error: RunError | None = None,
+    ) -> None: ...
+
+class LaunchRun:
+    """One run of :func:`launch_runs`: columns and events if ``ok``, else ``error``."""
+
+    ok: bool
+    columns: dict[str, _Array]
+    events: list[LaunchEvent]
+    error: RunError | None
+    def __init__(
+        self,
+        columns: dict[str, _Array] | None = None,
+        events: Sequence[LaunchEvent] = (),
+        error: RunError | None = None,
+    ) -> None: ...
 
 def capacity_conventions() -> list[str]: ...
 def capacity_to_cf(convention_key: str, values: _ArrayLike) -> _Array: ...
@@ -46,7 +114,7 @@ def transient_runs(
     init: dict[str, float] | None = None,
     options: dict[str, Any] | None = None,
     threads: int = 0,
-) -> list[_RunEntry]: ...
+) -> list[TransientRun]: ...
 def launch_columns() -> list[str]: ...
 
 class Vehicle:
@@ -74,7 +142,23 @@ def launch_runs(
     scenario: dict[str, Any],
     options: dict[str, Any] | None = None,
     threads: int = 0,
-) -> list[_RunEntry]: ...
+) -> list[LaunchRun]: ...
+
+# physics owned by the core (one owner per fact)
+def default_flow_time_constant_s(geometry: _ArrayLike, fluid_length_m: float) -> float: ...
+def reference_pump_speed_rpm() -> float: ...
+def reference_pump_speed_rad_s() -> float: ...
+def mass_matrix_bound(
+    geometry: _ArrayLike,
+    fluid_length_m: float,
+    inertia_kg_m2: Sequence[float],
+    shape_effect_m2: Sequence[float],
+) -> dict[str, Any]: ...
+def steady_mode_names() -> dict[int, str]: ...
+def steady_torque_ratio(
+    stator_mode: npt.NDArray[np.int8], pump_torque_nm: _ArrayLike, turbine_torque_nm: _ArrayLike
+) -> _Array: ...
+def vehicle_engine_drag_nm(speed_rad_s: float, drag_torque_nm: float, drag_nm_s_per_rad: float) -> float: ...
 
 # The FMU's variable table (crates/tcsim-fmu/src/variables.rs, bound in crates/tcsim-py/src/fmu.rs)
 

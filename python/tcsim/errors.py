@@ -7,6 +7,7 @@ wrong is a failure of tcsim or of a solver (exit code 1).
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from typing import Any
 
 
@@ -28,22 +29,54 @@ class TcsimWarning(UserWarning):
     """A suspicious but usable input (for example an implausible stall torque)."""
 
 
+class CoreText(str):
+    """A value as the core wrote it, already in the file's notation (``"1930"``, ``7 values``): shown
+    as it is, not quoted again."""
+
+
 def _show(value: Any) -> str:
     if isinstance(value, float):
         return f"{value:.6g}"
-    text = repr(value) if isinstance(value, str) else str(value)
+    text = repr(value) if isinstance(value, str) and not isinstance(value, CoreText) else str(value)
     return text if len(text) <= 80 else text[:77] + "..."
 
 
 def core_value(value: Any) -> Any:
-    """The core reports values as text; show numbers as numbers."""
+    """The core reports values as text; show numbers as numbers and the rest as the core wrote it."""
     try:
         return float(value)
     except (TypeError, ValueError):
-        return value
+        return CoreText(value) if isinstance(value, str) else value
 
 
-def from_core(exc: Exception, source: str, field_prefix: str = "") -> InputError:
-    """Wrap a ``tcsim._core.CoreInputError`` (args: message, field, value, expected)."""
-    _message, field, value, expected = exc.args
-    return InputError(source, field_prefix + field, core_value(value), expected)
+#: How each input the core names in an error (its ``source``: ``tcsim._core.input_sources()``) is
+#: shown when the caller has no file for it.
+CORE_SOURCE_NAMES: dict[str, str] = {
+    "converter": "converter",
+    "drive": "drive",
+    "initial": "initial state",
+    "scenario": "scenario",
+    "vehicle": "vehicle",
+    "options": "solver options",
+}
+
+
+def core_input_error(
+    source: str, field: str, value: Any, expected: str, files: Mapping[str, str], field_prefix: str = ""
+) -> InputError:
+    """The :class:`InputError` of an input error the core attributed to ``source`` (one of
+    :data:`CORE_SOURCE_NAMES`): shown as ``files[source]`` (the file the caller read that input
+    from), else by the input's name."""
+    where = files.get(source) or CORE_SOURCE_NAMES.get(source, source)
+    return InputError(where, field_prefix + field, core_value(value), expected)
+
+
+def from_core(exc: Exception, files: Mapping[str, str] | str, field_prefix: str = "") -> InputError:
+    """Wrap a ``tcsim._core.CoreInputError`` (args: message, field, value, expected, source).
+    ``files`` maps the core's sources to files (see :func:`core_input_error`); a single name is the
+    file of the one input the caller passed (a converter's, for the steady-state functions), which
+    the error is then about whatever its source."""
+    _message, field, value, expected = exc.args[:4]
+    if isinstance(files, str):
+        return InputError(files, field_prefix + field, core_value(value), expected)
+    return core_input_error(exc.args[4], field, value, expected, files, field_prefix)

@@ -21,6 +21,9 @@ MEASUREMENT = REPO / "tests" / "golden" / "data" / "takeoff_measurement.csv"
 DOCUMENTED = [
     "tcsim._core.launch_runs",
     "tcsim._core.transient_runs",
+    "tcsim._core.TransientRun",
+    "tcsim._core.TransientEvent",
+    "tcsim._core.RunError",
     "tcsim.characterise",
     "tcsim.coupling_point",
     "tcsim.dynamic_model",

@@ -14,6 +14,7 @@ import pytest
 
 import tcsim
 import tcsim.cli
+from tcsim import _core
 from tcsim.analysis.launch import (
     EVENT_COLUMNS,
     SUMMARY_COLUMNS,
@@ -295,7 +296,8 @@ def test_launch_summary_columns_and_values():
 
 
 def fake_launch_runs(models, vehicle, scenario, options, threads):
-    """Entries like the core's: a first-order acceleration whose lag grows with the shape effect."""
+    """Results like the core's (``_core.LaunchRun``): a first-order acceleration whose lag grows with
+    the shape effect; ``fail_input`` in a model spec is the (source, field) of an input error."""
     assert {"engine", "gearbox", "lockup", "driveline", "tyres", "body", "brake"} <= set(vehicle.to_dict())
     t = np.round(np.arange(0.0, scenario["end_time_s"] + 1e-9, 0.01), 9)
     acc_pedal = np.interp(t, scenario["time_s"], scenario["accelerator_pedal"])
@@ -305,10 +307,11 @@ def fake_launch_runs(models, vehicle, scenario, options, threads):
     for m in models:
         shape = sum(abs(s) for s in m.get("shape_effect_m2", []))
         if shape > 0.5:
-            out.append(("solver", "step size too small at t = 5.12 s"))
+            out.append(_core.LaunchRun(error=_core.RunError("solver", "step size too small at t = 5.12 s")))
             continue
         if m.get("fail_input"):
-            out.append(("input", "bad", m["fail_input"], "-1", "a positive value"))
+            source, fld = m["fail_input"]
+            out.append(_core.LaunchRun(error=_core.RunError("input", "bad", source, fld, "-1", "a positive value")))
             continue
         tau = 0.05 + (0.1 if m["kind"] != "table" else 0.0) + shape
         a = np.where(t < release, 0.0, 6.0 * acc_pedal * (1 - np.exp(-(t - release) / tau)))
@@ -333,8 +336,8 @@ def fake_launch_runs(models, vehicle, scenario, options, threads):
             "stator_speed_rad_s": np.full_like(t, np.nan),
         }
         cols = {k: np.asarray(c)[:n] for k, c in cols.items()}
-        events = [(float(t[np.argmax(v >= 12.5)]), "upshift", 1, 2)] if (v[:n] >= 12.5).any() else []
-        out.append(("ok", cols, events))
+        events = [_core.LaunchEvent(float(t[np.argmax(v >= 12.5)]), "upshift", 2)] if (v[:n] >= 12.5).any() else []
+        out.append(_core.LaunchRun(cols, events))
     return out
 
 
@@ -359,21 +362,21 @@ def test_run_launch_unpacks_columns_and_events(fake_core, vehicle):
         assert set(LAUNCH_COLUMNS) <= set(f.columns) and "stator_speed_rad_s" not in f.columns  # all-NaN dropped
         assert f.vehicle_speed_m_s.iloc[-1] >= 100 / 3.6 and run.events[0][1] == "upshift"
     ev = events_table(runs)
-    assert list(ev.columns) == list(EVENT_COLUMNS) and len(ev) == 3 and ev.detail[0] == "1 2"
+    assert list(ev.columns) == list(EVENT_COLUMNS) and len(ev) == 3 and ev.detail[0] == "2"
 
 
 def test_run_launch_errors(fake_core, vehicle, monkeypatch):
     table = dynamic_model(vehicle.converter, "table")
     scen = flip_flop()
-    bad_vehicle = type(table)("table", {**table.spec, "fail_input": "engine.inertia_kg_m2"}, table.source)
+    bad_vehicle = type(table)("table", {**table.spec, "fail_input": ("vehicle", "engine.inertia_kg_m2")}, table.source)
     with pytest.raises(InputError) as err:
         run_launch(vehicle, scen, [bad_vehicle])
     assert err.value.source == vehicle.path and err.value.field == "engine.inertia_kg_m2" and err.value.value == -1.0
-    bad_scen = type(table)("table", {**table.spec, "fail_input": "time_s"}, table.source)
+    bad_scen = type(table)("table", {**table.spec, "fail_input": ("scenario", "time_s")}, table.source)
     with pytest.raises(InputError) as err:
         run_launch(vehicle, scen, [bad_scen])
     assert err.value.source == "scenario flip-flop"
-    bad_model = type(table)("table", {**table.spec, "fail_input": "capacity_factor_nm_s2"}, table.source)
+    bad_model = type(table)("table", {**table.spec, "fail_input": ("converter", "capacity_factor_nm_s2")}, table.source)
     with pytest.raises(InputError) as err:
         run_launch(vehicle, scen, [bad_model])
     assert err.value.source == table.source
@@ -385,7 +388,7 @@ def test_run_launch_errors(fake_core, vehicle, monkeypatch):
     assert list(frames) == ["a"]
 
     def core_error(*args):
-        raise tcsim._core.CoreInputError("bad", "[gearbox].ratios", "-1", "positive")
+        raise tcsim._core.CoreInputError("bad", "[gearbox].ratios", "-1", "positive", "vehicle")
 
     monkeypatch.setattr(tcsim._core, "launch_runs", core_error)
     with pytest.raises(InputError) as err:
@@ -496,7 +499,10 @@ def test_cli_bad_scenario_file_exit_2(fake_core, tmp_path, capsys):
 
 def test_cli_solver_failure_exit_1_nothing_written(monkeypatch, tmp_path, capsys):
     monkeypatch.setattr(
-        tcsim._core, "launch_runs", lambda *a: [("solver", "step size too small at t = 5.3 s")] * 3, raising=False
+        tcsim._core,
+        "launch_runs",
+        lambda *a: [_core.LaunchRun(error=_core.RunError("solver", "step size too small at t = 5.3 s"))] * 3,
+        raising=False,
     )
     out = tmp_path / "out"
     assert tcsim.cli.main(["launch", "--out", str(out)]) == 1

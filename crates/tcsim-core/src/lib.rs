@@ -27,4 +27,4 @@ pub mod scalar;
 pub mod units;
 pub mod vehicle;
 
-pub use error::{CoreError, CoreResult};
+pub use error::{CoreError, CoreResult, InputSource};

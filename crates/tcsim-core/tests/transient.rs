@@ -10,6 +10,7 @@ use tcsim_core::engine::isolated::{simulate, Drive, InitialState, Trajectory};
 use tcsim_core::engine::options::SolverOptions;
 use tcsim_core::engine::outputs::{columns, COLUMNS};
 use tcsim_core::engine::signal::Signal;
+use tcsim_core::InputSource;
 
 fn col<'a>(cols: &'a [Vec<f64>], name: &str) -> &'a [f64] {
     &cols[COLUMNS.iter().position(|c| *c == name).unwrap_or_else(|| panic!("no column {name}"))]
@@ -318,7 +319,9 @@ fn bad_runs_are_input_errors() {
         turbine_speed_rad_s: Signal::constant(0.0),
     };
     match simulate(&ht(SHAPE), &drive, &t, &InitialState::default(), &SolverOptions::default()) {
-        Err(tcsim_core::engine::options::TransientError::Input(e)) => assert_eq!(e.field, "initial pump_torque_nm"),
+        Err(tcsim_core::engine::options::TransientError::Input(e)) => {
+            assert_eq!((e.field.as_str(), e.source), ("initial pump_torque_nm", InputSource::Drive))
+        }
         other => panic!("{other:?}"),
     }
     let init = InitialState {
@@ -327,8 +330,15 @@ fn bad_runs_are_input_errors() {
         flow_m3_s: Some(0.01),
         ..Default::default()
     };
-    assert!(simulate(&ht(SHAPE), &drive, &t, &init, &SolverOptions::default()).is_err());
-    assert!(simulate(&ht(SHAPE), &drive, &[0.0, 0.0], &InitialState::default(), &SolverOptions::default()).is_err());
+    // each error says which input it is about
+    let source = |r: tcsim_core::engine::options::TransientResult<_>| match r {
+        Err(tcsim_core::engine::options::TransientError::Input(e)) => e.source,
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(source(simulate(&ht(SHAPE), &drive, &t, &init, &SolverOptions::default())), InputSource::Initial);
+    let times = [0.0, 0.0];
+    let r = simulate(&ht(SHAPE), &drive, &times, &InitialState::default(), &SolverOptions::default());
+    assert_eq!(source(r), InputSource::Drive);
 }
 
 #[test]

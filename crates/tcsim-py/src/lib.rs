@@ -2,7 +2,9 @@
 //!
 //! Every entry point converts NumPy arrays to slices, releases the GIL for the computation and
 //! turns a core error ([`CoreError`]) into `tcsim._core.CoreInputError(message, field, value,
-//! expected)`. A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
+//! expected, source)`, `source` naming the input at fault (`converter`, `drive`, `initial`,
+//! `scenario`, `vehicle`, `options`). The batch runs return typed results ([`TransientRun`],
+//! [`LaunchRun`]). A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
 //! Python.
 
 mod fmu;
@@ -36,17 +38,17 @@ use tcsim_core::vehicle::file::{read_vehicle as read_vehicle_core, VehicleDocume
 use tcsim_core::vehicle::launch::simulate_launch;
 use tcsim_core::vehicle::outputs::launch_column_names;
 use tcsim_core::vehicle::parameters::Scenario;
-use tcsim_core::CoreError;
+use tcsim_core::{CoreError, InputSource};
 
 pyo3::create_exception!(
     _core,
     CoreInputError,
     PyValueError,
-    "Bad input to the tcsim core: args are (message, field, value, expected)."
+    "Bad input to the tcsim core: args are (message, field, value, expected, source), source the input at fault: converter, drive, initial, scenario, vehicle or options."
 );
 
 fn input_error(e: CoreError) -> PyErr {
-    CoreInputError::new_err((e.to_string(), e.field, e.value, e.expected))
+    CoreInputError::new_err((e.to_string(), e.field, e.value, e.expected, e.source.key()))
 }
 
 /// Run `f`, turning a panic into a `RuntimeError` instead of letting it unwind into Python.
@@ -92,6 +94,12 @@ fn param(key: &str) -> PyResult<HtParam> {
         .into_iter()
         .find(|p| p.key() == key)
         .ok_or_else(|| PyValueError::new_err(format!("unknown Hrovat & Tobler parameter {key:?}")))
+}
+
+/// The inputs a `CoreInputError` or a `RunError` may be about, as its `source` names them.
+#[pyfunction]
+fn input_sources() -> Vec<&'static str> {
+    InputSource::ALL.iter().map(|s| s.key()).collect()
 }
 
 /// Names of the capacity conventions.
@@ -280,6 +288,199 @@ fn table_steady_states<'py>(
 }
 
 // ---------------------------------------------------------------------------------------------
+// Typed results of the batch runs
+
+/// Why a run of a batch failed: `kind` is `"input"` (the user's input; `source`, `field`,
+/// `value` and `expected` as in `CoreInputError`) or `"solver"` (`message` only).
+#[pyclass(frozen, get_all, module = "tcsim._core")]
+struct RunError {
+    kind: String,
+    message: String,
+    source: Option<String>,
+    field: Option<String>,
+    value: Option<String>,
+    expected: Option<String>,
+}
+
+#[pymethods]
+impl RunError {
+    #[new]
+    #[pyo3(signature = (kind, message, source=None, field=None, value=None, expected=None))]
+    fn new(
+        kind: String,
+        message: String,
+        source: Option<String>,
+        field: Option<String>,
+        value: Option<String>,
+        expected: Option<String>,
+    ) -> PyResult<Self> {
+        if kind != "input" && kind != "solver" {
+            return Err(PyValueError::new_err(format!("RunError kind {kind:?}: expected \"input\" or \"solver\"")));
+        }
+        Ok(RunError { kind, message, source, field, value, expected })
+    }
+    fn __repr__(&self) -> String {
+        format!("RunError(kind={:?}, message={:?}, source={:?})", self.kind, self.message, self.source)
+    }
+}
+
+impl RunError {
+    fn from_core(e: TransientError) -> Self {
+        match e {
+            TransientError::Input(e) => RunError {
+                kind: "input".into(),
+                message: e.to_string(),
+                source: Some(e.source.key().into()),
+                field: Some(e.field),
+                value: Some(e.value),
+                expected: Some(e.expected),
+            },
+            e @ TransientError::Solver { .. } => RunError {
+                kind: "solver".into(),
+                message: e.to_string(),
+                source: None,
+                field: None,
+                value: None,
+                expected: None,
+            },
+        }
+    }
+}
+
+/// An event of an isolated run: `kind` (stator-release, stator-lock, flow-zero, flow-start), the
+/// stator clutch and the flow direction after it (+1, −1, 0 held at zero).
+#[pyclass(frozen, get_all, module = "tcsim._core")]
+struct TransientEvent {
+    time_s: f64,
+    kind: String,
+    stator_locked: bool,
+    flow_sign: f64,
+}
+
+#[pymethods]
+impl TransientEvent {
+    #[new]
+    fn new(time_s: f64, kind: String, stator_locked: bool, flow_sign: f64) -> Self {
+        TransientEvent { time_s, kind, stator_locked, flow_sign }
+    }
+    fn __repr__(&self) -> String {
+        format!("TransientEvent(time_s={}, kind={:?})", self.time_s, self.kind)
+    }
+}
+
+/// An event of a launch run: `kind` (gear shifts, lock-up, converter events) and the gear after it.
+#[pyclass(frozen, get_all, module = "tcsim._core")]
+struct LaunchEvent {
+    time_s: f64,
+    kind: String,
+    gear: usize,
+}
+
+#[pymethods]
+impl LaunchEvent {
+    #[new]
+    fn new(time_s: f64, kind: String, gear: usize) -> Self {
+        LaunchEvent { time_s, kind, gear }
+    }
+    fn __repr__(&self) -> String {
+        format!("LaunchEvent(time_s={}, kind={:?}, gear={})", self.time_s, self.kind, self.gear)
+    }
+}
+
+/// One run of `transient_runs`: `columns` (name → array) and `events` if `ok`, else `error`.
+#[pyclass(frozen, get_all, module = "tcsim._core")]
+struct TransientRun {
+    columns: Py<PyDict>,
+    events: Vec<Py<TransientEvent>>,
+    error: Option<Py<RunError>>,
+}
+
+#[pymethods]
+impl TransientRun {
+    #[new]
+    #[pyo3(signature = (columns=None, events=Vec::new(), error=None))]
+    fn new(
+        py: Python<'_>,
+        columns: Option<Py<PyDict>>,
+        events: Vec<Py<TransientEvent>>,
+        error: Option<Py<RunError>>,
+    ) -> Self {
+        TransientRun { columns: columns.unwrap_or_else(|| PyDict::new(py).unbind()), events, error }
+    }
+    /// True when the run finished (no `error`).
+    #[getter]
+    fn ok(&self) -> bool {
+        self.error.is_none()
+    }
+}
+
+/// One run of `launch_runs`: `columns` (name → array) and `events` if `ok`, else `error`.
+#[pyclass(frozen, get_all, module = "tcsim._core")]
+struct LaunchRun {
+    columns: Py<PyDict>,
+    events: Vec<Py<LaunchEvent>>,
+    error: Option<Py<RunError>>,
+}
+
+#[pymethods]
+impl LaunchRun {
+    #[new]
+    #[pyo3(signature = (columns=None, events=Vec::new(), error=None))]
+    fn new(
+        py: Python<'_>,
+        columns: Option<Py<PyDict>>,
+        events: Vec<Py<LaunchEvent>>,
+        error: Option<Py<RunError>>,
+    ) -> Self {
+        LaunchRun { columns: columns.unwrap_or_else(|| PyDict::new(py).unbind()), events, error }
+    }
+    /// True when the run finished (no `error`).
+    #[getter]
+    fn ok(&self) -> bool {
+        self.error.is_none()
+    }
+}
+
+/// `{name: array}` of a run's output columns.
+fn column_dict<'py>(py: Python<'py>, names: &[&str], cols: Vec<Vec<f64>>) -> PyResult<Py<PyDict>> {
+    let d = PyDict::new(py);
+    for (name, col) in names.iter().zip(cols) {
+        d.set_item(*name, col.into_pyarray(py))?;
+    }
+    Ok(d.unbind())
+}
+
+fn transient_run(
+    py: Python<'_>,
+    r: tcsim_core::engine::options::TransientResult<tcsim_core::batch::RunOutput>,
+) -> PyResult<TransientRun> {
+    let names = tcsim_core::engine::outputs::COLUMNS;
+    Ok(match r {
+        Ok((cols, events)) => TransientRun {
+            columns: column_dict(py, &names, cols)?,
+            events: events
+                .iter()
+                .map(|e| {
+                    let ev = TransientEvent::new(
+                        e.time_s,
+                        event_name(e.kind).into(),
+                        e.mode.stator_locked,
+                        e.mode.flow_sign,
+                    );
+                    Py::new(py, ev)
+                })
+                .collect::<PyResult<_>>()?,
+            error: None,
+        },
+        Err(e) => TransientRun {
+            columns: PyDict::new(py).unbind(),
+            events: vec![],
+            error: Some(Py::new(py, RunError::from_core(e))?),
+        },
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
 // Transient runs
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -320,7 +521,7 @@ fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal
     let t: Vec<f64> = item(d, "time_s")?;
     match d.get_item(key)? {
         Some(v) if v.extract::<f64>().is_ok() => Ok(Signal::constant(v.extract::<f64>()?)),
-        _ => Signal::new(key, t, item(d, key)?, window).map_err(input_error),
+        _ => Signal::new(key, t, item(d, key)?, window).map_err(|e| input_error(e.about(InputSource::Drive))),
     }
 }
 
@@ -348,14 +549,16 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
                 drag_nm_s2: opt_item(d, "load_drag_nm_s2")?.unwrap_or(0.0),
             };
             if !(load.inertia_kg_m2.is_finite() && load.inertia_kg_m2 >= 0.0) {
-                return Err(input_error(CoreError::new(
+                return Err(input_error(CoreError::of(
+                    InputSource::Drive,
                     "load_inertia_kg_m2",
                     load.inertia_kg_m2,
                     "a finite inertia of zero or more in kg·m²",
                 )));
             }
             if !(load.drag_nm_s2.is_finite() && load.drag_nm_s2 >= 0.0) {
-                return Err(input_error(CoreError::new(
+                return Err(input_error(CoreError::of(
+                    InputSource::Drive,
                     "load_drag_nm_s2",
                     load.drag_nm_s2,
                     "a finite drag coefficient of zero or more",
@@ -394,7 +597,7 @@ fn options_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<SolverOptions> {
         ("first_step_s", o.first_step_s),
     ] {
         if !(v.is_finite() && v > 0.0) {
-            return Err(input_error(CoreError::new(k, v, "a finite, positive tolerance")));
+            return Err(input_error(CoreError::of(InputSource::Options, k, v, "a finite, positive tolerance")));
         }
     }
     Ok(o)
@@ -428,8 +631,8 @@ fn transient_columns() -> Vec<&'static str> {
 
 /// Run transient jobs: `models[i]` under `drives[i]` (a list of length one is broadcast), with
 /// the GIL released and `threads` workers (0: one per core). Each model and drive is a dict (see
-/// tcsim.transient). Returns one entry per job: `("ok", {column: array}, [(time_s, kind, stator_locked,
-/// flow_sign)])`, or `("input", message, field, value, expected)`, or `("solver", message)`.
+/// tcsim.transient). Returns one [`TransientRun`] per job: its columns and [`TransientEvent`]s, or
+/// its [`RunError`].
 #[pyfunction]
 #[pyo3(signature = (models, drives, init=None, options=None, threads=0))]
 fn transient_runs<'py>(
@@ -439,7 +642,7 @@ fn transient_runs<'py>(
     init: Option<Bound<'py, PyDict>>,
     options: Option<Bound<'py, PyDict>>,
     threads: usize,
-) -> PyResult<Vec<Py<PyAny>>> {
+) -> PyResult<Vec<TransientRun>> {
     guard(|| {
         let n = models.len().max(drives.len());
         if models.is_empty()
@@ -465,30 +668,7 @@ fn transient_runs<'py>(
             })
             .collect::<PyResult<Vec<_>>>()?;
         let results = py.detach(|| run_transient_jobs(&jobs, threads));
-        results
-            .into_iter()
-            .map(|r| -> PyResult<Py<PyAny>> {
-                Ok(match r {
-                    Ok((cols, events)) => {
-                        let d = PyDict::new(py);
-                        for (name, col) in tcsim_core::engine::outputs::COLUMNS.iter().zip(cols) {
-                            d.set_item(*name, col.into_pyarray(py))?;
-                        }
-                        let ev: Vec<(f64, &str, bool, f64)> = events
-                            .iter()
-                            .map(|e| (e.time_s, event_name(e.kind), e.mode.stator_locked, e.mode.flow_sign))
-                            .collect();
-                        ("ok", d, ev).into_pyobject(py)?.into_any().unbind()
-                    }
-                    Err(TransientError::Input(e)) => {
-                        ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind()
-                    }
-                    Err(e @ TransientError::Solver { .. }) => {
-                        ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind()
-                    }
-                })
-            })
-            .collect()
+        results.into_iter().map(|r| transient_run(py, r)).collect()
     })
 }
 
@@ -582,24 +762,48 @@ fn vehicle_sections() -> Vec<&'static str> {
 #[pyfunction]
 fn read_vehicle(text: &str, file: &str) -> PyResult<PyVehicle> {
     guard(|| {
-        let doc = read_vehicle_core(text)
-            .map_err(|e| CoreInputError::new_err((format!("{file}: {e}"), e.field, e.value, e.expected)))?;
+        let doc = read_vehicle_core(text).map_err(|e| {
+            let e = e.about(InputSource::Vehicle);
+            CoreInputError::new_err((format!("{file}: {e}"), e.field, e.value, e.expected, e.source.key()))
+        })?;
         Ok(PyVehicle { file: file.to_string(), doc })
     })
 }
 
 fn scenario_from(d: &Bound<'_, PyDict>) -> PyResult<Scenario> {
     let t: Vec<f64> = item(d, "time_s")?;
+    let scenario_error = |e: CoreError| input_error(e.about(InputSource::Scenario));
     let signal =
-        |key: &str| -> PyResult<Signal> { Signal::new(key, t.clone(), item(d, key)?, 0.0).map_err(input_error) };
+        |key: &str| -> PyResult<Signal> { Signal::new(key, t.clone(), item(d, key)?, 0.0).map_err(scenario_error) };
     Ok(Scenario {
         accelerator_pedal: signal("accelerator_pedal")?,
         brake_pedal: signal("brake_pedal")?,
         end_time_s: item(d, "end_time_s")?,
         stop_speed_m_s: opt_item(d, "stop_speed_m_s")?,
         engine_torque_nm: match opt_item::<Vec<f64>>(d, "engine_torque_nm")? {
-            Some(v) => Some(Signal::new("engine_torque_nm", t.clone(), v, 0.0).map_err(input_error)?),
+            Some(v) => Some(Signal::new("engine_torque_nm", t.clone(), v, 0.0).map_err(scenario_error)?),
             None => None,
+        },
+    })
+}
+
+fn launch_run(
+    py: Python<'_>,
+    r: tcsim_core::engine::options::TransientResult<(Vec<Vec<f64>>, Vec<tcsim_core::vehicle::modes::VehicleEvent>)>,
+) -> PyResult<LaunchRun> {
+    Ok(match r {
+        Ok((cols, events)) => LaunchRun {
+            columns: column_dict(py, &launch_column_names(), cols)?,
+            events: events
+                .iter()
+                .map(|e| Py::new(py, LaunchEvent::new(e.time_s, e.kind.into(), e.gear)))
+                .collect::<PyResult<_>>()?,
+            error: None,
+        },
+        Err(e) => LaunchRun {
+            columns: PyDict::new(py).unbind(),
+            events: vec![],
+            error: Some(Py::new(py, RunError::from_core(e))?),
         },
     })
 }
@@ -613,8 +817,8 @@ fn launch_columns() -> Vec<&'static str> {
 /// Launch runs: each model dict (as for transient_runs) in the same vehicle (a `Vehicle` from
 /// `read_vehicle`, validated there) and scenario, from the
 /// braked standstill, GIL released, `threads` workers. `options` takes the solver options of
-/// transient_runs and `output_step_s` (default 0.01). Entries as transient_runs': ("ok", columns,
-/// [(time_s, kind, gear)]), ("input", message, field, value, expected) or ("solver", message).
+/// transient_runs and `output_step_s` (default 0.01). Returns one [`LaunchRun`] per model: its
+/// columns and [`LaunchEvent`]s, or its [`RunError`].
 #[pyfunction]
 #[pyo3(signature = (models, vehicle, scenario, options=None, threads=0))]
 fn launch_runs<'py>(
@@ -624,7 +828,7 @@ fn launch_runs<'py>(
     scenario: Bound<'py, PyDict>,
     options: Option<Bound<'py, PyDict>>,
     threads: usize,
-) -> PyResult<Vec<Py<PyAny>>> {
+) -> PyResult<Vec<LaunchRun>> {
     guard(|| {
         let v = vehicle.get().doc.vehicle.clone();
         let sc = scenario_from(&scenario)?;
@@ -642,28 +846,7 @@ fn launch_runs<'py>(
                 })
             })
         });
-        let names = launch_column_names();
-        results
-            .into_iter()
-            .map(|r| -> PyResult<Py<PyAny>> {
-                Ok(match r {
-                    Ok((cols, events)) => {
-                        let d = PyDict::new(py);
-                        for (name, col) in names.iter().zip(cols) {
-                            d.set_item(*name, col.into_pyarray(py))?;
-                        }
-                        let ev: Vec<(f64, &str, usize)> = events.iter().map(|e| (e.time_s, e.kind, e.gear)).collect();
-                        ("ok", d, ev).into_pyobject(py)?.into_any().unbind()
-                    }
-                    Err(TransientError::Input(e)) => {
-                        ("input", e.to_string(), e.field, e.value, e.expected).into_pyobject(py)?.into_any().unbind()
-                    }
-                    Err(e @ TransientError::Solver { .. }) => {
-                        ("solver", e.to_string()).into_pyobject(py)?.into_any().unbind()
-                    }
-                })
-            })
-            .collect()
+        results.into_iter().map(|r| launch_run(py, r)).collect()
     })
 }
 
@@ -772,6 +955,12 @@ fn vehicle_engine_drag_nm(speed_rad_s: f64, drag_torque_nm: f64, drag_nm_s_per_r
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
+    m.add_class::<RunError>()?;
+    m.add_class::<TransientEvent>()?;
+    m.add_class::<TransientRun>()?;
+    m.add_class::<LaunchEvent>()?;
+    m.add_class::<LaunchRun>()?;
+    m.add_function(wrap_pyfunction!(input_sources, m)?)?;
     m.add_function(wrap_pyfunction!(capacity_conventions, m)?)?;
     m.add_function(wrap_pyfunction!(default_flow_time_constant_s, m)?)?;
     m.add_function(wrap_pyfunction!(reference_pump_speed_rpm, m)?)?;

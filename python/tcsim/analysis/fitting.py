@@ -40,9 +40,9 @@ from ..errors import InputError
 from ..models.characteristic import Characteristic
 from ..models.converter import STEADY_KEYS, STEADY_SCALE, Converter, GeometrySection, load_converter
 from ..models.steady import characterise_hrovat_tobler
-from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
+from ..units import DEFAULT_PUMP_SPEED_RAD_S, RAD_S_PER_RPM
 
-PUMP_SPEED_RAD_S = DEFAULT_PUMP_SPEED_RPM * RAD_S_PER_RPM
+PUMP_SPEED_RAD_S = DEFAULT_PUMP_SPEED_RAD_S
 CORE_NAMES = tuple(_core.ht_parameter_names())
 ANGLES = tuple(k for k in STEADY_KEYS if k.endswith("_deg"))
 LOSSES = ("pump_shock_loss", "turbine_shock_loss", "stator_shock_loss", "friction_loss")

@@ -28,7 +28,7 @@ import pandas as pd
 from .. import _core
 from ..errors import InputError
 from ..models.converter import STEADY_KEYS, STEADY_SCALE, Converter
-from ..models.steady import STATOR_MODES, hrovat_tobler_steady_state
+from ..models.steady import STATOR_MODES, hrovat_tobler_steady_state, steady_torque_ratio
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 
 #: Status of a parameter value the model does not accept (CSV column ``stator_mode``).
@@ -176,15 +176,12 @@ def _solve(rows: np.ndarray, speed_ratio: np.ndarray, pump_speed_rad_s: float) -
 
 def _columns(out: dict[str, np.ndarray], pump_speed_rad_s: float) -> dict[str, np.ndarray]:
     """TR and CF as in :func:`tcsim.steady.characterise_hrovat_tobler`; NaN without a steady state."""
-    mode = out["stator_mode"]
-    tp, tt = out["pump_torque_nm"], out["turbine_torque_nm"]
-    tr = np.where(mode == 2, 1.0, tt / np.where(tp == 0, 1.0, tp))
     cols = {
         k: np.asarray(out[k], dtype=float)
         for k in ("flow_m3_s", "pump_torque_nm", "turbine_torque_nm", "stator_torque_nm", "stator_speed_rad_s")
     }
-    cols["torque_ratio"] = np.where(mode < 0, np.nan, tr)
-    cols["capacity_factor_nm_s2"] = tp / pump_speed_rad_s**2
+    cols["torque_ratio"] = steady_torque_ratio(out)
+    cols["capacity_factor_nm_s2"] = out["pump_torque_nm"] / pump_speed_rad_s**2
     return cols
 
 

@@ -4,20 +4,18 @@ See ``docs/transient.md``."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
-import numpy as np
-
 from .. import _core
-from ..errors import InputError
-from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
+from ..errors import InputError, from_core
+from ..units import DEFAULT_PUMP_SPEED_RAD_S
 from .converter import MODELS, Converter, load_converter
 
-#: Pump speed at which the default quasi-dynamic flow time constant is evaluated (stall), rad/s.
-FLOW_TIME_CONSTANT_PUMP_SPEED_RAD_S = DEFAULT_PUMP_SPEED_RPM * RAD_S_PER_RPM
+#: Pump speed at which the default quasi-dynamic flow time constant is evaluated (stall), rad/s:
+#: the core's reference pump speed.
+FLOW_TIME_CONSTANT_PUMP_SPEED_RAD_S = DEFAULT_PUMP_SPEED_RAD_S
 
 
 # ---------------------------------------------------------------------------------------------
@@ -73,25 +71,16 @@ def _inertia(conv: Converter, model: str) -> list[float]:
 
 
 def default_flow_time_constant_s(conv: Converter) -> float:
-    """Default τ_Q of the quasi-dynamic model: the fluid's inertance over the slope of the net head
-    with respect to the flow, ``τ_Q = (ρL_f/A) / |∂F_Q/∂Q|``, for the Hrovat & Tobler geometry at
-    stall (locked stator) and 2000 rpm pump speed (physics notes §5). It scales as 1/ω_p."""
+    """Default τ_Q of the quasi-dynamic model, from the core
+    (``tcsim._core.default_flow_time_constant_s``): the fluid's inertance over the slope of the net
+    head with respect to the flow, ``τ_Q = (ρL_f/A) / |∂F_Q/∂Q|``, for the Hrovat & Tobler geometry
+    at stall (locked stator) and the reference pump speed (2000 rpm, physics notes §5). It scales as
+    1/ω_p."""
     g = _require(conv, "geometry", "quasi-dynamic (default flow time constant)")
-    wp = FLOW_TIME_CONSTANT_PUMP_SPEED_RAD_S
-    flow = float(_core.ht_steady_states(conv.core_geometry(), np.array([wp]), np.array([0.0]))["flow_m3_s"][0])
-    rad = math.pi / 180.0
-    tp, tt, ts = (math.tan(getattr(g, f"{e}_exit_angle_deg") * rad) for e in ("pump", "turbine", "stator"))
-    tpp, ttt, tss = (math.tan(getattr(g, f"{e}_inlet_angle_deg") * rad) for e in ("pump", "turbine", "stator"))
-    rp, rs = g.pump_exit_radius_m, g.stator_exit_radius_m
-    q = flow / g.flow_area_m2
-    # ∂/∂q of eq 2.15's right-hand side divided by ρ, at ω_t = ω_s = 0 (dhead/dq and shock/friction)
-    slope = wp * (rp * tp - rs * ts) - (
-        g.pump_shock_loss * (-rs * wp + q * (ts - tpp)) * (ts - tpp)
-        + g.turbine_shock_loss * (rp * wp + q * (tp - ttt)) * (tp - ttt)
-        + g.stator_shock_loss * q * (tt - tss) ** 2
-        + g.friction_loss * (3 + tp * tp + tt * tt + ts * ts) * q
-    )
-    return g.fluid_length_m / abs(slope)
+    try:
+        return _core.default_flow_time_constant_s(conv.core_geometry(), g.fluid_length_m)
+    except _core.CoreInputError as e:
+        raise from_core(e, conv.path) from None
 
 
 def dynamic_model(converter: Converter | str, model: str = "hrovat-tobler") -> DynamicModel:

@@ -4,8 +4,13 @@ notes §4) and the shape-effect values the sweeps use (Li & Sundén 2016 §4.1).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
+import numpy as np
+
+from .. import _core
+from ..errors import from_core
 from .dynamic import DynamicModel
 
 #: The shape effects of thesis figures 4.1–4.4 (S_p = S_t = v) and its largest pair (figure 4.1).
@@ -20,13 +25,23 @@ THESIS_PAIR_M2 = (0.4, 0.3)
 @dataclass(frozen=True)
 class MassMatrixBound:
     """``M`` is positive definite iff ``ρL_f/A > Σ ρ²S_x²/I_x`` (Schur complement of the inertias).
-    ``room`` is ``ρL_f/A`` less the stator's term, which the fit and the sweep keep as given."""
+    ``room`` is ``ρL_f/A`` less the stator's term, which the fit and the sweep keep as given.
+
+    Every number comes from the core (``tcsim._core.mass_matrix_bound``); the methods ask it again
+    for other pump and turbine shape effects (the stator's kept)."""
 
     density_kg_m3: float
     pump_inertia_kg_m2: float
     turbine_inertia_kg_m2: float
     inertance_kg_m4: float  # ρ L_f / A
     stator_term_kg_m4: float
+    #: The core's arguments but the pump and turbine shape effects: (geometry row as an (1, 15)
+    #: array, fluid length, inertias, stator shape effect).
+    core_args: tuple[Any, ...] = field(default=(), repr=False, compare=False)
+
+    def _at(self, pump_m2: float, turbine_m2: float) -> dict[str, Any]:
+        geometry, fluid_length_m, inertia, stator_m2 = self.core_args
+        return _core.mass_matrix_bound(geometry, fluid_length_m, inertia, [pump_m2, turbine_m2, stator_m2])
 
     @property
     def room(self) -> float:
@@ -34,12 +49,12 @@ class MassMatrixBound:
 
     def load(self, pump_m2: float, turbine_m2: float) -> float:
         """``ρ²S_p²/I_p + ρ²S_t²/I_t``."""
-        rho2 = self.density_kg_m3**2
-        return rho2 * (pump_m2**2 / self.pump_inertia_kg_m2 + turbine_m2**2 / self.turbine_inertia_kg_m2)
+        terms = self._at(pump_m2, turbine_m2)["shape_terms_kg_m4"]
+        return terms[0] + terms[1]
 
     def admissible(self, pump_m2: float, turbine_m2: float) -> bool:
-        """The core's test: ``ρ²S_p²/I_p + ρ²S_t²/I_t < room``."""
-        return self.load(pump_m2, turbine_m2) < self.room
+        """The core's test: ``ρL_f/A − Σ ρ²S_x²/I_x > 0``."""
+        return self._at(pump_m2, turbine_m2)["margin_kg_m4"] > 0.0
 
     def within(self, pump_m2: float, turbine_m2: float, fraction: float) -> bool:
         """The fit's joint condition: ``load ≤ fraction²·room`` (the box corners of the default
@@ -48,27 +63,30 @@ class MassMatrixBound:
 
     def single(self) -> tuple[float, float]:
         """Largest admissible |S_p| with S_t = 0 and |S_t| with S_p = 0, m²."""
-        room = max(self.room, 0.0)
-        return (
-            math.sqrt(room * self.pump_inertia_kg_m2) / self.density_kg_m3,
-            math.sqrt(room * self.turbine_inertia_kg_m2) / self.density_kg_m3,
-        )
+        bounds = self._at(0.0, 0.0)["shape_effect_bounds_m2"]
+        return bounds[0], bounds[1]
 
     def equal(self) -> float:
-        """Largest admissible |S| with S_p = S_t = S, m²."""
+        """Largest admissible |S| with S_p = S_t = S, m² (``load`` is quadratic in S)."""
         return math.sqrt(max(self.room, 0.0) / self.load(1.0, 1.0))
 
 
 def mass_matrix_bound(model: DynamicModel) -> MassMatrixBound | None:
-    """The bound of a Hrovat & Tobler model from its core spec (geometry row: flow area at index
-    0, density at 1); None for the quasi-dynamic model, which has no such bound (§5)."""
+    """The bound of a Hrovat & Tobler model from its core spec, computed by the core; None for the
+    quasi-dynamic model, which has no such bound (§5)."""
     if model.name != "hrovat-tobler":
         return None
     s = model.spec
-    area, rho = s["geometry"][0], s["geometry"][1]
-    ip, it, i_s = s["inertia_kg_m2"]
-    stator = s["shape_effect_m2"][2]
-    return MassMatrixBound(rho, ip, it, rho * s["fluid_length_m"] / area, rho**2 * stator**2 / i_s)
+    geometry = np.ascontiguousarray(np.atleast_2d(np.asarray(s["geometry"], dtype=float)))
+    inertia = [float(i) for i in s["inertia_kg_m2"]]
+    args = (geometry, float(s["fluid_length_m"]), inertia, float(s["shape_effect_m2"][2]))
+    try:
+        b = MassMatrixBound(0.0, 0.0, 0.0, 0.0, 0.0, args)._at(*s["shape_effect_m2"][:2])
+    except _core.CoreInputError as e:
+        raise from_core(e, model.source) from None
+    return MassMatrixBound(
+        b["density_kg_m3"], inertia[0], inertia[1], b["inertance_kg_m4"], b["shape_terms_kg_m4"][2], args
+    )
 
 
 def inadmissible_note(bound: MassMatrixBound, pump_m2: float, turbine_m2: float) -> str:

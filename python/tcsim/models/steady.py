@@ -20,7 +20,8 @@ from ..errors import InputError, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .converter import Converter
 
-STATOR_MODES = {0: "locked", 1: "free-wheeling", 2: "no-flow", -1: "no-steady-state"}
+#: Codes of the ``stator_mode`` column of the core's steady states and their names (the core's).
+STATOR_MODES: dict[int, str] = _core.steady_mode_names()
 
 
 def _derived(df: pd.DataFrame) -> pd.DataFrame:
@@ -103,6 +104,13 @@ def hrovat_tobler_steady_state(
     return _core.ht_steady_states(geometry, wp, wt, strict)
 
 
+def steady_torque_ratio(out: dict[str, np.ndarray]) -> np.ndarray:
+    """TR of the steady states ``out`` of :func:`hrovat_tobler_steady_state`, by the core's rule
+    (``tcsim._core.steady_torque_ratio``): 1 in no-flow, ``T_t/T_p`` otherwise, NaN without a
+    steady state."""
+    return _core.steady_torque_ratio(out["stator_mode"], out["pump_torque_nm"], out["turbine_torque_nm"])
+
+
 def coupling_point(conv: Converter) -> float | None:
     """Speed ratio where the Hrovat & Tobler stator clutch releases, or None below SR = 1."""
     return _core.ht_coupling_point(conv.core_geometry())
@@ -134,11 +142,7 @@ def characterise_hrovat_tobler(
         out = hrovat_tobler_steady_state(conv.core_geometry(), pump, sr * wp)
     except _core.CoreInputError as e:
         raise from_core(e, conv.path, "[geometry] at ") from None
-    tr = np.where(
-        out["stator_mode"] == 2,
-        1.0,
-        out["turbine_torque_nm"] / np.where(out["pump_torque_nm"] == 0, 1.0, out["pump_torque_nm"]),
-    )
+    tr = steady_torque_ratio(out)
     df = pd.DataFrame(
         {
             "speed_ratio": sr,

@@ -3,9 +3,11 @@ under one scenario, and the runs of the shape-effect sweep (Li & Sundén 2016, �
 
 :func:`run_launch` is the only call into the core: all models in one call, the GIL released, one
 worker per core. Each run gives a time series with at least :data:`LAUNCH_COLUMNS` and its events
-(gear shifts, lock-up, converter events) as ``(time_s, kind, ...)``, a field of :class:`LaunchRun`.
+(gear shifts, lock-up, converter events) as ``(time_s, kind, gear)``, a field of :class:`LaunchRun`.
+The core's typed results (``tcsim._core.LaunchRun``) are read in one place, :func:`_unpack`.
 Errors: a bad vehicle, scenario or model is an :class:`~tcsim.errors.InputError` naming the file
-its field belongs to; a solver failure is a :class:`~tcsim.simulation.transient.SolverError`.
+of the input the core blames (its ``source``, data, not text); a solver failure is a
+:class:`~tcsim.simulation.transient.SolverError`.
 """
 
 from __future__ import annotations
@@ -19,12 +21,12 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError, TcsimWarning, core_value
+from ..errors import TcsimWarning, core_input_error, from_core
 from ..models.dynamic import DynamicModel
 from ..models.dynamic import select_models as select_converter_models
 from ..models.shape_effects import THESIS_PAIR_M2, mass_matrix_bound, sweep_values
-from ..models.vehicle import SECTIONS, Vehicle
-from .scenarios import SCENARIO_KEYS, Scenario
+from ..models.vehicle import Vehicle
+from .scenarios import Scenario
 from .transient import SolverError
 
 #: The shape-effect sweep runs to this long after the brake release (figures 4.3–4.6 show the first
@@ -53,13 +55,12 @@ DYNAMIC_MODELS: tuple[str, ...] = ("hrovat-tobler", "quasi-dynamic")
 # the core call
 
 
-def _source_of(fld: str, vehicle: Vehicle, scenario: Scenario, model: DynamicModel | None) -> str:
-    head = fld.lstrip("[").split("]")[0].split(".")[0].split("[")[0]
-    if head in SECTIONS or head == "vehicle":
-        return vehicle.path
-    if head in ("scenario", *SCENARIO_KEYS):
-        return scenario.source
-    return model.source if model is not None else "model"
+def _files(vehicle: Vehicle, scenario: Scenario, models: Sequence[DynamicModel]) -> dict[str, str]:
+    """Where each input the core may blame comes from (the models' converter file when they share
+    one)."""
+    converters = {m.source for m in models}
+    files = {"vehicle": vehicle.path, "scenario": scenario.source}
+    return {**files, "converter": converters.pop()} if len(converters) == 1 else {**files, "converter": "model"}
 
 
 @dataclass(frozen=True)
@@ -71,10 +72,18 @@ class LaunchRun:
     events: list[tuple[Any, ...]] = field(default_factory=list)
 
 
-def _run(columns: Mapping[str, Any], events: Sequence[Sequence[Any]]) -> LaunchRun:
-    df = pd.DataFrame({k: np.asarray(v) for k, v in columns.items()})
-    keep = df.notna().any() | (df.columns == "time_s")
-    return LaunchRun(df.loc[:, keep], [tuple(e) for e in events])
+def _unpack(run: _core.LaunchRun, name: str, files: Mapping[str, str]) -> LaunchRun | Exception:
+    """The one reading of the core's result of a launch run: the run, or its error (an
+    :class:`InputError` naming the file of the input the core blames, or a :class:`SolverError`)."""
+    err = run.error
+    if err is None:
+        df = pd.DataFrame({k: np.asarray(v) for k, v in run.columns.items()})
+        keep = df.notna().any() | (df.columns == "time_s")
+        return LaunchRun(df.loc[:, keep], [(e.time_s, e.kind, e.gear) for e in run.events])
+    if err.kind == "input":
+        assert err.source is not None and err.field is not None and err.expected is not None
+        return core_input_error(err.source, err.field, err.value, err.expected, files)
+    return SolverError(f"{name}: {err.message}")
 
 
 def run_launch(
@@ -106,23 +115,16 @@ def run_launch(
     try:
         raw = _core.launch_runs([m.spec for m in models], vehicle.core, scenario.core_spec(), options, threads)
     except _core.CoreInputError as e:
-        _msg, fld, value, expected = e.args
-        only = models[0] if len(models) == 1 else None
-        raise InputError(_source_of(fld, vehicle, scenario, only), fld, core_value(value), expected) from None
+        raise from_core(e, _files(vehicle, scenario, models)) from None
     out: dict[str, LaunchRun] = {}
-    for name, model, entry in zip(names, models, raw):
-        status = entry[0]
-        if status == "ok":
-            out[name] = _run(entry[1], entry[2])
+    for name, model, run in zip(names, models, raw):
+        result = _unpack(run, name, _files(vehicle, scenario, [model]))
+        if isinstance(result, LaunchRun):
+            out[name] = result
             continue
-        if status == "input":
-            _, _msg, fld, value, expected = entry
-            err: Exception = InputError(_source_of(fld, vehicle, scenario, model), fld, core_value(value), expected)
-            text = str(err)
-        else:
-            err, text = SolverError(f"{name}: {entry[1]}"), f"solver: {entry[1]}"
         if on_error == "raise":
-            raise err
+            raise result
+        text = f"solver: {run.error.message}" if isinstance(result, SolverError) and run.error else str(result)
         warnings.warn(f"{name} left out ({text})", TcsimWarning, stacklevel=2)
     return out
 

@@ -21,8 +21,6 @@ SPEED_100_KM_H_M_S = 100.0 * KM_H
 PEDAL_SWAP_S = 0.05
 #: Brake pedal position at or below which the brake counts as released (scenario files).
 BRAKE_RELEASED = 1e-3
-#: Fields of a scenario the core may name in an error.
-SCENARIO_KEYS = ("time_s", "accelerator_pedal", "brake_pedal", "end_time_s", "stop_speed_m_s")
 
 
 # ---------------------------------------------------------------------------------------------

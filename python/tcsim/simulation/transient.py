@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError, core_value
+from ..errors import InputError, core_input_error, from_core
 from ..models.converter import Converter
 from ..models.drives import Drive
 from ..models.dynamic import DynamicModel, dynamic_model
@@ -73,16 +73,17 @@ def _options(rtol: float | None, **extra) -> dict[str, Any]:
     return o
 
 
-def _unpack(entry, model: DynamicModel, index: int | None) -> TransientResult:
-    status = entry[0]
+def _unpack(run: _core.TransientRun, model: DynamicModel, index: int | None) -> TransientResult:
+    """The one reading of the core's result of a transient run (raises its error)."""
     where = "" if index is None else f" (run {index})"
-    if status == "ok":
-        _, cols, events = entry
-        return TransientResult(model.name, dict(cols), [Event(*e) for e in events])
-    if status == "input":
-        _, _msg, fld, value, expected = entry
-        raise InputError(model.source, fld + where, core_value(value), expected)
-    raise SolverError(f"{model.name}{where}: {entry[1]}")
+    err = run.error
+    if err is None:
+        events = [Event(e.time_s, e.kind, e.stator_locked, e.flow_sign) for e in run.events]
+        return TransientResult(model.name, dict(run.columns), events)
+    if err.kind == "input":
+        assert err.source is not None and err.field is not None and err.expected is not None
+        raise core_input_error(err.source, err.field + where, err.value, err.expected, {"converter": model.source})
+    raise SolverError(f"{model.name}{where}: {err.message}")
 
 
 def _initial(initial: dict[str, float] | None) -> dict[str, float] | None:
@@ -138,9 +139,7 @@ def simulate_batch(
             [m.spec for m in models], specs, _initial(initial), _options(rtol, **solver_options), threads
         )
     except _core.CoreInputError as e:
-        _msg, fld, value, expected = e.args
-        raise InputError(
-            models[0].source if len(models) == 1 else "model or drive", fld, core_value(value), expected
-        ) from None
+        converters = {m.source for m in models}
+        raise from_core(e, {"converter": converters.pop() if len(converters) == 1 else "model"}) from None
     n = len(raw)
     return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None) for i, r in enumerate(raw)]

@@ -42,7 +42,7 @@ use crate::engine::converter_events::{EventKind, Mode, Sample};
 use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
 use crate::engine::segment::SmoothSegment;
 use crate::engine::signal::Signal;
-use crate::error::CoreError;
+use crate::error::{CoreError, InputSource};
 
 /// How the converter is driven (issue: drives a, b, c).
 #[derive(Debug, Clone)]
@@ -424,7 +424,8 @@ pub fn initial_state(
         model
             .steady_point(wp, wt)
             .map_err(|e| {
-                CoreError::new(
+                CoreError::of(
+                    InputSource::Initial,
                     format!("initial state: {}", e.field),
                     e.value,
                     format!("{}; give the initial state explicitly", e.expected),
@@ -453,11 +454,12 @@ pub fn initial_state(
         ("initial flow_m3_s", u[3]),
     ] {
         if !v.is_finite() {
-            return Err(CoreError::new(name, v, "a finite value").into());
+            return Err(CoreError::of(InputSource::Initial, name, v, "a finite value").into());
         }
     }
     if model.has_stator_clutch() && u[STATOR] < 0.0 {
-        return Err(CoreError::new(
+        return Err(CoreError::of(
+            InputSource::Initial,
             "initial stator_speed_rad_s",
             u[STATOR],
             "zero or more: the one-way clutch stops backward rotation",
@@ -471,7 +473,12 @@ pub fn initial_state(
 /// speed `wt` ≥ 0.
 fn steady_pump_speed(model: &dyn ConverterDynamics, pump_torque_nm: f64, wt: f64) -> TransientResult<f64> {
     let bad = |expected: &str| {
-        TransientError::Input(CoreError::new("initial pump_torque_nm", pump_torque_nm, expected.to_string()))
+        TransientError::Input(CoreError::of(
+            InputSource::Drive,
+            "initial pump_torque_nm",
+            pump_torque_nm,
+            expected.to_string(),
+        ))
     };
     if pump_torque_nm.is_nan() || pump_torque_nm <= 0.0 {
         return Err(bad(
@@ -526,13 +533,15 @@ pub fn simulate(
 
 fn check_times(times_s: &[f64]) -> TransientResult<()> {
     if times_s.len() < 2 {
-        return Err(CoreError::new("time_s", format!("{} samples", times_s.len()), "at least two output times").into());
+        let n = format!("{} samples", times_s.len());
+        return Err(CoreError::of(InputSource::Drive, "time_s", n, "at least two output times").into());
     }
     if let Some(i) = times_s.iter().position(|t| !t.is_finite()) {
-        return Err(CoreError::new(format!("time_s[{i}]"), times_s[i], "finite times").into());
+        return Err(CoreError::of(InputSource::Drive, format!("time_s[{i}]"), times_s[i], "finite times").into());
     }
     if let Some(i) = (1..times_s.len()).find(|&i| times_s[i] <= times_s[i - 1]) {
-        return Err(CoreError::new(format!("time_s[{i}]"), times_s[i], "strictly increasing times").into());
+        let expected = "strictly increasing times";
+        return Err(CoreError::of(InputSource::Drive, format!("time_s[{i}]"), times_s[i], expected).into());
     }
     Ok(())
 }

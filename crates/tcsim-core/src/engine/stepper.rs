@@ -90,7 +90,13 @@ impl<M: ConverterDynamics> Stepper<M> {
     /// (pass the previous end values for continuous inputs). Returns the sample at the end.
     pub fn do_step(&mut self, h: f64, inputs_start: [f64; 2], inputs_end: [f64; 2]) -> TransientResult<Sample> {
         if !(h.is_finite() && h > 0.0) {
-            return Err(crate::CoreError::new("communication step size", h, "a finite, positive step").into());
+            let e = crate::CoreError::of(
+                crate::InputSource::Options,
+                "communication step size",
+                h,
+                "a finite, positive step",
+            );
+            return Err(e.into());
         }
         let (t0, t1) = (self.time_s, self.time_s + h);
         let drive = self.drive([t0, t1], inputs_start, inputs_end)?;

@@ -12,7 +12,7 @@ use crate::converter::dynamics::{ConverterDynamics, PUMP, TURBINE};
 use crate::engine::converter_events::{self, Mode as ConverterMode};
 use crate::engine::options::{SolverOptions, TransientError, TransientResult};
 use crate::engine::segment::{run_segment, SmoothSegment};
-use crate::error::{CoreError, CoreResult};
+use crate::error::{CoreError, CoreResult, InputSource};
 
 /// A launch run: samples, events, the kinetic energy removed at clutch locking events
 /// (momentum-conserving), and the solver's step count.
@@ -41,11 +41,14 @@ pub fn initial_state(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario) 
         Ok(crank - pump_at(w)?)
     };
     let (mut lo, mut hi) = (1.0_f64, v.engine.full_load.x().last().copied().unwrap_or(700.0));
+    // a logged engine torque is the scenario's; the engine model is the vehicle's
+    let source = if sc.engine_torque_nm.is_some() { InputSource::Scenario } else { InputSource::Vehicle };
     if balance(lo)? <= 0.0 || balance(hi)? >= 0.0 {
         return Err(match &sc.engine_torque_nm {
             Some(log) => CoreError::new("engine_torque_nm[0]", log.value(0.0), "a positive logged engine torque at the start that the stalled converter can absorb"),
             None => CoreError::new("[engine].idle_speed_rad_s", v.engine.idle_speed_rad_s, "an idle governor and full-load curve that can hold the stalled converter (no engine speed balances them)"),
         }
+        .about(source)
         .into());
     }
     for _ in 0..200 {
@@ -179,12 +182,14 @@ fn pending_switch(plant: &Plant, u: &Coords, t: f64) -> Option<Root> {
 
 /// The output times of a launch (validating the vehicle, the end time and the step).
 fn output_times(v: &Vehicle, sc: &Scenario, output_step_s: f64) -> TransientResult<Vec<f64>> {
-    v.validate()?;
+    v.validate().map_err(|e| e.about(InputSource::Vehicle))?;
     if !(sc.end_time_s.is_finite() && sc.end_time_s > 0.0) {
-        return Err(CoreError::new("end_time_s", sc.end_time_s, "a finite, positive end time").into());
+        let e = CoreError::of(InputSource::Scenario, "end_time_s", sc.end_time_s, "a finite, positive end time");
+        return Err(e.into());
     }
     if !(output_step_s.is_finite() && output_step_s > 0.0) {
-        return Err(CoreError::new("output_step_s", output_step_s, "a finite, positive output step").into());
+        let expected = "a finite, positive output step";
+        return Err(CoreError::of(InputSource::Options, "output_step_s", output_step_s, expected).into());
     }
     let n_out = (sc.end_time_s / output_step_s).round() as usize + 1;
     Ok((0..n_out).map(|i| (i as f64 * output_step_s).min(sc.end_time_s)).collect())

@@ -1,0 +1,149 @@
+"""The binding's typed result protocol (``_core.TransientRun``, ``_core.LaunchRun``, their events
+and ``_core.RunError``) and input errors attributed by the core as data (``source``), mapped to
+the right file without reading the message."""
+
+from __future__ import annotations
+
+import re
+from importlib import resources
+
+import numpy as np
+import pytest
+
+from tcsim import _core
+from tcsim import transient as tr
+from tcsim.errors import InputError
+from tcsim.models.dynamic import dynamic_model
+from tcsim.models.vehicle import load_vehicle
+from tcsim.simulation.launch import run_launch, select_models
+from tcsim.simulation.scenarios import flip_flop
+
+T = np.linspace(0.0, 1.0, 11)
+
+
+def test_input_sources_are_the_core_ones():
+    assert _core.input_sources() == ["converter", "drive", "initial", "scenario", "vehicle", "options"]
+
+
+def test_transient_runs_return_typed_results():
+    m = dynamic_model("li-sunden-2016", "hrovat-tobler")
+    drive = tr.isolated_takeoff(tip_out=True).spec()
+    bad = {**drive, "output_time_s": [0.0, 0.0]}
+    ok, failed = _core.transient_runs([m.spec], [drive, bad])
+    assert isinstance(ok, _core.TransientRun) and ok.ok and ok.error is None
+    assert list(ok.columns) == _core.transient_columns() and len(ok.columns["time_s"]) == len(drive["time_s"])
+    assert ok.events and all(isinstance(e, _core.TransientEvent) for e in ok.events)
+    e = ok.events[0]
+    assert e.kind == "stator-release" and isinstance(e.stator_locked, bool) and e.flow_sign in (-1.0, 0.0, 1.0)
+    assert not failed.ok and failed.columns == {} and failed.events == []
+    err = failed.error
+    assert isinstance(err, _core.RunError) and err.kind == "input"
+    assert (err.source, err.field, err.expected) == ("drive", "time_s[1]", "strictly increasing times")
+    assert err.message == "time_s[1] = 0: expected strictly increasing times"
+
+
+def test_launch_runs_return_typed_results():
+    v = load_vehicle()
+    table, ht = (dynamic_model(v.converter, name) for name in ("table", "hrovat-tobler"))
+    scen = flip_flop(hold_s=0.5, end_time_s=3.0).core_spec()
+    runs = _core.launch_runs([table.spec, ht.spec], v.core, scen)
+    assert all(isinstance(r, _core.LaunchRun) and r.ok and r.error is None for r in runs)
+    assert list(runs[0].columns) == _core.launch_columns()
+    assert all(isinstance(e, _core.LaunchEvent) and isinstance(e.gear, int) for e in runs[0].events)
+    assert runs[0].events[0].kind == "brake-release" and runs[0].events[0].gear == 1
+
+
+def test_result_types_can_be_built_for_stand_ins():
+    err = _core.RunError("solver", "step size too small")
+    run = _core.LaunchRun(error=err)
+    assert not run.ok and run.columns == {} and run.events == [] and run.error.source is None
+    ev = _core.LaunchEvent(1.5, "upshift", 2)
+    run = _core.LaunchRun({"time_s": np.zeros(2)}, [ev])
+    assert run.ok and run.events[0].gear == 2
+    assert _core.TransientRun(events=[_core.TransientEvent(0.1, "flow-zero", True, 0.0)]).events[0].kind == "flow-zero"
+    with pytest.raises(ValueError, match="kind"):
+        _core.RunError("oops", "message")
+    with pytest.raises(AttributeError):
+        run.ok = False  # frozen
+
+
+def test_core_input_error_carries_its_source():
+    drive = tr.PumpTorqueTurbineSpeed(np.array([0.0, 1.0]), np.array([50.0, np.nan]), np.zeros(2)).spec()
+    with pytest.raises(_core.CoreInputError) as e:
+        _core.transient_runs([dynamic_model("li-sunden-2016", "table").spec], [drive])
+    message, field, value, expected, source = e.value.args
+    assert (field, value, expected, source) == ("pump_torque_nm[1]", "NaN", "a finite value", "drive")
+    assert message == "pump_torque_nm[1] = NaN: expected a finite value"
+
+
+# the Python side maps the source to a file; these named the converter file before
+
+
+def test_drive_errors_name_the_drive():
+    drive = tr.PumpTorqueTurbineSpeed(np.array([0.0, 1.0, 2.0]), np.array([50.0, np.nan, 50.0]), np.zeros(3))
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", drive, model="table")
+    assert (e.value.source, e.value.field) == ("drive", "pump_torque_nm[1]")
+    assert str(e.value) == "drive: pump_torque_nm[1] = nan: expected a finite value"
+    drive = tr.PumpTorqueTurbineSpeed(np.array([0.0, 1.0]), np.array([-20.0, -20.0]), np.zeros(2))
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", drive, model="hrovat-tobler")
+    assert (e.value.source, e.value.field) == ("drive", "initial pump_torque_nm")
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="table", times_s=[0.0, 0.5, 0.5])
+    assert (e.value.source, e.value.field) == ("drive", "time_s[2]")
+
+
+def test_initial_state_errors_name_the_initial_state():
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), times_s=T, initial={"stator_speed_rad_s": -1.0})
+    assert (e.value.source, e.value.field) == ("initial state", "initial stator_speed_rad_s")
+
+
+def test_option_errors_name_the_solver_options():
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="table", times_s=T, rtol=-1.0)
+    assert (e.value.source, e.value.field, e.value.value) == ("solver options", "rtol", -1.0)
+    v = load_vehicle()
+    models = select_models(v, ["table", "hrovat-tobler"])
+    with pytest.raises(InputError) as e:
+        run_launch(v, flip_flop(), models, options={"output_step_s": -0.01})
+    assert (e.value.source, e.value.field) == ("solver options", "output_step_s")
+    with pytest.raises(InputError) as e:
+        run_launch(v, flip_flop(), models, options={"rtol": 0.0})
+    assert (e.value.source, e.value.field) == ("solver options", "rtol")
+
+
+def test_converter_errors_of_a_launch_name_the_shared_converter_file():
+    v = load_vehicle()
+    table, ht = (dynamic_model(v.converter, name) for name in ("table", "hrovat-tobler"))
+    bad = ht.with_shape_effects(0.2, 0.0)
+    with pytest.raises(InputError) as e:
+        run_launch(v, flip_flop(), [table, bad])
+    assert (e.value.source, e.value.field) == (table.source, "geometry.pump_shape_effect_m2")
+    other = type(bad)(bad.name, bad.spec, "other.toml")
+    with pytest.raises(InputError) as e:
+        run_launch(v, flip_flop(), [table, other])
+    assert e.value.source == "model"
+
+
+def test_vehicle_errors_the_core_finds_name_the_vehicle_file():
+    """The one vehicle check (``_core.read_vehicle``) says the error is the vehicle's, in the file's
+    dialect; ``launch_runs`` takes only a vehicle the core has read."""
+    text = (resources.files("tcsim") / "data" / "vehicles" / "midsize-awd-8at.toml").read_text()
+    short = re.sub(r"(?m)^full_load_torque_nm = \[(.*), ([^,\]]+)\]$", r"full_load_torque_nm = [\1]", text)
+    with pytest.raises(_core.CoreInputError) as e:
+        _core.read_vehicle(short, "v.toml")
+    assert e.value.args[1] == "[engine].full_load_torque_nm" and e.value.args[4] == "vehicle"
+    steep = re.sub(r"(?m)^grade_percent = .*$", "grade_percent = 60.0", text)
+    with pytest.raises(_core.CoreInputError) as e:
+        _core.read_vehicle(steep, "v.toml")
+    assert e.value.args[1:] == (
+        "[body].grade_percent",
+        "60",
+        "a finite number at least -50 and at most 50",
+        "vehicle",
+    )
+    m = dynamic_model("li-sunden-2016", "table")
+    with pytest.raises(TypeError):
+        _core.launch_runs([m.spec], load_vehicle().core_spec(), flip_flop().core_spec())
