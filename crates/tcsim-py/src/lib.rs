@@ -33,7 +33,6 @@ use tcsim_core::engine::converter_events::EventKind;
 use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
 use tcsim_core::engine::options::{SolverOptions, TransientError};
 use tcsim_core::engine::signal::Signal;
-use tcsim_core::vehicle::components::engine_drag_nm;
 use tcsim_core::vehicle::file::{read_vehicle as read_vehicle_core, VehicleDocument};
 use tcsim_core::vehicle::launch::simulate_launch;
 use tcsim_core::vehicle::outputs::launch_column_names;
@@ -944,14 +943,6 @@ fn steady_torque_ratio<'py>(
     })
 }
 
-/// The engine's drag torque in the vehicle plant, N·m, at engine speed `speed_rad_s` (rad/s):
-/// `drag_torque_nm·tanh(ω/1 rad/s) + drag_nm_s_per_rad·ω`, opposing rotation (zero at rest).
-/// (The drag of the former Python vehicle schema, which lacked the tanh, is gone with that schema.)
-#[pyfunction]
-fn vehicle_engine_drag_nm(speed_rad_s: f64, drag_torque_nm: f64, drag_nm_s_per_rad: f64) -> f64 {
-    engine_drag_nm(speed_rad_s, drag_torque_nm, drag_nm_s_per_rad)
-}
-
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
@@ -968,7 +959,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mass_matrix_bound, m)?)?;
     m.add_function(wrap_pyfunction!(steady_mode_names, m)?)?;
     m.add_function(wrap_pyfunction!(steady_torque_ratio, m)?)?;
-    m.add_function(wrap_pyfunction!(vehicle_engine_drag_nm, m)?)?;
     m.add_function(wrap_pyfunction!(capacity_to_cf, m)?)?;
     m.add_function(wrap_pyfunction!(cf_to_capacity, m)?)?;
     m.add_function(wrap_pyfunction!(ht_parameter_names, m)?)?;
