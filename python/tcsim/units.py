@@ -2,16 +2,15 @@
 
 from __future__ import annotations
 
-import math
-
 from . import _core
 
-#: rad/s per rpm.
-RAD_S_PER_RPM = math.pi / 30.0
+_UNITS = _core.unit_constants()  # the core's tcsim_core::units, the one owner of these numbers
+#: rad/s per rpm (π/30).
+RAD_S_PER_RPM: float = _UNITS["rad_s_per_rpm"]
 #: m/s per km/h.
-KM_H = 1.0 / 3.6
+KM_H: float = _UNITS["m_s_per_km_h"]
 #: N·m per lbf·ft.
-LBF_FT_IN_NM = 1.3558179483314004
+LBF_FT_IN_NM: float = _UNITS["nm_per_lbf_ft"]
 #: The pump speed at which tcsim evaluates steady states and stall figures unless told otherwise, rpm:
 #: the core's reference pump speed (also where the default flow time constant τ_Q is evaluated).
 DEFAULT_PUMP_SPEED_RPM: float = _core.reference_pump_speed_rpm()

@@ -107,3 +107,11 @@ def test_steady_torque_ratio_is_the_reference_rule():
     df = characterise_hrovat_tobler(conv)
     strict = hrovat_tobler_steady_state(conv.core_geometry(), df["pump_speed_rad_s"], df["turbine_speed_rad_s"])
     np.testing.assert_array_equal(df["torque_ratio"], reference_torque_ratio(strict))
+
+
+def test_unit_constants_are_the_core_ones_and_the_plain_values():
+    # one owner (tcsim_core::units); bit for bit what the Python side computed before
+    assert units.RAD_S_PER_RPM == _core.unit_constants()["rad_s_per_rpm"] == math.pi / 30.0
+    assert units.KM_H == _core.unit_constants()["m_s_per_km_h"] == 1.0 / 3.6
+    assert units.LBF_FT_IN_NM == _core.unit_constants()["nm_per_lbf_ft"] == 1.3558179483314004
+    assert 2000.0 * units.RAD_S_PER_RPM == pytest.approx(units.DEFAULT_PUMP_SPEED_RAD_S, rel=1e-15)

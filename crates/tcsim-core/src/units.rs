@@ -2,6 +2,10 @@
 
 /// rpm per rad/s (`60 / 2π`).
 pub const RPM_PER_RAD_S: f64 = 60.0 / (2.0 * std::f64::consts::PI);
+/// rad/s per rpm (`π/30`), the factor the Python side multiplies by.
+pub const RAD_S_PER_RPM: f64 = std::f64::consts::PI / 30.0;
+/// m/s per km/h.
+pub const M_S_PER_KM_H: f64 = 1.0 / 3.6;
 /// N·m per lbf·ft.
 pub const NM_PER_LBF_FT: f64 = 1.355_817_948_331_400_4;
 /// Standard gravity, m/s².
@@ -29,5 +33,7 @@ mod tests {
         assert_eq!(REFERENCE_PUMP_SPEED_RAD_S, 2000.0 * std::f64::consts::PI / 30.0);
         assert_eq!(rad_s_from_rpm(REFERENCE_PUMP_SPEED_RPM), REFERENCE_PUMP_SPEED_RAD_S);
         assert!((REFERENCE_PUMP_SPEED_RAD_S * RPM_PER_RAD_S - 2000.0).abs() < 1e-9);
+        assert!((RAD_S_PER_RPM * RPM_PER_RAD_S - 1.0).abs() < 1e-15);
+        assert!((M_S_PER_KM_H * 3.6 - 1.0).abs() < 1e-15);
     }
 }

@@ -868,6 +868,19 @@ fn default_flow_time_constant_s(geometry: PyReadonlyArray2<'_, f64>, fluid_lengt
     })
 }
 
+/// The unit conversions of the core (`tcsim_core::units`), by name: `rad_s_per_rpm`, `m_s_per_km_h`,
+/// `nm_per_lbf_ft`, `gravity_m_s2`. Python's `tcsim.units` takes its constants from here.
+#[pyfunction]
+fn unit_constants() -> BTreeMap<&'static str, f64> {
+    use tcsim_core::units::{GRAVITY_M_S2, M_S_PER_KM_H, NM_PER_LBF_FT, RAD_S_PER_RPM};
+    BTreeMap::from([
+        ("rad_s_per_rpm", RAD_S_PER_RPM),
+        ("m_s_per_km_h", M_S_PER_KM_H),
+        ("nm_per_lbf_ft", NM_PER_LBF_FT),
+        ("gravity_m_s2", GRAVITY_M_S2),
+    ])
+}
+
 /// The reference pump speed in rpm (2000): where the default τ_Q is evaluated and the default pump
 /// speed of a characterisation. Convert with `reference_pump_speed_rad_s()`.
 #[pyfunction]
@@ -954,6 +967,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(input_sources, m)?)?;
     m.add_function(wrap_pyfunction!(capacity_conventions, m)?)?;
     m.add_function(wrap_pyfunction!(default_flow_time_constant_s, m)?)?;
+    m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
     m.add_function(wrap_pyfunction!(reference_pump_speed_rpm, m)?)?;
     m.add_function(wrap_pyfunction!(reference_pump_speed_rad_s, m)?)?;
     m.add_function(wrap_pyfunction!(mass_matrix_bound, m)?)?;
