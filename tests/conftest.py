@@ -13,6 +13,7 @@ import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
+import pandas as pd
 import pytest
 
 from tcsim.cli import main
@@ -22,24 +23,12 @@ from tcsim.io import fmu as fmu_io
 REPO = Path(__file__).resolve().parents[1]
 CONVERTER_DATA = REPO / "tests" / "data" / "converters"  # published tables (tests/data/README.md)
 
-# Li & Sundén (2016) Table C.1 with CF in N·m/(rad/s)²
-C1_SR = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0]
-C1_TR = [2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00]
-C1_CF = [
-    3.272e-3,
-    3.257e-3,
-    3.228e-3,
-    3.181e-3,
-    3.112e-3,
-    3.017e-3,
-    2.887e-3,
-    2.713e-3,
-    2.481e-3,
-    2.370e-3,
-    1.842e-3,
-    1.237e-3,
-    0.187e-3,
-]
+# Li & Sundén (2016) Table C.1 with CF in N·m/(rad/s)², from the published table in tests/data
+TABLE_C1 = CONVERTER_DATA / "li_sunden_2016_table_c1.csv"
+_C1 = pd.read_csv(TABLE_C1, comment="#")
+C1_SR: list[float] = _C1["speed_ratio"].tolist()
+C1_TR: list[float] = _C1["torque_ratio"].tolist()
+C1_CF: list[float] = _C1["capacity_factor_nm_s2"].tolist()
 
 
 @dataclass

@@ -15,28 +15,8 @@ from tcsim.cli import main
 
 Frames = dict[str, pd.DataFrame]
 
-# Li & Sundén (2016) Table C.1, CF in N·m/(rad/s)²
-C1 = pd.DataFrame(
-    {
-        "speed_ratio": [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
-        "torque_ratio": [2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
-        "capacity_factor_nm_s2": [
-            3.272e-3,
-            3.257e-3,
-            3.228e-3,
-            3.181e-3,
-            3.112e-3,
-            3.017e-3,
-            2.887e-3,
-            2.713e-3,
-            2.481e-3,
-            2.370e-3,
-            1.842e-3,
-            1.237e-3,
-            0.187e-3,
-        ],
-    }
-)
+# Li & Sundén (2016) Table C.1, CF in N·m/(rad/s)²: the published table in tests/data
+TABLE_C1 = Path(__file__).resolve().parents[1] / "data" / "converters" / "li_sunden_2016_table_c1.csv"
 
 
 def make_measurement(path: Path) -> None:
@@ -89,9 +69,7 @@ def study(out: Path, data: Path) -> Frames:
 
 
 def fit(out: Path, data: Path) -> Frames:
-    target = out.parent / "c1.csv"
-    C1.to_csv(target, index=False)
-    _run("fit", "li-sunden-2016", "--target", target, "--out", out)
+    _run("fit", "li-sunden-2016", "--target", TABLE_C1, "--out", out)
     fitted = tomllib.loads((out / "fitted.toml").read_text())
     rows = [
         (f"{section}.{key}", float(value))

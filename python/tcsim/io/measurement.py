@@ -320,6 +320,20 @@ READERS: dict[str, Callable[[Path, _Chooser], _Loaded]] = {
 # checks
 
 
+def reader_for(path: Path, what: str) -> Callable[[Path, _Chooser], _Loaded]:
+    """The reader of a time-series file by its extension (:data:`READERS`); an :class:`InputError`
+    naming the file when the extension is unknown or the file does not exist (``what`` says which
+    kind of file the command wanted: ``measurement``, ``scenario``)."""
+    reader = READERS.get(path.suffix.lower())
+    if reader is None:
+        raise InputError(
+            str(path), "(extension)", path.suffix or "(none)", f"a {what} file ending in one of {', '.join(READERS)}"
+        )
+    if not path.is_file():
+        raise InputError(str(path), "(file)", "not found", f"an existing {what} file")
+    return reader
+
+
 def _at(row: int, time_s: np.ndarray | None) -> str:
     """Where a value is: the 1-based data row, and the time once that is known."""
     return f"row {row + 1}" + (f" (time_s {time_s[row]:g})" if time_s is not None else "")
@@ -414,16 +428,7 @@ def read_measurement(
         if target not in _QUANTITY:
             raise InputError("--channel", "--channel", f"{target}={column}", _MAP_EXPECTED)
     path = Path(path)
-    reader = READERS.get(path.suffix.lower())
-    if reader is None:
-        raise InputError(
-            str(path),
-            "(extension)",
-            path.suffix or "(none)",
-            f"a measurement file ending in one of {', '.join(READERS)}",
-        )
-    if not path.is_file():
-        raise InputError(str(path), "(file)", "not found", "an existing measurement file")
+    reader = reader_for(path, "measurement")
 
     picker = _Picker(path, channels, required, optional)
     raw, units = reader(path, picker)

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..errors import InputError
 from ..simulation.scenarios import Scenario, brake_release_time, flip_flop, part_pedal
-from .measurement import READERS, check_finite, check_increasing, check_numeric
+from .measurement import check_finite, check_increasing, check_numeric, reader_for
 
 _PEDALS = ("accelerator_pedal", "brake_pedal")
 _TIME_COLUMNS = {"time_s": 1.0, "time_ms": 1e-3}
@@ -72,16 +72,7 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
     or ``stop_speed_m_s``; the brake release time is :func:`brake_release_time`. Times are
     shifted so that the first sample is time 0 (runs start at time 0, braked and at rest)."""
     path = Path(path)
-    reader = READERS.get(path.suffix.lower())
-    if reader is None:
-        raise InputError(
-            str(path),
-            "(extension)",
-            path.suffix or "(none)",
-            f"a scenario file ending in one of {', '.join(READERS)}",
-        )
-    if not path.is_file():
-        raise InputError(str(path), "(file)", "not found", "an existing scenario file")
+    reader = reader_for(path, "scenario")
     picker = _ScenarioPicker(path)
     raw, units = reader(path, picker)
     time_column, time_factor = picker.picks["time_s"]
