@@ -42,13 +42,13 @@ class RunError:
     ) -> None: ...
 
 class TransientEvent:
-    """An event of an isolated run; ``flow_sign`` after it: +1, −1 or 0 (held at zero)."""
+    """An event of an isolated run; ``flow_direction`` after it: +1, −1 or 0 (held at zero)."""
 
     time_s: float
     kind: str
     stator_locked: bool
-    flow_sign: float
-    def __init__(self, time_s: float, kind: str, stator_locked: bool, flow_sign: float) -> None: ...
+    flow_direction: float
+    def __init__(self, time_s: float, kind: str, stator_locked: bool, flow_direction: float) -> None: ...
 
 class LaunchEvent:
     """An event of a launch run (gear shifts, lock-up, converter events) and the gear after it."""

@@ -34,7 +34,7 @@ def test_transient_runs_return_typed_results():
     assert list(ok.columns) == _core.transient_columns() and len(ok.columns["time_s"]) == len(drive["time_s"])
     assert ok.events and all(isinstance(e, _core.TransientEvent) for e in ok.events)
     e = ok.events[0]
-    assert e.kind == "stator-release" and isinstance(e.stator_locked, bool) and e.flow_sign in (-1.0, 0.0, 1.0)
+    assert e.kind == "stator-release" and isinstance(e.stator_locked, bool) and e.flow_direction in (-1.0, 0.0, 1.0)
     assert not failed.ok and failed.columns == {} and failed.events == []
     err = failed.error
     assert isinstance(err, _core.RunError) and err.kind == "input"

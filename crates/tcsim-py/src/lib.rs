@@ -353,14 +353,14 @@ struct TransientEvent {
     time_s: f64,
     kind: String,
     stator_locked: bool,
-    flow_sign: f64,
+    flow_direction: f64,
 }
 
 #[pymethods]
 impl TransientEvent {
     #[new]
-    fn new(time_s: f64, kind: String, stator_locked: bool, flow_sign: f64) -> Self {
-        TransientEvent { time_s, kind, stator_locked, flow_sign }
+    fn new(time_s: f64, kind: String, stator_locked: bool, flow_direction: f64) -> Self {
+        TransientEvent { time_s, kind, stator_locked, flow_direction }
     }
     fn __repr__(&self) -> String {
         format!("TransientEvent(time_s={}, kind={:?})", self.time_s, self.kind)

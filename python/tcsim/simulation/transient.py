@@ -78,7 +78,7 @@ def _unpack(run: _core.TransientRun, model: DynamicModel, index: int | None) -> 
     where = "" if index is None else f" (run {index})"
     err = run.error
     if err is None:
-        events = [Event(e.time_s, e.kind, e.stator_locked, e.flow_sign) for e in run.events]
+        events = [Event(e.time_s, e.kind, e.stator_locked, e.flow_direction) for e in run.events]
         return TransientResult(model.name, dict(run.columns), events)
     if err.kind == "input":
         assert err.source is not None and err.field is not None and err.expected is not None
