@@ -396,12 +396,6 @@ def test_run_launch_errors(fake_core, vehicle, monkeypatch):
     assert err.value.source == vehicle.path
 
 
-def test_run_launch_without_the_core_is_a_clear_failure(monkeypatch, vehicle):
-    monkeypatch.delattr(tcsim._core, "launch_runs", raising=False)
-    with pytest.raises(RuntimeError, match="launch_runs"):
-        run_launch(vehicle, flip_flop(), select_models(vehicle, ["table"]))
-
-
 def test_sweep_cases_use_admissible_values(vehicle):
     models = select_models(vehicle, [])
     cases = sweep_cases(models)

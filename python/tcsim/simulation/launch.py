@@ -107,11 +107,6 @@ def run_launch(
     names = list(labels) if labels is not None else [m.name for m in models]
     if len(names) != len(models) or len(set(names)) != len(names):
         raise ValueError(f"one unique label per model needed: {names}")
-    if not hasattr(_core, "launch_runs"):  # a core built without the vehicle plant
-        raise RuntimeError(
-            "this build of tcsim._core has no vehicle plant (launch_runs); reinstall tcsim "
-            "(python3 -m pip install .) from a source tree that has it"
-        )
     try:
         raw = _core.launch_runs([m.spec for m in models], vehicle.core, scenario.core_spec(), options, threads)
     except _core.CoreInputError as e:
