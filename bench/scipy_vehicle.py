@@ -1,8 +1,8 @@
 """Plain NumPy/SciPy reference: the whole-vehicle launch with the table converter model.
 
-Benchmark baseline and independent oracle for tcsim's vehicle plant
-(``crates/tcsim-core/src/vehicle.rs``, equations in ``docs/vehicle.md``), transcribed for the
-**table** converter model only (``TableDynamics`` in ``crates/tcsim-core/src/dynamics.rs``:
+Benchmark baseline and independent oracle for tcsim's vehicle plant (``crates/tcsim-core/src/vehicle/``:
+``plant.rs``, ``components.rs``, ``launch.rs``; equations in ``docs/vehicle.md``), transcribed for the
+**table** converter model only (``TableDynamics`` in ``crates/tcsim-core/src/converter/dynamics.rs``:
 ``I_p ω̇_p = T_p − CF(SR) ω_p|ω_p|``, ``I_t ω̇_t = TR(SR) CF(SR) ω_p|ω_p| + T_t``, the Table C.1
 characteristic of ``li-sunden-2016.toml`` interpolated linearly in SR = ω_t/ω_p, end values held).
 
@@ -64,7 +64,7 @@ REPO = Path(__file__).resolve().parents[1]
 CONVERTER = REPO / "python/tcsim/data/converters/li-sunden-2016.toml"
 
 G = 9.81  # standard gravity, m/s²
-# Regularisation scales of vehicle.rs
+# Regularisation scales of crates/tcsim-core/src/vehicle/ (components.rs, modes.rs)
 CLUTCH_SLIP_RAD_S = 0.2  # tanh(slip/0.2) of the lock-up and shift clutches
 SYNC_SLIP_RAD_S = 0.5  # a synchronising clutch locks below this slip
 BRAKE_SPEED_RAD_S = 0.002  # tanh(ω/0.002) of the brake on a moving axle

@@ -920,12 +920,14 @@ fn mass_matrix_bound<'py>(
         d.set_item("shape_terms_kg_m4", b.shape_terms_kg_m4.to_vec())?;
         d.set_item("margin_kg_m4", b.margin_kg_m4())?;
         d.set_item("shape_effect_bounds_m2", b.shape_effect_bounds().to_vec())?;
+        d.set_item("pump_turbine_room_kg_m4", b.pump_turbine_room_kg_m4())?;
+        d.set_item("equal_shape_effect_bound_m2", b.equal_shape_effect_bound_m2())?;
         Ok(d)
     })
 }
 
 /// Codes of the `stator_mode` column of `ht_steady_states` and their names: `{0: "locked",
-/// 1: "free-wheeling", 2: "no-flow", -1: "no-steady-state"}`. Replaces `tcsim.steady.STATOR_MODES`
+/// 1: "free-wheeling", 2: "no-flow", -1: "no-steady-state"}`. Replaces the former Python `STATOR_MODES` table
 /// and the bare `mode == 2` of `steady.py` and `study.py`.
 #[pyfunction]
 fn steady_mode_names() -> BTreeMap<i8, &'static str> {

@@ -104,8 +104,8 @@ class Characteristic:
         lo, hi = PLAUSIBLE_STALL_TORQUE_NM
         if not lo <= t <= hi:
             warnings.warn(
-                f"{self.source}: stall torque at 2000 rpm is {t:.4g} N·m with the capacity read as "
-                f"{self.convention}; a passenger-car converter gives {lo:g}–{hi:g} N·m. "
+                f"{self.source}: stall torque at {DEFAULT_PUMP_SPEED_RPM:g} rpm is {t:.4g} N·m with the capacity "
+                f"read as {self.convention}; a passenger-car converter gives {lo:g}–{hi:g} N·m. "
                 "Check the capacity convention.",
                 TcsimWarning,
                 stacklevel=3,

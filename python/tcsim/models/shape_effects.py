@@ -3,7 +3,6 @@ notes §4) and the shape-effect values the sweeps use (Li & Sundén 2016 §4.1).
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -45,7 +44,8 @@ class MassMatrixBound:
 
     @property
     def room(self) -> float:
-        return self.inertance_kg_m4 - self.stator_term_kg_m4
+        """``ρL_f/A − ρ²S_s²/I_s``, kg/m⁴ (the core's ``pump_turbine_room_kg_m4``)."""
+        return float(self._at(0.0, 0.0)["pump_turbine_room_kg_m4"])
 
     def load(self, pump_m2: float, turbine_m2: float) -> float:
         """``ρ²S_p²/I_p + ρ²S_t²/I_t``."""
@@ -67,8 +67,8 @@ class MassMatrixBound:
         return bounds[0], bounds[1]
 
     def equal(self) -> float:
-        """Largest admissible |S| with S_p = S_t = S, m² (``load`` is quadratic in S)."""
-        return math.sqrt(max(self.room, 0.0) / self.load(1.0, 1.0))
+        """Largest admissible |S| with S_p = S_t = S, m² (the core's ``equal_shape_effect_bound_m2``)."""
+        return float(self._at(0.0, 0.0)["equal_shape_effect_bound_m2"])
 
 
 def mass_matrix_bound(model: DynamicModel) -> MassMatrixBound | None:

@@ -358,6 +358,20 @@ impl MassMatrixBound {
         self.inertance_kg_m4 - self.shape_terms_kg_m4.iter().sum::<f64>()
     }
 
+    /// `ρL_f/A − ρ²S_s²/I_s`, kg/m⁴: the inertance left for the pump and turbine shape effects with the
+    /// stator's as given (what a fit or a sweep of `S_p`, `S_t` may use).
+    pub fn pump_turbine_room_kg_m4(&self) -> f64 {
+        self.inertance_kg_m4 - self.shape_terms_kg_m4[2]
+    }
+
+    /// Largest admissible `|S|` with `S_p = S_t = S` and the stator's as given, m²:
+    /// `√(room / (ρ²/I_p + ρ²/I_t))` (0 when no room is left).
+    pub fn equal_shape_effect_bound_m2(&self) -> f64 {
+        let (rho, inertia) = (self.density_kg_m3, self.inertia_kg_m2);
+        let unit_load = rho * rho * 1.0f64.powi(2) / inertia[0] + rho * rho * 1.0f64.powi(2) / inertia[1];
+        (self.pump_turbine_room_kg_m4().max(0.0) / unit_load).sqrt()
+    }
+
     /// Largest admissible magnitude of each shape effect with the others as given, m² (0 when the
     /// others already use up the inertance).
     pub fn shape_effect_bounds(&self) -> [f64; 3] {
