@@ -39,7 +39,7 @@ from .. import _core
 from ..errors import InputError
 from ..models.characteristic import Characteristic
 from ..models.converter import STEADY_KEYS, STEADY_SCALE, Converter, GeometrySection, load_converter
-from ..models.steady import characterise_hrovat_tobler
+from ..models.steady import characterise_hrovat_tobler, ratio_frame
 from ..units import DEFAULT_PUMP_SPEED_RAD_S, RAD_S_PER_RPM
 
 PUMP_SPEED_RAD_S = DEFAULT_PUMP_SPEED_RAD_S
@@ -635,14 +635,4 @@ def model_curve(conv: Converter) -> pd.DataFrame:
     except InputError:  # a point of the sweep without a steady state: plot the others
         sr = np.linspace(0.0, 1.0, 101)
         tr, cf, _, _ = _core.ht_ratio_gradients(conv.core_geometry(), PUMP_SPEED_RAD_S, sr, [])
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(cf))
-        return pd.DataFrame(
-            {
-                "speed_ratio": sr,
-                "torque_ratio": tr,
-                "capacity_factor_nm_s2": cf,
-                "k_factor_rpm_per_sqrt_nm": k,
-                "efficiency": tr * sr,
-            }
-        )
+        return ratio_frame(sr, tr, cf)

@@ -24,13 +24,31 @@ from .converter import Converter
 STATOR_MODES: dict[int, str] = _core.steady_mode_names()
 
 
+def k_factor_rpm_per_sqrt_nm(capacity_factor_nm_s2: np.ndarray) -> np.ndarray:
+    """K-factor, rpm/√(N·m), of capacity factors in N·m/(rad/s)² (the core's conversion; inf at CF 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(capacity_factor_nm_s2))
+
+
+def ratio_frame(speed_ratio: np.ndarray, torque_ratio: np.ndarray, capacity_factor_nm_s2: np.ndarray) -> pd.DataFrame:
+    """SR, TR and CF with what follows from them: the K-factor and the efficiency TR·SR."""
+    return pd.DataFrame(
+        {
+            "speed_ratio": speed_ratio,
+            "torque_ratio": torque_ratio,
+            "capacity_factor_nm_s2": capacity_factor_nm_s2,
+            "k_factor_rpm_per_sqrt_nm": k_factor_rpm_per_sqrt_nm(capacity_factor_nm_s2),
+            "efficiency": torque_ratio * speed_ratio,
+        }
+    )
+
+
 def _derived(df: pd.DataFrame) -> pd.DataFrame:
     """Add CF, K-factor and efficiency from torques and speeds."""
     wp = df["pump_speed_rad_s"].to_numpy()
     cf = df["pump_torque_nm"].to_numpy() / wp**2
     df["capacity_factor_nm_s2"] = cf
-    with np.errstate(divide="ignore", invalid="ignore"):
-        df["k_factor_rpm_per_sqrt_nm"] = _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(cf))
+    df["k_factor_rpm_per_sqrt_nm"] = k_factor_rpm_per_sqrt_nm(cf)
     df["efficiency"] = df["torque_ratio"] * df["speed_ratio"]
     return df
 

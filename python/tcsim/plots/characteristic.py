@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from .. import _core
 from ..models.characteristic import Characteristic
+from ..models.steady import ratio_frame
 from .common import plt
 
 QUANTITIES = {
@@ -20,18 +20,7 @@ QUANTITIES = {
 
 
 def table_columns(table: Characteristic) -> pd.DataFrame:
-    sr, tr, cf = table.arrays()
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = _core.cf_to_capacity("k_factor_rpm_per_sqrt_nm", np.ascontiguousarray(cf))
-    return pd.DataFrame(
-        {
-            "speed_ratio": sr,
-            "torque_ratio": tr,
-            "capacity_factor_nm_s2": cf,
-            "k_factor_rpm_per_sqrt_nm": k,
-            "efficiency": tr * sr,
-        }
-    )
+    return ratio_frame(*table.arrays())
 
 
 def plot_characteristic(
