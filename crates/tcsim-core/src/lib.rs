@@ -15,6 +15,7 @@
 //! * [`batch`]: batched evaluation for characteristics, studies, fitting and parallel runs.
 //! * [`interp`]: linear interpolation with the end values held.
 //! * [`units`]: unit constants and the 2000 rpm reference pump speed.
+//! * [`plausibility`]: the physical plausibility ranges of converters, fluids and measurements.
 //! * [`linalg`], [`scalar`], [`error`]: small dense inverse, dual numbers, the error type.
 
 pub mod batch;
@@ -23,6 +24,7 @@ pub mod engine;
 pub mod error;
 pub mod interp;
 pub mod linalg;
+pub mod plausibility;
 pub mod scalar;
 pub mod units;
 pub mod vehicle;

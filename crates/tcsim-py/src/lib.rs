@@ -881,6 +881,13 @@ fn unit_constants() -> BTreeMap<&'static str, f64> {
     ])
 }
 
+/// The physical plausibility ranges (tcsim_core::plausibility, their one owner): a list of
+/// `(quantity, unit, low, high, why)`.
+#[pyfunction]
+fn plausibility_ranges() -> Vec<(&'static str, &'static str, f64, f64, &'static str)> {
+    tcsim_core::plausibility::RANGES.iter().map(|r| (r.quantity, r.unit, r.low, r.high, r.why)).collect()
+}
+
 /// The reference pump speed in rpm (2000): where the default τ_Q is evaluated and the default pump
 /// speed of a characterisation. Convert with `reference_pump_speed_rad_s()`.
 #[pyfunction]
@@ -970,6 +977,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capacity_conventions, m)?)?;
     m.add_function(wrap_pyfunction!(default_flow_time_constant_s, m)?)?;
     m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
+    m.add_function(wrap_pyfunction!(plausibility_ranges, m)?)?;
     m.add_function(wrap_pyfunction!(reference_pump_speed_rpm, m)?)?;
     m.add_function(wrap_pyfunction!(reference_pump_speed_rad_s, m)?)?;
     m.add_function(wrap_pyfunction!(mass_matrix_bound, m)?)?;

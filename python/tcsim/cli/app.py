@@ -37,6 +37,13 @@ ModelsOpt = Annotated[
     ),
 ]
 OutOpt = Annotated[Path, typer.Option("--out", "-o", help="output directory")]
+AllowImplausibleOpt = Annotated[
+    bool,
+    typer.Option(
+        "--allow-implausible",
+        help="run values outside the plausibility ranges (docs/guarantees.md) with a warning instead of refusing them",
+    ),
+]
 ChannelOpt = Annotated[list[str] | None, typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")]
 
 

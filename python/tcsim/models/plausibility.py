@@ -1,0 +1,77 @@
+"""Physical plausibility ranges, read from the core (``tcsim_core::plausibility``, their one owner).
+
+A value outside its range is suspicious rather than impossible: most often a unit mistake (rpm in a
+rad/s column, milliseconds in a ``time_s`` column) or a typo. Two ways to act on it:
+
+* :func:`check_plausible` for measured and commanded values: an :class:`~tcsim.errors.InputError`
+  (exit 2) that names the range and the override, or with ``allow=True`` (the command line's
+  ``--allow-implausible``) a :class:`~tcsim.errors.TcsimWarning`;
+* :func:`warn_implausible` for a converter's design values: always a warning.
+
+Values that make the numbers non-finite are refused by the readers and the core whatever the ranges
+say. ``docs/guarantees.md`` lists the ranges.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from .. import _core
+from ..errors import InputError, TcsimWarning
+
+#: The command-line option that turns a refusal of :func:`check_plausible` into a warning.
+OVERRIDE_OPTION = "--allow-implausible"
+
+
+@dataclass(frozen=True)
+class PlausibleRange:
+    """One quantity's plausible range, closed at both ends, in ``unit``."""
+
+    quantity: str
+    unit: str
+    low: float
+    high: float
+    why: str
+
+    def describe(self) -> str:
+        """``-1100 to 1100 rad/s (shaft speeds …)``."""
+        unit = f" {self.unit}" if self.unit else ""
+        return f"{self.low:g} to {self.high:g}{unit} ({self.why})"
+
+
+#: Every range by quantity, from the core.
+RANGES: dict[str, PlausibleRange] = {r[0]: PlausibleRange(*r) for r in _core.plausibility_ranges()}
+
+
+def _first_outside(quantity: str, values: object) -> tuple[PlausibleRange, float | None]:
+    rng = RANGES[quantity]
+    v = np.atleast_1d(np.asarray(values, dtype=float))
+    outside = np.flatnonzero(np.isfinite(v) & ((v < rng.low) | (v > rng.high)))
+    return rng, (float(v[outside[0]]) if len(outside) else None)
+
+
+def check_plausible(quantity: str, values: object, source: str, field: str, allow: bool = False) -> None:
+    """Refuse the first of ``values`` outside the range of ``quantity`` (an :class:`InputError` of
+    ``source``/``field`` naming the range and :data:`OVERRIDE_OPTION`), or with ``allow`` warn.
+    Non-finite values are the readers' to refuse and are skipped here."""
+    rng, bad = _first_outside(quantity, values)
+    if bad is None:
+        return
+    if not allow:
+        raise InputError(source, field, bad, f"a plausible value, {rng.describe()}; {OVERRIDE_OPTION} runs it anyway")
+    _warn(rng, bad, source, field)
+
+
+def warn_implausible(quantity: str, values: object, source: str, field: str) -> None:
+    """Warn (a :class:`TcsimWarning`) about the first of ``values`` outside the range of ``quantity``."""
+    rng, bad = _first_outside(quantity, values)
+    if bad is not None:
+        _warn(rng, bad, source, field)
+
+
+def _warn(rng: PlausibleRange, value: float, source: str, field: str) -> None:
+    message = f"{source}: {field} = {value:.6g} is outside the plausible {rng.describe()}"
+    warnings.warn(message, TcsimWarning, stacklevel=3)
