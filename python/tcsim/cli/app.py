@@ -1,21 +1,26 @@
 """The typer app, its consoles and the entry point that maps errors to exit codes.
 
-Exit codes (conventions.md): 0 success; 2 bad input, with one message naming the file, the
-field, the value and what was expected, and no output written; 1 a failure that is not the
-user's (the message says what failed).
+Exit codes (conventions.md, guarantees.md): 0 success; 2 bad input, with one message naming the
+file, the field, the value and what was expected, and no output written; 1 a failure that is not
+the user's (the message says what failed); 130 interrupted by SIGINT (Ctrl-C), 143 by SIGTERM, with
+one line ``interrupted (SIGINT): nothing written`` and nothing written.
 """
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import sys
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.markup import escape
 
 from ..errors import InputError, TcsimWarning
+from ..reports.format import rich_text
 
 app = typer.Typer(
     add_completion=False,
@@ -40,20 +45,87 @@ OutOpt = Annotated[Path, typer.Option("--out", "-o", help="output directory")]
 ChannelOpt = Annotated[list[str] | None, typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")]
 
 
+def say(line: str) -> None:
+    """Print a plain line (a command's result) on stdout, never read as rich markup."""
+    stdout.print(rich_text(line))
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     if issubclass(category, TcsimWarning):
-        console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True)
+        console.print(f"[yellow]warning:[/yellow] {rich_text(message)}", highlight=False, soft_wrap=True)
     else:
-        console.print(f"warning: {category.__name__}: {escape(str(message))}", highlight=False, soft_wrap=True)
+        console.print(f"warning: {category.__name__}: {rich_text(message)}", highlight=False, soft_wrap=True)
+
+
+class Interrupted(KeyboardInterrupt):
+    """A termination signal (SIGTERM) turned into an exception, so that the run unwinds and cleans
+    up as on Ctrl-C; ``signum`` is the signal's number."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+#: The signals :func:`_raise_interrupted` turned into :class:`Interrupted` in this process.
+_received: list[int] = []
+
+#: The exit code typer returns for a ``KeyboardInterrupt`` it caught (the exception is lost).
+_TYPER_INTERRUPT = 130
+
+
+def _raise_interrupted(signum, frame):
+    _received.append(signum)
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def _sigterm_raises() -> Iterator[None]:
+    """SIGTERM raises :class:`Interrupted` while the block runs (the previous handler restored after)."""
+    try:
+        previous = signal.signal(signal.SIGTERM, _raise_interrupted)
+    except ValueError:  # not the main thread: signals are not ours to handle
+        yield
+        return
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def interrupt_line(e: KeyboardInterrupt) -> tuple[str, int]:
+    """The one line and the exit code (128 + the signal's number) of an interrupted run."""
+    from ..io import outputs
+
+    signum = e.signum if isinstance(e, Interrupted) else signal.SIGINT
+    name = signal.Signals(signum).name
+    if outputs.committed:
+        done = ", ".join(str(p) for p in outputs.committed)
+        return f"interrupted ({name}) after {done} was written completely", 128 + signum
+    return f"interrupted ({name}): nothing written", 128 + signum
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: runs the app and maps errors to exit codes."""
+    """Entry point: runs the app and maps errors to exit codes (see the module's docstring)."""
+    from ..io import outputs
+
     warnings.showwarning = _show_warning
+    outputs.command_line = list(sys.argv[1:] if argv is None else argv)
+    outputs.committed.clear()
+    _received.clear()
     try:
-        app(args=argv, standalone_mode=False)
+        with _sigterm_raises():
+            return _run(argv)
+    except KeyboardInterrupt as e:  # also raised by a second signal while the first is handled
+        line, code = interrupt_line(e)
+        console.print(rich_text(line), highlight=False, soft_wrap=True)
+        return code
+
+
+def _run(argv: list[str] | None) -> int:
+    try:
+        rv = app(args=argv, standalone_mode=False)
     except InputError as e:
-        console.print(f"[red]error:[/red] {escape(str(e))}", highlight=False, soft_wrap=True)
+        console.print(f"[red]error:[/red] {rich_text(e)}", highlight=False, soft_wrap=True)
         return 2
     except typer.Abort:
         console.print("aborted")
@@ -65,6 +137,8 @@ def main(argv: list[str] | None = None) -> int:
         if callable(show) and isinstance(code, int):
             show()  # a usage error from the command-line parser (exit code 2)
             return code
-        console.print(f"[red]tcsim failed:[/red] {type(e).__name__}: {escape(str(e))}", highlight=False, soft_wrap=True)
+        console.print(f"[red]tcsim failed:[/red] {type(e).__name__}: {rich_text(e)}", highlight=False, soft_wrap=True)
         return 1
+    if rv == _TYPER_INTERRUPT:  # typer caught the interrupt and returned its exit code
+        raise Interrupted(_received[-1]) if _received else KeyboardInterrupt()
     return 0
