@@ -2,7 +2,7 @@
 no output directory, no staging folder and no other file. The moments are found by the run's phases,
 not by sleeping: "just after start" is when ``tcsim.cli.main`` has installed its SIGTERM handler
 (Linux's /proc/PID/status), "while writing" when the staging folder exists. The batch calls of the
-core are cancelled by Ctrl-C (checked in-process: the call raises instead of returning)."""
+core are cancelled by a signal: the call raises instead of running to its end."""
 
 from __future__ import annotations
 
@@ -10,19 +10,11 @@ import os
 import signal
 import subprocess
 import sys
-import threading
 import time
 from pathlib import Path
 
 import pytest
 
-from tcsim import _core
-from tcsim.models.dynamic import dynamic_model
-from tcsim.models.vehicle import load_vehicle
-from tcsim.simulation.scenarios import flip_flop
-
-#: Launch runs of the in-process batch: some 20 s of work on two cores, cancelled after 0.2 s.
-N_RUNS = 400
 HANG_GUARD_S = 600  # a hang guard only; nothing is asserted about durations
 POLL_S = 0.005
 
@@ -101,44 +93,57 @@ def test_an_interrupted_run_exits_128_plus_the_signal_and_leaves_nothing(tmp_pat
 
 
 # ---------------------------------------------------------------------------------------------
-# the core's batch calls are cancelled, in-process
+# the core's batch calls are cancelled
 
+#: A batch of launch runs far longer than any hang guard (some hours of work), started in a
+#: subprocess that reports its thread count first; the signal is sent once the batch's threads exist.
+BATCH_SCRIPT = """
+import sys
+from pathlib import Path
+from tcsim import _core
+from tcsim.cli.app import _sigterm_raises
+from tcsim.models.dynamic import dynamic_model
+from tcsim.models.vehicle import load_vehicle
+from tcsim.simulation.scenarios import flip_flop
 
-def _sigint_soon(delay_s: float) -> threading.Timer:
-    timer = threading.Timer(delay_s, os.kill, (os.getpid(), signal.SIGINT))
-    timer.start()
-    return timer
-
-
-def test_ctrl_c_cancels_a_launch_batch():
-    """A Ctrl-C during `_core.launch_runs` raises KeyboardInterrupt from the call itself: the
-    batch (far longer than the delay) does not run to its end first, as it did before."""
-    veh = load_vehicle(None)
-    spec = dynamic_model(veh.converter, "quasi-dynamic").spec
-    runs = None
-    timer = _sigint_soon(0.2)
+veh = load_vehicle(None)
+spec = dynamic_model(veh.converter, "quasi-dynamic").spec
+threads = next(l for l in Path("/proc/self/status").read_text().splitlines() if l.startswith("Threads:"))
+print(threads.split()[1], flush=True)
+with _sigterm_raises():
     try:
-        with pytest.raises(KeyboardInterrupt):
-            runs = _core.launch_runs([spec] * N_RUNS, veh.core, flip_flop().core_spec(), None, 0)
+        _core.launch_runs([spec] * 200_000, veh.core, flip_flop().core_spec(), {"output_step_s": 0.5}, 0)
+    except KeyboardInterrupt as e:
+        print("raised by the call:", type(e).__name__, flush=True)
+        sys.exit(3)
+print("the batch ran to its end", flush=True)
+"""
+
+
+def _threads(pid: int) -> int:
+    status = Path(f"/proc/{pid}/status").read_text()
+    return int(next(line for line in status.splitlines() if line.startswith("Threads:")).split()[1])
+
+
+@pytest.mark.subprocess
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM], ids=lambda s: s.name)
+def test_a_signal_cancels_a_running_batch_call(sig):
+    """Ctrl-C (and SIGTERM under ``main``'s handler) during `_core.launch_runs` raises from the call:
+    before, the batch ran to its end first (here: hours, caught by the hang guard)."""
+    if not Path("/proc/self/status").exists():
+        pytest.skip("needs /proc to see the batch's threads")
+    p = subprocess.Popen([sys.executable, "-c", BATCH_SCRIPT], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert p.stdout is not None
+        baseline = int(p.stdout.readline())
+        while _threads(p.pid) <= baseline:  # the batch has started when its threads exist
+            assert p.poll() is None, p.communicate()
+            time.sleep(POLL_S)
+        p.send_signal(sig)
+        out, err = p.communicate(timeout=120)  # hang guard
     finally:
-        timer.cancel()
-    assert runs is None
-
-
-def test_sigterm_handler_of_main_cancels_a_batch():
-    """The exception of a Python SIGTERM handler (as ``tcsim.cli.main`` installs) ends the batch too."""
-    from tcsim.cli.app import Interrupted, _sigterm_raises
-
-    veh = load_vehicle(None)
-    spec = dynamic_model(veh.converter, "quasi-dynamic").spec
-    runs, before = None, signal.getsignal(signal.SIGTERM)
-    with _sigterm_raises():
-        timer = threading.Timer(0.2, os.kill, (os.getpid(), signal.SIGTERM))
-        timer.start()
-        try:
-            with pytest.raises(Interrupted) as e:
-                runs = _core.launch_runs([spec] * N_RUNS, veh.core, flip_flop().core_spec(), None, 0)
-        finally:
-            timer.cancel()
-    assert runs is None and e.value.signum == signal.SIGTERM
-    assert signal.getsignal(signal.SIGTERM) == before  # the previous handler is back
+        if p.poll() is None:
+            p.kill()
+            p.communicate()
+    expected = "Interrupted" if sig == signal.SIGTERM else "KeyboardInterrupt"
+    assert (p.returncode, out.strip()) == (3, f"raised by the call: {expected}"), err

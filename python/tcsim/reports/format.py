@@ -3,9 +3,12 @@
 from __future__ import annotations
 
 import math
+import re
 from typing import Any
 
-from rich.markup import escape
+#: What rich reads as a markup tag (``[bold]``, ``[/]``, ``[link=…]``, ``[#fff]``, ``[@click]``), with
+#: the backslashes before it (rich.markup's own pattern).
+_TAG = re.compile(r"(\\*)(\[[a-z#/@][^[]*?])")
 
 
 def fmt_number(x: Any, spec: str = ".6g", missing: str = "–") -> str:
@@ -15,5 +18,8 @@ def fmt_number(x: Any, spec: str = ".6g", missing: str = "–") -> str:
 
 def rich_text(text: Any) -> str:
     """``text`` (a path, a name, a whole plain line) safe to hand to rich: shown as it is, never read
-    as markup (``[/]``, ``[red]`` …). Every user string that reaches rich goes through here."""
-    return escape(str(text))
+    as markup (``[/]``, ``[red]`` …). Every user string that reaches rich goes through here.
+
+    Like ``rich.markup.escape`` without its doubling of a trailing backslash (which shows as two),
+    so the result must stand alone or end the markup string, as it does everywhere in tcsim."""
+    return _TAG.sub(lambda m: f"{m.group(1)}{m.group(1)}\\{m.group(2)}", str(text))
