@@ -16,12 +16,12 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+import tcsim.models.steady as steady
+from conftest import TABLE_C1
 from tcsim.errors import InputError
 from tcsim.io import outputs
 from tcsim.io.outputs import MANIFEST, output_dir
 from tcsim.units import RAD_S_PER_RPM
-
-from conftest import TABLE_C1
 
 
 def snapshot(root: Path) -> dict[str, bytes]:
@@ -42,7 +42,7 @@ def assert_manifest_consistent(out: Path) -> dict:
     doc = json.loads((out / MANIFEST).read_text())
     listed = {f["name"]: f for f in doc["files"]}
     present = {k for k in snapshot(out) if k != MANIFEST}
-    assert present == set(listed), (present ^ set(listed))
+    assert present == set(listed), present ^ set(listed)
     for name, entry in listed.items():
         data = (out / name).read_bytes()
         assert (len(data), hashlib.sha256(data).hexdigest()) == (entry["size"], entry["sha256"]), name
@@ -165,8 +165,6 @@ def test_an_earlier_output_with_a_changed_file_is_refused(cli, tmp_path):
 
 def test_the_rule_is_checked_again_after_the_compute(cli, tmp_path, monkeypatch):
     """A file that appears in --out during the compute: refused before writing, nothing written."""
-    import tcsim.models.steady as steady
-
     out = tmp_path / "o"
     run = steady.characterise
 

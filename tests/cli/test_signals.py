@@ -132,7 +132,8 @@ def test_a_signal_cancels_a_running_batch_call(sig):
     before, the batch ran to its end first (here: hours, caught by the hang guard)."""
     if not Path("/proc/self/status").exists():
         pytest.skip("needs /proc to see the batch's threads")
-    p = subprocess.Popen([sys.executable, "-c", BATCH_SCRIPT], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    cmd = [sys.executable, "-c", BATCH_SCRIPT]
+    p = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert p.stdout is not None
         baseline = int(p.stdout.readline())

@@ -535,7 +535,8 @@ def _output_path(out_path: str | Path) -> Path:
     if out.is_dir():
         raise InputError("command line", "--out", str(out), "a .fmu file (a directory of that name exists)")
     if out.is_file() and not _is_fmu(out):
-        raise InputError("command line", "--out", str(out), "a new .fmu file or an FMU to replace (the file is not an FMU)")
+        expected = "a new .fmu file or an FMU to replace (the file is not an FMU)"
+        raise InputError("command line", "--out", str(out), expected)
     return out
 
 

@@ -41,9 +41,8 @@ def plot_characteristic(
             ax.plot(df["speed_ratio"], np.where(np.isfinite(y), y, np.nan), label=mpl_text(name))
         if ref is not None:
             y = ref[column].to_numpy(dtype=float)
-            ax.plot(
-                ref["speed_ratio"], np.where(np.isfinite(y), y, np.nan), "o", mfc="none", color="k", label=mpl_text(table_label)
-            )
+            y = np.where(np.isfinite(y), y, np.nan)
+            ax.plot(ref["speed_ratio"], y, "o", mfc="none", color="k", label=mpl_text(table_label))
         if coupling_point is not None:
             ax.axvline(coupling_point, color="0.6", ls=":", lw=1, label=f"coupling point SR {coupling_point:.3f}")
         ax.set_xlabel("Speed ratio [-]")
