@@ -75,7 +75,7 @@ def test_mpl_text_draws_every_character_as_given(tmp_path):
         fig.savefig(tmp_path / "t.png")  # raised for mathtext, surrogates (and drew controls as boxes)
     plt.close(fig)
     assert mpl_text("$x$ costs $5") == r"\$x\$ costs \$5"
-    assert mpl_text("a\x01b") == r"a\x01b"
+    assert mpl_text("a\x01b\tc\nd") == r"a\x01b\tc\nd"
 
 
 def test_rich_text_is_shown_as_it_is():

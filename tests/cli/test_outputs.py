@@ -266,3 +266,11 @@ def test_manifest_module_state_is_per_run(cli, tmp_path):
     assert outputs.committed == [tmp_path / "o"]
     assert cli("characterise", "li-sunden-2016", "--out", tmp_path / "o", "--model", "nope").code == 2
     assert outputs.committed == []
+
+
+def test_a_bundled_name_is_not_an_input_file(cli, tmp_path):
+    """`--out li-sunden-2016` twice: the converter argument names the bundled converter, not the
+    earlier output directory of that name."""
+    for _ in range(2):
+        assert cli("characterise", "li-sunden-2016", "--out", "li-sunden-2016", cwd=tmp_path).code == 0
+    assert_manifest_consistent(tmp_path / "li-sunden-2016")

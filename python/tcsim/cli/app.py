@@ -109,7 +109,7 @@ def main(argv: list[str] | None = None) -> int:
     from ..io import outputs
 
     warnings.showwarning = _show_warning
-    outputs.command_line = list(sys.argv[1:] if argv is None else argv)
+    outputs.command_line = ["tcsim", *(sys.argv[1:] if argv is None else argv)]
     outputs.committed.clear()
     _received.clear()
     try:
@@ -119,6 +119,8 @@ def main(argv: list[str] | None = None) -> int:
         line, code = interrupt_line(e)
         console.print(rich_text(line), highlight=False, soft_wrap=True)
         return code
+    finally:
+        outputs.command_line = []
 
 
 def _run(argv: list[str] | None) -> int:

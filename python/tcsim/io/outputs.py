@@ -48,7 +48,8 @@ MANIFEST = "tcsim-manifest.json"
 EXPECTED_DIR = "a new or empty directory, or the output of an earlier tcsim run"
 _SIGNALS = {signal.SIGINT, signal.SIGTERM}
 
-#: The command line recorded in manifests (set by the command-line entry point).
+#: The command line recorded in manifests: set by the command-line entry point while it runs; the
+#: Python program's ``sys.argv`` otherwise.
 command_line: list[str] = []
 #: Output directories and files this process has put in place (for the interrupt message).
 committed: list[Path] = []
@@ -101,12 +102,13 @@ def _foreign_files(out: Path) -> list[str]:
 
 
 def _contained_inputs(out: Path, inputs: Iterable[str | Path]) -> list[str]:
-    """The inputs of the run that are ``out`` or lie inside it."""
+    """The input files of the run that are ``out`` or lie inside it (an argument that names no file,
+    such as a bundled converter's name, is none)."""
     target = out.resolve()
     inside = []
     for inp in inputs:
         path = Path(inp)
-        if path.exists():
+        if path.is_file():
             resolved = path.resolve()
             if resolved == target or resolved.is_relative_to(target):
                 inside.append(str(inp))
@@ -117,7 +119,7 @@ def check_output_dir(out: str | Path, inputs: Iterable[str | Path] = ()) -> None
     """Refuse an ``out`` the rule of this module does not allow (:class:`InputError`)."""
     out = Path(out)
     contained = _contained_inputs(out, inputs)
-    if contained and out.resolve() == Path(contained[0]).resolve():
+    if any(out.resolve() == Path(c).resolve() for c in contained):
         raise _refuse(out, "a directory, not an input file of this run")
     if contained:
         raise _refuse(out, f"a directory that holds no input of this run (it holds {_listing(contained)})")
@@ -145,7 +147,7 @@ def _manifest(stage: Path) -> str:
         {"name": name, "size": path.stat().st_size, "sha256": _sha256(path)}
         for name, path in sorted(_files(stage).items())
     ]
-    command = ["tcsim", *(command_line or sys.argv[1:])]
+    command = command_line or sys.argv
     return json.dumps({"tcsim": version, "command": command, "files": files}, indent=1) + "\n"
 
 

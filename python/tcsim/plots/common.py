@@ -14,9 +14,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 __all__ = ["finish_figure", "mpl_text", "plt"]
 
-#: Control characters (shown as ``\x01``) and lone surrogates (a non-UTF-8 file name decoded with
-#: ``surrogateescape``; shown as U+FFFD), which matplotlib cannot draw.
-_UNDRAWABLE = re.compile("[\x00-\x08\x0b-\x1f\x7f\ud800-\udfff]")
+#: Control characters, tab and newline included (shown as ``\x01``, ``\t``), and lone surrogates (a
+#: non-UTF-8 file name decoded with ``surrogateescape``; shown as U+FFFD): matplotlib cannot draw them.
+_UNDRAWABLE = re.compile("[\x00-\x1f\x7f\ud800-\udfff]")
 
 
 def _undrawable(match: re.Match[str]) -> str:
