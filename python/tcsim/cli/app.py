@@ -92,6 +92,29 @@ def _sigterm_raises() -> Iterator[None]:
         signal.signal(signal.SIGTERM, previous)
 
 
+@contextlib.contextmanager
+def _signals_ignored() -> Iterator[None]:
+    """SIGINT and SIGTERM ignored while the block runs (the previous handlers restored after)."""
+    try:
+        previous = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _forget_unhandled_interrupt() -> None:
+    """Clear CPython's record of a ``KeyboardInterrupt`` that left an ``eval`` of a string (typer
+    evaluates the commands' annotations that way): with it set, the interpreter ends the process by
+    SIGINT at exit whatever its exit code. Every later string ``eval`` clears it (CPython 3.11–3.13,
+    ``run_eval_code_obj``)."""
+    eval("None")
+
+
 def interrupt_line(e: KeyboardInterrupt) -> tuple[str, int]:
     """The one line and the exit code (128 + the signal's number) of an interrupted run."""
     from ..io import outputs
@@ -117,7 +140,9 @@ def main(argv: list[str] | None = None) -> int:
             return _run(argv)
     except KeyboardInterrupt as e:  # also raised by a second signal while the first is handled
         line, code = interrupt_line(e)
-        console.print(rich_text(line), highlight=False, soft_wrap=True)
+        _forget_unhandled_interrupt()
+        with _signals_ignored():  # a second Ctrl-C now would print a traceback after the line
+            console.print(rich_text(line), highlight=False, soft_wrap=True)
         return code
     finally:
         outputs.command_line = []
