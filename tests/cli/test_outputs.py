@@ -11,6 +11,7 @@ import shutil
 import subprocess
 import sys
 import threading
+import zipfile
 from pathlib import Path
 
 import pandas as pd
@@ -19,6 +20,7 @@ import pytest
 import tcsim.models.steady as steady
 from conftest import TABLE_C1
 from tcsim.errors import InputError
+from tcsim.io import fmu as fmu_io
 from tcsim.io import outputs
 from tcsim.io.outputs import MANIFEST, output_dir
 from tcsim.units import RAD_S_PER_RPM
@@ -274,3 +276,24 @@ def test_a_bundled_name_is_not_an_input_file(cli, tmp_path):
     for _ in range(2):
         assert cli("characterise", "li-sunden-2016", "--out", "li-sunden-2016", cwd=tmp_path).code == 0
     assert_manifest_consistent(tmp_path / "li-sunden-2016")
+
+
+# ---------------------------------------------------------------------------------------------
+# export-fmu: one file
+
+
+def test_export_fmu_replaces_only_an_fmu(cli, fmu_library, monkeypatch, tmp_path):
+    monkeypatch.setenv(fmu_io.LIBRARY_ENV, str(fmu_library))
+    mine = tmp_path / "mine.fmu"
+    mine.write_text("not an FMU\n")
+    r = cli("export-fmu", "li-sunden-2016", "--model", "table", "--out", mine)
+    assert_refused(r, "the file is not an FMU")
+    assert mine.read_text() == "not an FMU\n"
+    (tmp_path / "dir.fmu").mkdir()
+    assert_refused(cli("export-fmu", "li-sunden-2016", "--model", "table", "--out", tmp_path / "dir.fmu"), "directory")
+    out = tmp_path / "c.fmu"
+    for _ in range(2):  # written, then replaced
+        assert cli("export-fmu", "li-sunden-2016", "--model", "table", "--out", out).code == 0
+        with zipfile.ZipFile(out) as zf:
+            assert "modelDescription.xml" in zf.namelist()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["c.fmu", "dir.fmu", "mine.fmu"]
