@@ -216,27 +216,32 @@ def output_dir(out: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[P
     check_output_dir(shown, inputs)
     target = Path(os.path.abspath(shown))
     target = target.resolve() if target.is_symlink() else target
-    created = _make_parents(target.parent, shown)
+    created: list[Path] = []
+    stage: Path | None = None
     done = False
     try:
-        try:
-            stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent))
-        except OSError as e:
-            raise _refuse(shown, f"a writable directory ({e.strerror})") from None
-        try:
-            yield stage
-            (stage / MANIFEST).write_text(_manifest(stage), encoding="utf-8")
-            _commit_dir(stage, target, shown, inputs)
-            done = True
-        finally:
-            if not done:
-                with _blocked():
-                    shutil.rmtree(stage, ignore_errors=True)
+        with _blocked():  # what is created is recorded before a signal can interrupt
+            created = _make_parents(target.parent, shown)
+            try:
+                stage = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent))
+            except OSError as e:
+                raise _refuse(shown, f"a writable directory ({e.strerror})") from None
+        yield stage
+        (stage / MANIFEST).write_text(_manifest(stage), encoding="utf-8")
+        _commit_dir(stage, target, shown, inputs)
+        done = True
     finally:
         if not done:
-            for directory in created:
-                with contextlib.suppress(OSError):
-                    directory.rmdir()
+            with _blocked():
+                if stage is not None:
+                    shutil.rmtree(stage, ignore_errors=True)
+                _remove_empty(created)
+
+
+def _remove_empty(directories: Sequence[Path]) -> None:
+    for directory in directories:
+        with contextlib.suppress(OSError):
+            directory.rmdir()
 
 
 @contextlib.contextmanager
@@ -268,29 +273,28 @@ def output_file(out: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[
     shown = Path(out)
     check_output_file(shown, inputs)
     target = Path(os.path.abspath(shown))
-    created = _make_parents(target.parent, shown)
+    created: list[Path] = []
+    tmp: Path | None = None
     done = False
     try:
-        try:
-            fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent)
-            os.close(fd)
-        except OSError as e:
-            raise _refuse(shown, f"a writable location ({e.strerror})") from None
-        tmp = Path(name)
-        try:
-            yield tmp
-            os.chmod(tmp, 0o666 & ~_umask())
-            with _locked_and_uninterrupted(target.parent):
-                check_output_file(shown, inputs)
-                os.replace(tmp, target)
-                committed.append(shown)
-                done = True
-        finally:
-            if not done:
-                with _blocked():
-                    tmp.unlink(missing_ok=True)
+        with _blocked():  # what is created is recorded before a signal can interrupt
+            created = _make_parents(target.parent, shown)
+            try:
+                fd, name = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".partial", dir=target.parent)
+                os.close(fd)
+            except OSError as e:
+                raise _refuse(shown, f"a writable location ({e.strerror})") from None
+            tmp = Path(name)
+        yield tmp
+        os.chmod(tmp, 0o666 & ~_umask())
+        with _locked_and_uninterrupted(target.parent):
+            check_output_file(shown, inputs)
+            os.replace(tmp, target)
+            committed.append(shown)
+            done = True
     finally:
         if not done:
-            for directory in created:
-                with contextlib.suppress(OSError):
-                    directory.rmdir()
+            with _blocked():
+                if tmp is not None:
+                    tmp.unlink(missing_ok=True)
+                _remove_empty(created)
