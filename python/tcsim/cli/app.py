@@ -3,7 +3,7 @@
 Exit codes (conventions.md, guarantees.md): 0 success; 2 bad input, with one message naming the
 file, the field, the value and what was expected, and no output written; 1 a failure that is not
 the user's (the message says what failed); 130 interrupted by SIGINT (Ctrl-C), 143 by SIGTERM, with
-one line ``interrupted (SIGINT): nothing written`` and nothing written.
+one line ``interrupted (SIGINT): nothing written`` and nothing written (docs/guarantees.md).
 """
 
 from __future__ import annotations
@@ -58,15 +58,15 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
 
 
 class Interrupted(KeyboardInterrupt):
-    """A termination signal (SIGTERM) turned into an exception, so that the run unwinds and cleans
-    up as on Ctrl-C; ``signum`` is the signal's number."""
+    """SIGINT or SIGTERM turned into an exception by :func:`tcsim.cli.main`, so that the run unwinds
+    and cleans up as on Ctrl-C; ``signum`` is the signal's number."""
 
     def __init__(self, signum: int):
         super().__init__(signal.Signals(signum).name)
         self.signum = signum
 
 
-#: The signals :func:`_raise_interrupted` turned into :class:`Interrupted` in this process.
+#: The signals :func:`_raise_interrupted` turned into :class:`Interrupted` in this run.
 _received: list[int] = []
 
 #: The exit code typer returns for a ``KeyboardInterrupt`` it caught (the exception is lost).
@@ -79,17 +79,20 @@ def _raise_interrupted(signum, frame):
 
 
 @contextlib.contextmanager
-def _sigterm_raises() -> Iterator[None]:
-    """SIGTERM raises :class:`Interrupted` while the block runs (the previous handler restored after)."""
+def _signals_raise() -> Iterator[None]:
+    """SIGINT and SIGTERM raise :class:`Interrupted` (and are recorded, also when the exception is
+    swallowed, e.g. raised in a ``__del__``) while the block runs; the previous handlers are restored
+    after."""
     try:
-        previous = signal.signal(signal.SIGTERM, _raise_interrupted)
+        previous = {sig: signal.signal(sig, _raise_interrupted) for sig in (signal.SIGINT, signal.SIGTERM)}
     except ValueError:  # not the main thread: signals are not ours to handle
         yield
         return
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 @contextlib.contextmanager
@@ -136,7 +139,7 @@ def main(argv: list[str] | None = None) -> int:
     outputs.committed.clear()
     _received.clear()
     try:
-        with _sigterm_raises():
+        with _signals_raise():
             return _run(argv)
     except KeyboardInterrupt as e:  # also raised by a second signal while the first is handled
         line, code = interrupt_line(e)
@@ -166,6 +169,6 @@ def _run(argv: list[str] | None) -> int:
             return code
         console.print(f"[red]tcsim failed:[/red] {type(e).__name__}: {rich_text(e)}", highlight=False, soft_wrap=True)
         return 1
-    if rv == _TYPER_INTERRUPT:  # typer caught the interrupt and returned its exit code
+    if rv == _TYPER_INTERRUPT or _received:  # typer caught the interrupt, or it was swallowed
         raise Interrupted(_received[-1]) if _received else KeyboardInterrupt()
     return 0
