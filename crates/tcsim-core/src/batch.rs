@@ -3,6 +3,8 @@
 //! These loops are what the Python API calls (with the GIL released) for characteristics, the
 //! parameter study and the fit.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use crate::converter::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE};
 use crate::error::CoreError;
 use crate::scalar::{Dual, Scalar};
@@ -49,6 +51,23 @@ pub fn ht_steady_states(
     turbine_speed_rad_s: &[f64],
     strict: bool,
 ) -> Result<HtSteadyColumns, PointError> {
+    let never = AtomicBool::new(false);
+    ht_steady_states_cancellable(geometry, pump_speed_rad_s, turbine_speed_rad_s, strict, &never)
+        .map(|cols| cols.unwrap_or_default())
+}
+
+/// Points between two looks at the cancel flag of [`ht_steady_states_cancellable`].
+const CANCEL_CHECK_POINTS: usize = 4096;
+
+/// [`ht_steady_states`] that stops early, returning `Ok(None)`, once `cancel` is set (looked at
+/// every [`CANCEL_CHECK_POINTS`] points).
+pub fn ht_steady_states_cancellable(
+    geometry: &[HtGeometry<f64>],
+    pump_speed_rad_s: &[f64],
+    turbine_speed_rad_s: &[f64],
+    strict: bool,
+    cancel: &AtomicBool,
+) -> Result<Option<HtSteadyColumns>, PointError> {
     let n = pump_speed_rad_s.len();
     assert!(
         turbine_speed_rad_s.len() == n && (geometry.len() == 1 || geometry.len() == n),
@@ -56,6 +75,9 @@ pub fn ht_steady_states(
     );
     let mut out = HtSteadyColumns::with_capacity(n);
     for i in 0..n {
+        if i % CANCEL_CHECK_POINTS == 0 && cancel.load(Ordering::Relaxed) {
+            return Ok(None);
+        }
         let g = &geometry[if geometry.len() == 1 { 0 } else { i }];
         match steady_state(g, pump_speed_rad_s[i], turbine_speed_rad_s[i]) {
             Ok(s) => {
@@ -81,7 +103,7 @@ pub fn ht_steady_states(
             }
         }
     }
-    Ok(out)
+    Ok(Some(out))
 }
 
 /// Torque ratio and capacity factor at the given speed ratios (pump speed `pump_speed_rad_s`),
@@ -165,19 +187,34 @@ pub fn run_transient_job(job: &TransientJob) -> crate::engine::options::Transien
 
 /// `f` over `jobs` on `threads` worker threads (0: one per core), results in job order.
 pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J) -> R + Sync) -> Vec<R> {
-    use std::sync::atomic::{AtomicUsize, Ordering};
+    let never = AtomicBool::new(false);
+    parallel_map_cancellable(jobs, threads, &never, f).into_iter().map(|r| r.expect("every job ran")).collect()
+}
+
+/// [`parallel_map`] that can be cancelled: once `cancel` is set, no worker starts another job (a
+/// job already started runs to its end). Results are in job order, `None` for the jobs not run.
+pub fn parallel_map_cancellable<J: Sync, R: Send>(
+    jobs: &[J],
+    threads: usize,
+    cancel: &AtomicBool,
+    f: impl Fn(&J) -> R + Sync,
+) -> Vec<Option<R>> {
+    use std::sync::atomic::AtomicUsize;
     use std::sync::Mutex;
     let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }
         .min(jobs.len())
         .max(1);
     if threads == 1 {
-        return jobs.iter().map(&f).collect();
+        return jobs.iter().map(|j| if cancel.load(Ordering::Relaxed) { None } else { Some(f(j)) }).collect();
     }
     let next = AtomicUsize::new(0);
     let results: Mutex<Vec<Option<R>>> = Mutex::new((0..jobs.len()).map(|_| None).collect());
     std::thread::scope(|scope| {
         for _ in 0..threads {
             scope.spawn(|| loop {
+                if cancel.load(Ordering::Relaxed) {
+                    break;
+                }
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 if i >= jobs.len() {
                     break;
@@ -189,7 +226,7 @@ pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J)
             });
         }
     });
-    results.into_inner().unwrap_or_default().into_iter().map(|r| r.expect("every job ran")).collect()
+    results.into_inner().unwrap_or_default()
 }
 
 /// Run all jobs on `threads` worker threads (0: one per core). Results are in job order.
@@ -198,6 +235,15 @@ pub fn run_transient_jobs(
     threads: usize,
 ) -> Vec<crate::engine::options::TransientResult<RunOutput>> {
     parallel_map(jobs, threads, run_transient_job)
+}
+
+/// [`run_transient_jobs`] that can be cancelled (see [`parallel_map_cancellable`]).
+pub fn run_transient_jobs_cancellable(
+    jobs: &[TransientJob],
+    threads: usize,
+    cancel: &AtomicBool,
+) -> Vec<Option<crate::engine::options::TransientResult<RunOutput>>> {
+    parallel_map_cancellable(jobs, threads, cancel, run_transient_job)
 }
 
 #[cfg(test)]
@@ -217,6 +263,19 @@ mod tests {
         let strict = ht_steady_states(&[g], &wp, &wt, true).unwrap_err();
         assert_eq!(strict.index, 2);
         assert_eq!(strict.error.field, "speed_ratio");
+    }
+
+    #[test]
+    fn a_set_cancel_flag_stops_the_batches() {
+        let cancel = AtomicBool::new(true);
+        let jobs = [1, 2, 3, 4];
+        assert!(parallel_map_cancellable(&jobs, 2, &cancel, |j| j * 2).iter().all(Option::is_none));
+        assert!(parallel_map_cancellable(&jobs, 1, &cancel, |j| j * 2).iter().all(Option::is_none));
+        let g = HtGeometry::appendix_d();
+        assert!(ht_steady_states_cancellable(&[g], &[200.0], &[0.0], true, &cancel).unwrap().is_none());
+        let go = AtomicBool::new(false);
+        let all = parallel_map_cancellable(&jobs, 2, &go, |j| j * 2);
+        assert_eq!(all, vec![Some(2), Some(4), Some(6), Some(8)]);
     }
 
     #[test]

@@ -11,6 +11,9 @@ mod fmu;
 
 use std::collections::BTreeMap;
 use std::panic::{catch_unwind, AssertUnwindSafe};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Condvar, Mutex};
+use std::time::Duration;
 
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
@@ -18,8 +21,8 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use tcsim_core::batch::{
-    ht_ratio_gradients as core_ratio_gradients, ht_steady_states as core_steady_states, run_transient_jobs,
-    TransientJob,
+    ht_ratio_gradients as core_ratio_gradients, ht_steady_states_cancellable as core_steady_states,
+    run_transient_jobs_cancellable, TransientJob,
 };
 use tcsim_core::converter::capacity::CapacityConvention;
 use tcsim_core::converter::dynamics::ConverterDynamics;
@@ -63,6 +66,59 @@ fn guard<T>(f: impl FnOnce() -> PyResult<T>) -> PyResult<T> {
             Err(PyRuntimeError::new_err(format!("internal error in the tcsim core: {msg}")))
         }
     }
+}
+
+/// How often a cancellable batch ([`cancellable`]) lets Python run its signal handlers.
+const SIGNAL_POLL: Duration = Duration::from_millis(50);
+
+/// Sets the `done` flag of [`cancellable`] when the work ends, also by a panic.
+struct DoneOnDrop<'a>(&'a (Mutex<bool>, Condvar));
+
+impl Drop for DoneOnDrop<'_> {
+    fn drop(&mut self) {
+        if let Ok(mut done) = self.0 .0.lock() {
+            *done = true;
+        }
+        self.0 .1.notify_all();
+    }
+}
+
+/// Run `work` with the GIL released on a helper thread, giving it a cancel flag, while this thread
+/// re-attaches every [`SIGNAL_POLL`] to run Python's signal handlers (`check_signals`). When a
+/// handler raises (Ctrl-C's `KeyboardInterrupt`, or the exception of a SIGTERM handler), the flag is
+/// set, the work's end is awaited (the core's workers start no new job) and that exception returned.
+/// `Ok(None)` from `work` (stopped by the flag) cannot reach the caller otherwise.
+fn cancellable<R: Send>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> Option<R> + Send) -> PyResult<R> {
+    let cancel = AtomicBool::new(false);
+    let done = (Mutex::new(false), Condvar::new());
+    let finished = || -> bool {
+        let Ok(guard) = done.0.lock() else { return true };
+        match done.1.wait_timeout_while(guard, SIGNAL_POLL, |d| !*d) {
+            Ok((d, _)) => *d,
+            Err(_) => true,
+        }
+    };
+    std::thread::scope(|scope| {
+        let handle = scope.spawn(|| {
+            let _done = DoneOnDrop(&done);
+            work(&cancel)
+        });
+        let mut pending = None;
+        while !py.detach(finished) {
+            if let Err(e) = py.check_signals() {
+                cancel.store(true, Ordering::Relaxed);
+                pending = Some(e);
+                break;
+            }
+        }
+        let result = handle.join();
+        match (pending, result) {
+            (Some(e), _) => Err(e),
+            (None, Ok(Some(r))) => Ok(r),
+            (None, Ok(None)) => Err(PyRuntimeError::new_err("internal error: a batch stopped without a cancel")),
+            (None, Err(_)) => Err(PyRuntimeError::new_err("internal error in the tcsim core: a batch worker panicked")),
+        }
+    })
 }
 
 fn slice<'a>(a: &'a PyReadonlyArray1<'_, f64>, name: &str) -> PyResult<&'a [f64]> {
@@ -172,9 +228,11 @@ fn ht_steady_states<'py>(
                 "pump and turbine speeds need equal lengths, and geometry one row or one row per point",
             ));
         }
-        let cols = py.detach(|| core_steady_states(&g, wp, wt, strict)).map_err(|e| {
-            input_error(CoreError { field: format!("{} (point {})", e.error.field, e.index), ..e.error })
-        })?;
+        let cols = cancellable(py, |cancel| match core_steady_states(&g, wp, wt, strict, cancel) {
+            Ok(cols) => cols.map(Ok),
+            Err(e) => Some(Err(e)),
+        })?
+        .map_err(|e| input_error(CoreError { field: format!("{} (point {})", e.error.field, e.index), ..e.error }))?;
         let d = PyDict::new(py);
         d.set_item("flow_m3_s", cols.flow_m3_s.into_pyarray(py))?;
         d.set_item("stator_speed_rad_s", cols.stator_speed_rad_s.into_pyarray(py))?;
@@ -666,7 +724,9 @@ fn transient_runs<'py>(
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
-        let results = py.detach(|| run_transient_jobs(&jobs, threads));
+        let results = cancellable(py, |cancel| {
+            run_transient_jobs_cancellable(&jobs, threads, cancel).into_iter().collect::<Option<Vec<_>>>()
+        })?;
         results.into_iter().map(|r| transient_run(py, r)).collect()
     })
 }
@@ -837,14 +897,16 @@ fn launch_runs<'py>(
             None => 0.01,
         };
         let parsed = models.iter().map(|m| model_from(m)).collect::<PyResult<Vec<_>>>()?;
-        let results = py.detach(|| {
-            tcsim_core::batch::parallel_map(&parsed, threads, |m| {
+        let results = cancellable(py, |cancel| {
+            tcsim_core::batch::parallel_map_cancellable(&parsed, threads, cancel, |m| {
                 tcsim_core::batch::catch_panic(|| {
                     let traj = simulate_launch(m.as_ref(), &v, &sc, step, &solver)?;
                     Ok((tcsim_core::vehicle::outputs::launch_columns(m.as_ref(), &sc, &traj), traj.events))
                 })
             })
-        });
+            .into_iter()
+            .collect::<Option<Vec<_>>>()
+        })?;
         results.into_iter().map(|r| launch_run(py, r)).collect()
     })
 }

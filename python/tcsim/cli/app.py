@@ -1,21 +1,26 @@
 """The typer app, its consoles and the entry point that maps errors to exit codes.
 
-Exit codes (conventions.md): 0 success; 2 bad input, with one message naming the file, the
-field, the value and what was expected, and no output written; 1 a failure that is not the
-user's (the message says what failed).
+Exit codes (conventions.md, guarantees.md): 0 success; 2 bad input, with one message naming the
+file, the field, the value and what was expected, and no output written; 1 a failure that is not
+the user's (the message says what failed); 130 interrupted by SIGINT (Ctrl-C), 143 by SIGTERM, with
+one line ``interrupted (SIGINT): nothing written`` and nothing written (docs/guarantees.md).
 """
 
 from __future__ import annotations
 
+import contextlib
+import signal
+import sys
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Annotated
 
 import typer
 from rich.console import Console
-from rich.markup import escape
 
 from ..errors import InputError, TcsimWarning
+from ..reports.format import rich_text
 
 app = typer.Typer(
     add_completion=False,
@@ -47,20 +52,117 @@ AllowImplausibleOpt = Annotated[
 ChannelOpt = Annotated[list[str] | None, typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")]
 
 
+def say(line: str) -> None:
+    """Print a plain line (a command's result) on stdout, never read as rich markup."""
+    stdout.print(rich_text(line))
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
     if issubclass(category, TcsimWarning):
-        console.print(f"[yellow]warning:[/yellow] {escape(str(message))}", highlight=False, soft_wrap=True)
+        console.print(f"[yellow]warning:[/yellow] {rich_text(message)}", highlight=False, soft_wrap=True)
     else:
-        console.print(f"warning: {category.__name__}: {escape(str(message))}", highlight=False, soft_wrap=True)
+        console.print(f"warning: {category.__name__}: {rich_text(message)}", highlight=False, soft_wrap=True)
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM turned into an exception by :func:`tcsim.cli.main`, so that the run unwinds
+    and cleans up as on Ctrl-C; ``signum`` is the signal's number."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+#: The signals :func:`_raise_interrupted` turned into :class:`Interrupted` in this run.
+_received: list[int] = []
+
+#: The exit code typer returns for a ``KeyboardInterrupt`` it caught (the exception is lost).
+_TYPER_INTERRUPT = 130
+
+
+def _raise_interrupted(signum, frame):
+    _received.append(signum)
+    raise Interrupted(signum)
+
+
+@contextlib.contextmanager
+def _signals_raise() -> Iterator[None]:
+    """SIGINT and SIGTERM raise :class:`Interrupted` (and are recorded, also when the exception is
+    swallowed, e.g. raised in a ``__del__``) while the block runs; the previous handlers are restored
+    after."""
+    try:
+        previous = {sig: signal.signal(sig, _raise_interrupted) for sig in (signal.SIGINT, signal.SIGTERM)}
+    except ValueError:  # not the main thread: signals are not ours to handle
+        yield
+        return
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+@contextlib.contextmanager
+def _signals_ignored() -> Iterator[None]:
+    """SIGINT and SIGTERM ignored while the block runs (the previous handlers restored after)."""
+    try:
+        previous = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+    except ValueError:  # not the main thread
+        yield
+        return
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def _forget_unhandled_interrupt() -> None:
+    """Clear CPython's record of a ``KeyboardInterrupt`` that left an ``eval`` of a string (typer
+    evaluates the commands' annotations that way): with it set, the interpreter ends the process by
+    SIGINT at exit whatever its exit code. Every later string ``eval`` clears it (CPython 3.11–3.13,
+    ``run_eval_code_obj``)."""
+    eval("None")
+
+
+def interrupt_line(e: KeyboardInterrupt) -> tuple[str, int]:
+    """The one line and the exit code (128 + the signal's number) of an interrupted run."""
+    from ..io import outputs
+
+    signum = e.signum if isinstance(e, Interrupted) else signal.SIGINT
+    name = signal.Signals(signum).name
+    if outputs.committed:
+        done = ", ".join(str(p) for p in outputs.committed)
+        return f"interrupted ({name}) after {done} was written completely", 128 + signum
+    return f"interrupted ({name}): nothing written", 128 + signum
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: runs the app and maps errors to exit codes."""
+    """Entry point: runs the app and maps errors to exit codes (see the module's docstring)."""
+    from ..io import outputs
+
     warnings.showwarning = _show_warning
+    outputs.command_line = ["tcsim", *(sys.argv[1:] if argv is None else argv)]
+    outputs.committed.clear()
+    _received.clear()
     try:
-        app(args=argv, standalone_mode=False)
+        with _signals_raise():
+            return _run(argv)
+    except KeyboardInterrupt as e:  # also raised by a second signal while the first is handled
+        line, code = interrupt_line(e)
+        _forget_unhandled_interrupt()
+        with _signals_ignored():  # a second Ctrl-C now would print a traceback after the line
+            console.print(rich_text(line), highlight=False, soft_wrap=True)
+        return code
+    finally:
+        outputs.command_line = []
+
+
+def _run(argv: list[str] | None) -> int:
+    try:
+        rv = app(args=argv, standalone_mode=False)
     except InputError as e:
-        console.print(f"[red]error:[/red] {escape(str(e))}", highlight=False, soft_wrap=True)
+        console.print(f"[red]error:[/red] {rich_text(e)}", highlight=False, soft_wrap=True)
         return 2
     except typer.Abort:
         console.print("aborted")
@@ -72,6 +174,8 @@ def main(argv: list[str] | None = None) -> int:
         if callable(show) and isinstance(code, int):
             show()  # a usage error from the command-line parser (exit code 2)
             return code
-        console.print(f"[red]tcsim failed:[/red] {type(e).__name__}: {escape(str(e))}", highlight=False, soft_wrap=True)
+        console.print(f"[red]tcsim failed:[/red] {type(e).__name__}: {rich_text(e)}", highlight=False, soft_wrap=True)
         return 1
+    if rv == _TYPER_INTERRUPT or _received:  # typer caught the interrupt, or it was swallowed
+        raise Interrupted(_received[-1]) if _received else KeyboardInterrupt()
     return 0

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..units import DEFAULT_PUMP_SPEED_RPM
-from .app import ModelOpt, OutOpt, stdout
+from .app import ModelOpt, OutOpt, say
 
 
 def characterise(
@@ -18,19 +18,22 @@ def characterise(
     out: OutOpt = Path("characteristic"),
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
-    from ..io.outputs import output_dir
+    from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_frames
     from ..models.converter import load_converter
     from ..models.steady import characterise as run
     from ..models.steady import coupling_point
     from ..plots.characteristic import plot_characteristic
 
+    check_output_dir(out, [converter])
     conv = load_converter(converter)
+    inputs = [converter, conv.path]
+    check_output_dir(out, inputs)
     model = model or ("hrovat-tobler" if "hrovat-tobler" in conv.models else "table")
     conv.require(model)
     df = run(conv, model, pump_speed_rpm)
     cp = coupling_point(conv) if model == "hrovat-tobler" else None
-    with output_dir(out) as stage:
+    with output_dir(out, inputs) as stage:
         write_frames({"characteristic.csv": df}, stage)
         table = conv.characteristic if model == "hrovat-tobler" else None
         plot_characteristic(
@@ -43,4 +46,4 @@ def characterise(
     msg = f"{model}: {len(df)} points written to {out}/characteristic.csv and plots"
     if cp is not None:
         msg += f"; coupling point at SR {cp:.4f}"
-    stdout.print(msg)
+    say(msg)

@@ -10,10 +10,11 @@ def converters() -> None:
     from rich.table import Table
 
     from ..models.converter import bundled_converters
+    from ..reports.format import rich_text
 
     table = Table(title="Bundled converters")
     for col in ("name", "models", "source"):
         table.add_column(col)
     for conv in bundled_converters():
-        table.add_row(conv.name, ", ".join(conv.models), conv.source)
+        table.add_row(rich_text(conv.name), ", ".join(conv.models), rich_text(conv.source))
     stdout.print(table)

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .app import stdout
+from .app import say
 
 #: The command's ``--help`` text.
 HELP = (
@@ -45,4 +45,4 @@ def export_fmu(
     ] = "pump-torque",
 ) -> None:
     """The command; its help is :data:`HELP`."""
-    stdout.print(export_fmu_command(converter, model, out, causality), highlight=False, soft_wrap=True)
+    say(export_fmu_command(converter, model, out, causality))

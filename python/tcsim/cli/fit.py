@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .app import OutOpt, stdout
+from .app import OutOpt, say
 
 
 def fit_command(
@@ -16,19 +16,22 @@ def fit_command(
     """Fit ``converter``'s [geometry] to the table of ``target``; write ``out``; the line to print."""
     from ..analysis import fitting
     from ..errors import InputError
-    from ..io.outputs import output_dir
+    from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_fit_files
     from ..models.converter import load_converter
     from ..models.steady import coupling_point
     from ..plots.characteristic import plot_characteristic
     from ..reports.fit import report_markdown
 
+    check_output_dir(out, [converter, target])
     free_names = fitting.check_free(fitting.parse_free(free))
     user_bounds = fitting.parse_bounds(bounds)
     start = load_converter(converter)
     start.require("hrovat-tobler")
     assert start.geometry is not None  # require() checked it
     table = fitting.target_table(target)
+    inputs = [converter, target, start.path, table.source]
+    check_output_dir(out, inputs)
     try:
         result = fitting.fit_hrovat_tobler(start.geometry, table, free_names, user_bounds, speed_ratio_max)
     except InputError as e:
@@ -36,7 +39,7 @@ def fit_command(
             raise InputError(start.path, e.field, e.value, e.expected) from None
         raise
     fitted = fitting.fitted_converter(start, result, table, fitting.target_label(target))
-    with output_dir(out) as stage:
+    with output_dir(out, inputs) as stage:
         write_fit_files(stage, start, fitted, result, table, report_markdown(result, start, []))
         curves = {
             "fitted Hrovat & Tobler": fitting.model_curve(fitted),
@@ -64,4 +67,4 @@ def fit(
     ] = None,
 ) -> None:
     """Fit Hrovat & Tobler parameters to a characteristic table: DIR/fitted.toml, report, plots."""
-    stdout.print(fit_command(converter, target, out, free, bound or [], speed_ratio_max))
+    say(fit_command(converter, target, out, free, bound or [], speed_ratio_max))

@@ -12,7 +12,7 @@ from typing import Annotated, Any
 
 import typer
 
-from .app import ChannelOpt, ModelOpt, OutOpt, stdout
+from .app import ChannelOpt, ModelOpt, OutOpt, say
 
 #: The command's ``--help`` text.
 HELP = "Fit the pump and turbine shape effects to a transient measurement; sweep plots like thesis figs 4.1–4.2."
@@ -39,7 +39,7 @@ def shape_fit_command(
     from ..analysis import shape_fit as sf
     from ..analysis.effective import measured_effective_torques
     from ..io.measurement import parse_channel_map, read_measurement
-    from ..io.outputs import output_dir
+    from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_frames, write_text_files
     from ..models.converter import load_converter
     from ..models.dynamic import dynamic_model
@@ -47,6 +47,7 @@ def shape_fit_command(
     from ..plots.shape_sweep import plot_shape_effect_sweep
     from ..reports.shape_fit import report_markdown, shape_fit_json
 
+    check_output_dir(out, [converter, measurement])
     sf.check_choice("--model", model, sf.MODELS)
     sf.check_choice("--target", target, sf.TARGETS)
     sf.check_choice("--drive", drive, sf.DRIVES)
@@ -58,6 +59,8 @@ def shape_fit_command(
         required=sf.required_channels(target, drive),
         optional=("pump_speed_rad_s", "pump_torque_nm"),
     )
+    inputs = [converter, measurement, conv.path, meas.source]
+    check_output_dir(out, inputs)
     base = dynamic_model(conv, model)
     inertia = base.spec["inertia_kg_m2"]
     effective = measured_effective_torques(meas, inertia[1], inertia[0])
@@ -71,7 +74,7 @@ def shape_fit_command(
     measured = sf.measured_frame(meas, effective)
     steady = sf.steady_run(conv, drv, meas.time_s)
     minima = sf.sweep_minima(sweep)
-    with output_dir(out) as stage:
+    with output_dir(out, inputs) as stage:
         title = f"{conv.name}, {result.model}: shape effects"
         plots = plot_shape_effect_sweep(sweep, stage, title, measured=measured, steady=steady)
         write_frames({"shape_sweep.csv": sweep}, stage)
@@ -98,4 +101,4 @@ def fit_shapes(
     equal: Annotated[bool, typer.Option("--equal", help="fit one shape effect, S_p = S_t")] = False,
 ) -> None:
     """The command; its help is :data:`HELP`."""
-    stdout.print(shape_fit_command(converter, measurement, out, model, target, channel or [], drive, equal))
+    say(shape_fit_command(converter, measurement, out, model, target, channel or [], drive, equal))

@@ -139,11 +139,14 @@ def launch(
     ] = False,
 ) -> None:
     """The command; its help is :data:`HELP`."""
-    from ..io.outputs import output_dir
+    from ..io.outputs import check_output_dir, output_dir
     from ..reports.console import launch_report, progress_display
+    from ..reports.format import rich_text
 
+    check_output_dir(out, [p for p in (vehicle, scenario) if p])
     result = launch_files(vehicle, scenario, model or [], sweep_shape_effects, progress=True)
-    with output_dir(out) as stage, progress_display(True) as display:
-        display.add_task(f"writing {out}/ (files and plots)", total=None)
+    inputs = [p for p in (vehicle, scenario, result.vehicle.path, result.vehicle.converter.path) if p]
+    with output_dir(out, inputs) as stage, progress_display(True) as display:
+        display.add_task(rich_text(f"writing {out}/ (files and plots)"), total=None)
         write_launch(result, stage)
     stdout.print(launch_report(result, Path(out)))

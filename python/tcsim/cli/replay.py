@@ -89,9 +89,10 @@ def replay(
     """Isolated converter driven by measured signals: DIR/<model>.csv, events, metrics, plots."""
     from ..analysis.replay import parse_initial
     from ..io.measurement import parse_channel_map
-    from ..io.outputs import output_dir
+    from ..io.outputs import check_output_dir, output_dir
     from ..reports.console import replay_report
 
+    check_output_dir(out, [converter, measurement])
     result = replay_files(
         converter,
         measurement,
@@ -102,6 +103,7 @@ def replay(
         window,
         metrics_window,
     )
-    with output_dir(out) as stage:
+    inputs = [converter, measurement, result.measurement.source]
+    with output_dir(out, inputs) as stage:
         write_replay(result, stage)
     stdout.print(replay_report(result, Path(out)))

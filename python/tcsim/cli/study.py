@@ -7,7 +7,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from .app import OutOpt, stdout
+from .app import OutOpt, say
 
 if TYPE_CHECKING:
     from ..analysis.study import StudyDefinition
@@ -16,19 +16,22 @@ if TYPE_CHECKING:
 def study_command(converter: str, out: str | Path, definition: StudyDefinition | None = None) -> str:
     """DIR/study.csv and DIR/study_<parameter>.png; the line to print."""
     from ..analysis.study import default_definition, run_study
-    from ..io.outputs import output_dir
+    from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_frames
     from ..models.converter import load_converter
     from ..plots.study import plot_study
     from ..reports.console import study_line
 
+    check_output_dir(out, [converter])
     conv = load_converter(converter)
+    inputs = [converter, conv.path]
+    check_output_dir(out, inputs)
     conv.require("hrovat-tobler")
     definition = definition or default_definition()
     df = run_study(conv, definition)
     title = f"{conv.name}, pump at {definition.pump_speed_rpm:g} rpm (stator free-wheeling above the coupling point)"
     references = {p.key: getattr(conv.geometry, p.key) for p in definition.parameters}
-    with output_dir(out) as stage:
+    with output_dir(out, inputs) as stage:
         write_frames({"study.csv": df}, stage)
         plot_study(df, definition.parameters, references, title, stage)
     return study_line(df, definition, Path(out))
@@ -39,4 +42,4 @@ def study(
     out: OutOpt = Path("study"),
 ) -> None:
     """Appendix D parameter study: one figure per parameter and DIR/study.csv."""
-    stdout.print(study_command(converter, out))
+    say(study_command(converter, out))

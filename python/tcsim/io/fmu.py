@@ -60,6 +60,7 @@ from ..models.converter import MODELS, Converter
 from ..models.drives import Drive, PumpTorqueTurbineSpeed, Speeds
 from ..models.dynamic import DynamicModel, resolve_model
 from ..simulation.transient import SolverError, simulate
+from .outputs import output_file
 
 #: ``modelIdentifier`` of the FMU: the binary is ``binaries/<platform>/tcsim_converter.<ext>``
 #: (owned by the FMU crate's variable table).
@@ -158,6 +159,24 @@ def fmu_parameters(model: DynamicModel) -> list[Parameter]:
 # modelDescription.xml, written from the variable table only
 
 
+#: Characters XML 1.0 does not allow, even as character references (C0 controls but tab, newline and
+#: carriage return; surrogates, which a non-UTF-8 file name decodes to; U+FFFE and U+FFFF).
+_XML_FORBIDDEN = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\ud800-\udfff\ufffe\uffff]")
+
+
+def xml_text(text: str) -> str:
+    """``text`` with every character XML 1.0 forbids shown as its escape (``\\x01``, ``\\udcff``):
+    every user string that reaches ``modelDescription.xml`` goes through here, then
+    :func:`xml_attr` or an element's escaping."""
+    return _XML_FORBIDDEN.sub(lambda m: m.group().encode("unicode_escape").decode("ascii"), text)
+
+
+def xml_attr(text: str) -> str:
+    """``text`` as a quoted XML attribute value (:func:`xml_text`, then ``&``, ``<``, ``"`` and
+    whitespace escaped)."""
+    return quoteattr(xml_text(text))
+
+
 def _version() -> str:
     try:
         return metadata.version("tcsim")
@@ -169,7 +188,7 @@ def _header(
     model: DynamicModel, causality: str, variables: list[dict[str, Any]], name: str, guid: str, stamp: str
 ) -> list[str]:
     """``<fmiModelDescription ...>`` with the Model Exchange and Co-Simulation capabilities."""
-    a, version, stem = quoteattr, _version(), Path(model.source).stem
+    a, version, stem = xml_attr, _version(), Path(model.source).stem
     outputs = ", ".join(v["name"] for v in variables if v["causality"] == "output")
     description = (
         f"Torque converter {stem}, {model.name} model (tcsim {version}). Inputs "
@@ -195,9 +214,9 @@ def _unit_definitions() -> list[str]:
     lines = ["  <UnitDefinitions>"]
     for name, base, display in _core.fmu_units():
         exponents = " ".join(f'{k}="{v}"' for k, v in base)
-        lines.append(f"    <Unit name={quoteattr(name)}>")
+        lines.append(f"    <Unit name={xml_attr(name)}>")
         lines.append(f"      <BaseUnit {exponents}/>" if exponents else "      <BaseUnit/>")
-        lines += [f'      <DisplayUnit name={quoteattr(d)} factor="{factor}"/>' for d, factor in display]
+        lines += [f'      <DisplayUnit name={xml_attr(d)} factor="{factor}"/>' for d, factor in display]
         lines.append("    </Unit>")
     return [*lines, "  </UnitDefinitions>"]
 
@@ -205,7 +224,7 @@ def _unit_definitions() -> list[str]:
 def _model_variables(variables: list[dict[str, Any]], index: dict[int, int]) -> list[str]:
     """``<ModelVariables>``: one ``<ScalarVariable>`` per row of the table (``index``: the 1-based
     index of each value reference)."""
-    a = quoteattr
+    a = xml_attr
     lines = ["  <ModelVariables>"]
     for v in variables:
         attrs = f'causality="{v["causality"]}" variability="{v["variability"]}"'
@@ -507,12 +526,26 @@ def _check_model(model: DynamicModel, causality: str) -> None:
 
 
 def _output_path(out_path: str | Path) -> Path:
+    """``out_path`` if it names a ``.fmu`` file that is missing or an FMU (a zip archive with a
+    ``modelDescription.xml``), which is then replaced; the rest of the rule is
+    :func:`tcsim.io.outputs.output_file`'s."""
     out = Path(out_path)
     if out.suffix.lower() != ".fmu":
         raise InputError("command line", "--out", str(out), "a file name ending in .fmu")
     if out.is_dir():
         raise InputError("command line", "--out", str(out), "a .fmu file (a directory of that name exists)")
+    if out.is_file() and not _is_fmu(out):
+        expected = "a new .fmu file or an FMU to replace (the file is not an FMU)"
+        raise InputError("command line", "--out", str(out), expected)
     return out
+
+
+def _is_fmu(path: Path) -> bool:
+    try:
+        with zipfile.ZipFile(path) as zf:
+            return "modelDescription.xml" in zf.namelist()
+    except (OSError, zipfile.BadZipFile):
+        return False
 
 
 def export_fmu(
@@ -524,7 +557,8 @@ def export_fmu(
     """Write the FMU of ``model`` (a name of :data:`tcsim.models.converter.MODELS`, or a
     :class:`~tcsim.transient.DynamicModel`, with ``converter`` then ignored) of ``converter`` (a
     :class:`~tcsim.models.converter.Converter`, bundled name or file) to ``out_path`` (``*.fmu``), written
-    atomically. Returns the path."""
+    atomically by the rule of :func:`tcsim.io.outputs.output_file` (an input of the run or a
+    directory of that name is refused, an existing file replaced). Returns the path."""
     _check_causality(causality)
     out = _output_path(out_path)
     dyn = resolve_model(converter if isinstance(converter, (Converter, DynamicModel)) else str(converter), model)
@@ -536,33 +570,21 @@ def export_fmu(
         _check_library(lib)
     root = source_root()
 
-    parent = out.resolve().parent
-    try:
-        parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp_name = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".partial", dir=parent)
-        os.close(fd)
-    except OSError as e:
-        raise InputError("command line", "--out", str(out), f"a writable location ({e.strerror})") from None
-    tmp = Path(tmp_name)
-    try:
-        with tempfile.TemporaryDirectory(prefix="tcsim-fmu-") as stage_dir:
-            stage = Path(stage_dir)
-            (stage / "modelDescription.xml").write_text(xml, encoding="utf-8")
-            (stage / "resources").mkdir()
-            (stage / "resources" / "model.json").write_text(json.dumps(config, indent=1) + "\n")
-            for lib in libs:
-                platform = PLATFORM_OF_SUFFIX[lib.suffix.lower()]
-                (stage / "binaries" / platform).mkdir(parents=True)
-                shutil.copyfile(lib, stage / "binaries" / platform / f"{MODEL_IDENTIFIER}{lib.suffix.lower()}")
-            _write_sources(root, stage / "sources")
-            with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
-                for item in sorted(stage.rglob("*")):
-                    if item.is_file():
-                        zf.write(item, item.relative_to(stage).as_posix())
-        os.chmod(tmp, 0o644)
-        os.replace(tmp, out)
-    finally:
-        tmp.unlink(missing_ok=True)
+    inputs = [str(p) for p in (converter, dyn.source) if isinstance(p, (str, Path))]
+    with output_file(out, inputs) as tmp, tempfile.TemporaryDirectory(prefix="tcsim-fmu-") as stage_dir:
+        stage = Path(stage_dir)
+        (stage / "modelDescription.xml").write_text(xml, encoding="utf-8")
+        (stage / "resources").mkdir()
+        (stage / "resources" / "model.json").write_text(json.dumps(config, indent=1) + "\n")
+        for lib in libs:
+            platform = PLATFORM_OF_SUFFIX[lib.suffix.lower()]
+            (stage / "binaries" / platform).mkdir(parents=True)
+            shutil.copyfile(lib, stage / "binaries" / platform / f"{MODEL_IDENTIFIER}{lib.suffix.lower()}")
+        _write_sources(root, stage / "sources")
+        with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
+            for item in sorted(stage.rglob("*")):
+                if item.is_file():
+                    zf.write(item, item.relative_to(stage).as_posix())
     return out
 
 

@@ -9,7 +9,7 @@ import pandas as pd
 
 from ..models.characteristic import Characteristic
 from ..models.steady import ratio_frame
-from .common import plt
+from .common import mpl_text, plt
 
 QUANTITIES = {
     "torque_ratio": ("Torque ratio [-]", "torque_ratio.png"),
@@ -38,17 +38,16 @@ def plot_characteristic(
         fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
         for name, df in curves.items():
             y = df[column].to_numpy(dtype=float)
-            ax.plot(df["speed_ratio"], np.where(np.isfinite(y), y, np.nan), label=name)
+            ax.plot(df["speed_ratio"], np.where(np.isfinite(y), y, np.nan), label=mpl_text(name))
         if ref is not None:
             y = ref[column].to_numpy(dtype=float)
-            ax.plot(
-                ref["speed_ratio"], np.where(np.isfinite(y), y, np.nan), "o", mfc="none", color="k", label=table_label
-            )
+            y = np.where(np.isfinite(y), y, np.nan)
+            ax.plot(ref["speed_ratio"], y, "o", mfc="none", color="k", label=mpl_text(table_label))
         if coupling_point is not None:
             ax.axvline(coupling_point, color="0.6", ls=":", lw=1, label=f"coupling point SR {coupling_point:.3f}")
         ax.set_xlabel("Speed ratio [-]")
         ax.set_ylabel(label)
-        ax.set_title(title)
+        ax.set_title(mpl_text(title))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
         path = out_dir / filename

@@ -24,7 +24,7 @@ import pandas as pd
 from matplotlib.ticker import MaxNLocator
 
 from ..units import KM_H
-from .common import finish_figure, plt
+from .common import finish_figure, mpl_text, plt
 
 COLOURS = {"table": "C0", "hrovat-tobler": "C1", "quasi-dynamic": "C2"}
 LABELS = {"table": "SS (table) model", "hrovat-tobler": "H&T model", "quasi-dynamic": "quasi-dynamic model"}
@@ -218,7 +218,7 @@ def plot_sweep(sweep: pd.DataFrame | None, steady: pd.DataFrame | None, release:
             fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
             for label, run in g.groupby("label", sort=False):
                 w = _window(run, a, b)
-                ax.plot(w["time_s"], w[column], lw=1.1, label=label)
+                ax.plot(w["time_s"], w[column], lw=1.1, label=mpl_text(label))
             if steady is not None:
                 w = _window(steady, a, b)
                 ax.plot(w["time_s"], w[column], color="0.3", ls="--", lw=1.2, label=LABELS["table"])

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import finish_figure, plt
+from .common import finish_figure, mpl_text, plt
 
 #: Signals by name (a measurement's channels, or a run's columns), each an array over time.
 Signals = Mapping[str, np.ndarray]
@@ -45,7 +45,7 @@ def plot_inputs(time_s: np.ndarray, channels: Signals, inputs: Sequence[str], ti
         ax.plot(time_s, channels[channel], color="k", lw=1.2)
         ax.set_ylabel(INPUT_LABELS[channel])
         ax.grid(True, alpha=0.3)
-    axes[0].set_title(title, fontsize="medium")
+    axes[0].set_title(mpl_text(title), fontsize="medium")
     axes[-1].set_xlabel("Time [s]")
     path = out_dir / "inputs.png"
     fig.savefig(path, dpi=120)
@@ -64,7 +64,7 @@ def plot_channel(
         ax.plot(time_s, measured, color="k", lw=1.6, label="measurement")
     for name, result in runs.items():
         y = np.asarray(result[channel], dtype=float)
-        ax.plot(result["time_s"], y, lw=1.1, label=f"{name} model")
+        ax.plot(result["time_s"], y, lw=1.1, label=mpl_text(f"{name} model"))
     ax.set_ylabel(label)
     title = f"{label.split(' [')[0]} ({note})" + ("" if measured is not None else ", not measured")
     return finish_figure(fig, ax, out_dir / filename, title)

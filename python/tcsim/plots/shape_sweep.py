@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .common import plt
+from .common import mpl_text, plt
 
 _PLOTS = (
     ("time_s", "effective_torque_ratio", "Time [s]", "Effective torque ratio [-]", "effective_torque_ratio_time.png"),
@@ -50,14 +50,14 @@ def plot_shape_effect_sweep(
     for x, y, xlabel, ylabel, filename in _PLOTS:
         fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
         for label, g in df[df["admissible"]].groupby("label", sort=False):
-            ax.plot(g[x], g[y], lw=1.0, label=label)
+            ax.plot(g[x], g[y], lw=1.0, label=mpl_text(label))
         for d, style in extra:
             d = pd.DataFrame(d)
             if x in d and y in d:
                 ax.plot(d[x], d[y], **style)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
-        ax.set_title(title)
+        ax.set_title(mpl_text(title))
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
         path = Path(out_dir) / filename

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ..analysis.study import ParameterRange
-from .common import plt
+from .common import mpl_text, plt
 
 _PANELS = (
     ("torque_ratio", "Torque ratio [-]"),
@@ -34,13 +34,13 @@ def plot_parameter(df: pd.DataFrame, p: ParameterRange, reference: float, path: 
         label = f"{value:.4g} {p.unit}" + (" (reference)" if is_ref else "")
         style = dict(color="k", lw=2.0, zorder=3) if is_ref else dict(color=colour, lw=1.3)
         for ax, (column, _) in zip(axes, _PANELS):
-            ax.plot(curve["speed_ratio"], curve[column], marker=".", ms=4, label=label, **style)
+            ax.plot(curve["speed_ratio"], curve[column], marker=".", ms=4, label=mpl_text(label), **style)
     for ax, (_, ylabel) in zip(axes, _PANELS):
         ax.set_xlabel("Speed ratio [-]")
         ax.set_ylabel(ylabel)
         ax.grid(True, alpha=0.3)
-    axes[0].legend(title=f"{p.label} [{p.unit}]", fontsize="small")
-    fig.suptitle(f"Effect of parameter '{p.label}': {title}")
+    axes[0].legend(title=mpl_text(f"{p.label} [{p.unit}]"), fontsize="small")
+    fig.suptitle(mpl_text(f"Effect of parameter '{p.label}': {title}"))
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path

@@ -16,7 +16,7 @@ from rich.table import Table
 from ..analysis.launch import Launch
 from ..analysis.replay import Replay
 from ..analysis.study import StudyDefinition
-from .format import fmt_number
+from .format import fmt_number, rich_text
 
 
 @contextlib.contextmanager
@@ -40,8 +40,10 @@ def launch_report(result: Launch, out: Path) -> Group:
     """A rich table of the launch summary and where the files are."""
     s = result.scenario
     table = Table(
-        title=f"launch of {result.vehicle.name} ({result.vehicle.converter.name}), scenario {s.name}, "
-        f"brake release at {s.brake_release_time_s:g} s"
+        title=rich_text(
+            f"launch of {result.vehicle.name} ({result.vehicle.converter.name}), scenario {s.name}, "
+            f"brake release at {s.brake_release_time_s:g} s"
+        )
     )
     for col in (
         "model",
@@ -55,7 +57,7 @@ def launch_report(result: Launch, out: Path) -> Group:
     reached = {"missing": "not reached"}
     for _, r in result.summary.iterrows():
         table.add_row(
-            r["model"],
+            rich_text(r["model"]),
             fmt_number(r["time_0_50_km_h_s"], ".2f", **reached),
             fmt_number(r["time_0_100_km_h_s"], ".2f", **reached),
             fmt_number(r["peak_accel_m_s2"], ".2f", **reached),
@@ -65,8 +67,10 @@ def launch_report(result: Launch, out: Path) -> Group:
     lines = [
         f"compute {result.compute_s * 1e3:.0f} ms for {len(result.runs)} models"
         + (f", sweep {result.sweep_compute_s * 1e3:.0f} ms" if result.sweep is not None else ""),
-        f"written to {out}/: summary.csv, {', '.join(f'{m}.csv' for m in result.runs)}, timeseries.csv, "
-        f"events.csv, scenario.csv{', shape_sweep*.csv' if result.sweep is not None else ''} and plots",
+        rich_text(
+            f"written to {out}/: summary.csv, {', '.join(f'{m}.csv' for m in result.runs)}, timeseries.csv, "
+            f"events.csv, scenario.csv{', shape_sweep*.csv' if result.sweep is not None else ''} and plots"
+        ),
     ]
     return Group(table, *lines)
 
@@ -74,8 +78,10 @@ def launch_report(result: Launch, out: Path) -> Group:
 def replay_report(replay: Replay, out: Path) -> Group:
     """A short rich summary: per model the events and the turbine-torque RMSE, then where the files are."""
     table = Table(
-        title=f"replay of {replay.measurement.source} on {replay.converter}, drive {replay.drive.name}, "
-        f"{len(replay.measurement.time_s)} samples"
+        title=rich_text(
+            f"replay of {replay.measurement.source} on {replay.converter}, drive {replay.drive.name}, "
+            f"{len(replay.measurement.time_s)} samples"
+        )
     )
     for col in ("model", "events", "turbine torque RMSE [N·m]", "NRMSE"):
         table.add_column(col)
@@ -85,16 +91,18 @@ def replay_report(replay: Replay, out: Path) -> Group:
         events = ", ".join(f"{e.kind} {e.time_s:.3f} s" for e in result.events) or "none"
         row = rows[rows["model"] == name]
         rmse, nrmse = (f"{row[c].iloc[0]:.4g}" for c in ("rmse", "nrmse")) if len(row) else ("n/a", "n/a")
-        table.add_row(name, events, rmse, nrmse)
+        table.add_row(rich_text(name), rich_text(events), rmse, nrmse)
     return Group(
         table,
-        f"written to {out}/: {', '.join(f'{m}.csv' for m in replay.results)}, events.csv, "
-        f"measurement.csv{', metrics.csv' if len(metrics) else ''} and plots",
+        rich_text(
+            f"written to {out}/: {', '.join(f'{m}.csv' for m in replay.results)}, events.csv, "
+            f"measurement.csv{', metrics.csv' if len(metrics) else ''} and plots"
+        ),
     )
 
 
 def study_line(df: pd.DataFrame, definition: StudyDefinition, out: Path) -> str:
-    """The one line ``tcsim study`` prints."""
+    """The one line ``tcsim study`` prints (plain text: escape it with :func:`rich_text` for rich)."""
     n_values = df.groupby("parameter", sort=False)["parameter_value"].nunique().sum()
     solved = int(np.isfinite(df["torque_ratio"]).sum())
     free = int(df["stator_mode"].isin(["free-wheeling", "no-flow"]).sum())
