@@ -27,7 +27,7 @@ REPO = Path(__file__).resolve().parents[1]
 # HYPOTHESIS_PROFILE=long runs many random examples by hand (tests/cli/bad_inputs/README.md).
 settings.register_profile(
     "ci",
-    max_examples=30,
+    max_examples=50,
     deadline=None,
     derandomize=True,
     database=None,

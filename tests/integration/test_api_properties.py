@@ -148,6 +148,9 @@ def output_samples(drive: dict[str, Any]) -> int:
 )
 def test_transient_runs_return_results_or_refuse_the_input(models, drives, init, opts, workers):
     assume(len(models) == len(drives) or 1 in (len(models), len(drives)))  # else a ValueError, by design
+    # defect 6 (issue 10): drive values beyond 1e6 give non-finite results (the xfail test below)
+    signals = [v for d in drives for k, v in d.items() if k not in ("kind", "time_s", "output_time_s")]
+    assume(not any(np.any(np.abs(np.asarray(v, dtype=float)) > 1e6) for v in [*signals, *(init or {}).values()]))
     try:
         runs = _core.transient_runs(models, drives, init, opts, workers)
     except _core.CoreInputError as e:
