@@ -15,12 +15,34 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from hypothesis import HealthCheck, settings
 
 from tcsim.cli import main
 from tcsim.errors import TcsimWarning
 from tcsim.io import fmu as fmu_io
 
 REPO = Path(__file__).resolve().parents[1]
+
+# Property-based tests (hypothesis): "ci", the default, is a fixed, reproducible budget;
+# HYPOTHESIS_PROFILE=long runs many random examples by hand (tests/cli/bad_inputs/README.md).
+settings.register_profile(
+    "ci",
+    max_examples=50,
+    deadline=None,
+    derandomize=True,
+    database=None,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
+settings.register_profile(
+    "long",
+    max_examples=2000,
+    deadline=None,
+    database=None,
+    print_blob=True,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture],
+)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 CONVERTER_DATA = REPO / "tests" / "data" / "converters"  # published tables (tests/data/README.md)
 
 # Li & Sundén (2016) Table C.1 with CF in N·m/(rad/s)², from the published table in tests/data
