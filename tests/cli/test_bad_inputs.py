@@ -22,7 +22,7 @@ BASE_ROOTS = (REPO / "python" / "tcsim" / "data", REPO / "tests" / "data", REPO 
 #: Hang guard of a case run as a subprocess, s (never asserted on: a timeout fails the case).
 SUBPROCESS_TIMEOUT_S = 60.0
 CASE_KEYS = {
-    *("id", "command", "exit", "file", "message", "files", "subprocess", "pending", "form", "timeout", "tags"),
+    *("id", "command", "exit", "file", "message", "files", "subprocess", "pending", "timeout", "tags"),
     "writes",
 }
 FILE_KEYS = {"text", "hex", "base", "replace", "prepend", "append", "make", "args", "dir"}
@@ -107,18 +107,14 @@ def run_subprocess(args: list[str], cwd: Path, timeout: float) -> tuple[int, str
 
 
 def check_message(case: dict[str, Any], stderr: str) -> None:
-    """One ``error:`` line naming the file, the fragments and what was expected (``form = "usage"``:
-    the command-line parser's usage block, whose last line starts ``Error:``)."""
+    """One ``error:`` line naming the file (``command line`` for options and usage errors), the
+    fragments and what was expected."""
     lines = [ln for ln in stderr.splitlines() if ln.strip()]
-    if case.get("form") == "usage":
-        assert lines and lines[0].startswith("Usage:") and lines[-1].startswith("Error: "), lines
-        msg = lines[-1]
-    else:
-        assert len(lines) == 1, f"expected one stderr line, got {len(lines)}: {lines}"
-        msg = lines[0]
-        assert msg.startswith("error: "), msg
-        assert "expected" in msg, msg
-        assert case["file"] in msg, f"file {case['file']!r} not named in {msg!r}"
+    assert len(lines) == 1, f"expected one stderr line, got {len(lines)}: {lines}"
+    msg = lines[0]
+    assert msg.startswith("error: "), msg
+    assert "expected" in msg, msg
+    assert case["file"] in msg, f"file {case['file']!r} not named in {msg!r}"
     for fragment in case.get("message", []):
         assert fragment in msg, f"{fragment!r} not in {msg!r}"
 
@@ -207,7 +203,7 @@ def test_catalogue_is_large_unique_and_covers_every_command_and_format():
     assert REQUIRED_FEATURES <= covered, sorted(REQUIRED_FEATURES - covered)
     for c in CASES:
         assert c["command"][0] in COMMANDS, c["id"]
-        assert c.get("form") == "usage" or c.get("file") or c["exit"] == 0, f"{c['id']}: no file to name"
+        assert c.get("file") or c["exit"] == 0, f"{c['id']}: no file to name"
         assert (c["exit"] == 0) == ("writes" in c), f"{c['id']}: exit 0 exactly when it names what it writes"
         assert c.get("pending") is None or c["_topic"] == "pending", f"{c['id']}: pending cases go in pending.toml"
     pending = [c for c in CASES if c["_topic"] == "pending"]

@@ -170,12 +170,39 @@ def _run(argv: list[str] | None) -> int:
     except SystemExit as e:  # typer/click's own exits
         return e.code if isinstance(e.code, int) else 1
     except Exception as e:  # click usage errors, and failures that are not the user's
-        show, code = getattr(e, "show", None), getattr(e, "exit_code", None)
-        if callable(show) and isinstance(code, int):
-            show()  # a usage error from the command-line parser (exit code 2)
-            return code
+        if callable(getattr(e, "format_message", None)) and getattr(e, "exit_code", None) == 2:
+            line = usage_error_line(e, sys.argv[1:] if argv is None else argv)
+            console.print(f"[red]error:[/red] {rich_text(line)}", highlight=False, soft_wrap=True)
+            return 2
         console.print(f"[red]tcsim failed:[/red] {type(e).__name__}: {rich_text(e)}", highlight=False, soft_wrap=True)
         return 1
     if rv == _TYPER_INTERRUPT or _received:  # typer caught the interrupt, or it was swallowed
         raise Interrupted(_received[-1]) if _received else KeyboardInterrupt()
     return 0
+
+
+def usage_error_line(e: Exception, argv: list[str]) -> str:
+    """A usage error of the command-line parser as one line naming the option and the value given
+    (``command line: --pump-speed-rpm = 'abc': expected …``), like every other input error."""
+    ctx = getattr(e, "ctx", None)
+    command = " ".join(["tcsim", *([ctx.info_name] if ctx is not None and ctx.parent is not None else [])])
+    reason = str(e.format_message()).rstrip(".")  # type: ignore[attr-defined]
+    param = getattr(e, "param", None)
+    opts = [o for o in getattr(param, "opts", []) if o.startswith("-")]
+    if type(e).__name__ == "BadParameter" and opts:
+        value = _option_value(argv, opts)
+        detail = reason.split(": ", 1)[-1]
+        return f"command line: {opts[0]} = {value!r}: expected a valid value ({detail}; see '{command} --help')"
+    return f"command line: {reason}: expected the usage of '{command} --help'"
+
+
+def _option_value(argv: list[str], opts: list[str]) -> str:
+    """The last value ``argv`` gives an option (``--opt VALUE`` or ``--opt=VALUE``)."""
+    value = ""
+    for i, arg in enumerate(argv):
+        for opt in opts:
+            if arg == opt and i + 1 < len(argv):
+                value = argv[i + 1]
+            elif arg.startswith(opt + "="):
+                value = arg[len(opt) + 1 :]
+    return value
