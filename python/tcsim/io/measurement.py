@@ -463,7 +463,8 @@ def check_numeric(path: Path, column: str, values: np.ndarray, time_s: np.ndarra
         nested = np.flatnonzero([not np.isscalar(v) and v is not None for v in objects])
         if len(nested):
             row = int(nested[0])
-            raise InputError(str(path), column, f"{values[row]!r} at {_at(row, time_s)}", "numbers only, one per row")
+            value = values[row].tolist() if isinstance(values[row], np.ndarray) else values[row]
+            raise InputError(str(path), column, f"{value!r} at {_at(row, time_s)}", "numbers only, one per row")
         parsed = pd.to_numeric(series, errors="coerce")
         bad = np.flatnonzero(parsed.isna() & series.notna())
         if not len(bad):

@@ -63,6 +63,11 @@ def _columns(path: Path, rows, names: list[str]):
 def read_table_csv(path: Path) -> Characteristic:
     rows = _rows(path)
     header_line, header = rows[0]
+    twice = [h for i, h in enumerate(header) if h in header[:i]]
+    if twice:
+        raise InputError(
+            str(path), f"line {header_line} (header)", twice[0], "each column name once (this one appears twice)"
+        )
     for required in ("speed_ratio", "torque_ratio"):
         if required not in header:
             raise InputError(str(path), f"line {header_line} (header)", ",".join(header), f"a {required} column")
