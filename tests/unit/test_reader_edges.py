@@ -17,7 +17,8 @@ import pytest
 import scipy.io
 from asammdf import MDF, Signal
 
-from tcsim.errors import InputError, TcsimWarning, escape_controls
+from tcsim import errors
+from tcsim.errors import InputError, TcsimWarning
 from tcsim.io.measurement import read_measurement
 from tcsim.io.scenario import read_scenario
 from tcsim.models.converter import load_converter
@@ -255,7 +256,7 @@ def test_a_toml_key_with_a_newline_gives_one_line(tmp_path):
 def test_error_messages_escape_control_characters_and_undecodable_bytes():
     err = InputError("a\udcffb.csv", "x\ny", "v\x1b[2J", "z\u2028w")
     assert str(err) == "a\\udcffb.csv: x\\ny = 'v\\x1b[2J': expected z\\u2028w"
-    assert escape_controls("±10 500 rpm · ü") == "±10 500 rpm · ü"
+    assert errors.escape_controls("±10 500 rpm · ü") == "±10 500 rpm · ü"
 
 
 @pytest.mark.parametrize(("key", "value"), [("k_factor_rpm_per_sqrt_nm", "1e-160"), ("capacity_nm_per_rpm2", "1e307")])
