@@ -217,7 +217,8 @@ def check_record_windows(meas: Measurement, window_s: float | None, metrics_wind
     span = float(t[-1] - t[0])
     spacing = float(np.median(np.diff(t)))
     where = f"the record's span {span:g} s of {meas.source}"
-    if window_s is not None and math.isfinite(window_s) and window_s > span:
+    slack = 1.0 + 1e-9  # time stamps written in decimal: a window "equal" to the span or the spacing is in
+    if window_s is not None and math.isfinite(window_s) and window_s > span * slack:
         raise InputError(
             "command line",
             "--window",
@@ -226,7 +227,7 @@ def check_record_windows(meas: Measurement, window_s: float | None, metrics_wind
         )
     if metrics_window_s is None or metrics_window_s == METRICS_WINDOW_S or not math.isfinite(metrics_window_s):
         return
-    if not spacing <= metrics_window_s <= span:
+    if not (spacing <= metrics_window_s * slack and metrics_window_s <= span * slack):
         raise InputError(
             "command line",
             "--metrics-window",

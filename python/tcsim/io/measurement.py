@@ -233,7 +233,9 @@ def _quiet_mdf_cleanup() -> Iterator[None]:
     previous = sys.unraisablehook
 
     def hook(unraisable) -> None:
-        if not type(unraisable.object).__module__.startswith("asammdf"):
+        where = unraisable.object  # the failing __del__ method, or the object
+        module = getattr(where, "__module__", None) or type(where).__module__
+        if not str(module).startswith("asammdf"):
             previous(unraisable)
 
     sys.unraisablehook = hook
