@@ -8,7 +8,7 @@ with the measured ones without feedback errors from the rest of a driveline.
 
     tcsim replay CONVERTER MEASUREMENT [--model M ...] [--out DIR] [--drive pump-torque|speeds]
                  [--channel TARGET=COLUMN ...] [--initial NAME=VALUE ...] [--window S]
-                 [--metrics-window S]
+                 [--metrics-window S] [--allow-implausible]
 
 Input channels
 --------------
@@ -19,7 +19,8 @@ unit-suffixed names (``time_s``, ``pump_torque_nm``, ``pump_speed_rad_s``, ``tur
 ``turbine_speed_rpm``, ``pump_torque_knm``, ...; converted), or through an explicit mapping
 ``--channel TARGET=COLUMN`` (repeatable, e.g. ``--channel pump_torque_nm=EngTrq``). MDF4 channel
 units decide the conversion when present. Missing channels, NaN, time going backwards and values
-that look like the wrong unit (a speed column in rpm named ``*_rad_s``) are input errors (exit 2).
+that look like the wrong unit (a speed column in rpm named ``*_rad_s``: the plausibility ranges,
+overridable with ``--allow-implausible``) are input errors (exit 2).
 
 Drives
 ------
@@ -56,8 +57,9 @@ A prescribed speed enters the equations with its derivative (the inertia and sha
 terms). ``--window S`` (default :data:`tcsim.models.drives.DERIVATIVE_WINDOW_S`, 0.04 s) sets the
 smoothing of that derivative: at each sample, the slope of the straight line fitted by least
 squares to all samples within ±S/2 (at least the neighbouring samples; a first-order
-Savitzky–Golay filter on non-uniform samples). ``--window 0`` gives the central difference.
-The *same* local least-squares slope, with the same window, differentiates the measured speeds
+Savitzky–Golay filter on non-uniform samples). ``--window 0`` gives the central difference, as
+does any window shorter than the sample spacing. A window longer than the record's span is refused
+(the default never is). The *same* local least-squares slope, with the same window, differentiates the measured speeds
 for the measured effective torques below (:func:`tcsim.analysis.effective.smoothed_rate`).
 
 Outputs (in DIR, default ``replay``; written all at once, nothing on error)
@@ -74,7 +76,9 @@ Outputs (in DIR, default ``replay``; written all at once, nothing on error)
 * ``metrics.csv`` when the measurement has reference outputs: one row per model × channel × window
   with ``model, channel, window, window_start_s, window_end_s, rmse, nrmse, max_abs_error,
   max_abs_error_time_s, n``. ``window`` is ``all`` for the whole record, else the number of a
-  consecutive window of ``--metrics-window`` seconds (default 1 s; the last one may be shorter).
+  consecutive window of ``--metrics-window`` seconds (default 1 s; the last one may be shorter;
+  windows without a sample are left out). An explicit ``--metrics-window`` shorter than the
+  median sample spacing or longer than the record's span is refused (:func:`check_record_windows`).
   The error is simulated − measured; RMSE = √mean(error²); NRMSE = RMSE / (max − min of the
   measured channel in the window), NaN when that range is zero; ``n`` is the number of samples.
 * Plots (PNG): ``inputs.png`` (the input signals, thesis figures 3.11/3.12); per reference output

@@ -12,9 +12,14 @@ A unit in the file's metadata (MDF4 channels carry one) decides the conversion w
 unconvertible unit is an error. Without one, a mapped column's own unit suffix is used if it has
 one of the target's quantity, otherwise the values are taken as SI.
 
-Everything the user can get wrong (a missing channel, NaN, time going backwards, values that look
-like the wrong unit, a corrupt file) is an :class:`~tcsim.errors.InputError` naming the file, the
-column, the value and what was expected; the first problem found wins.
+Everything the user can get wrong (a missing channel, NaN, time going backwards, a column name
+that appears twice, a cell that holds no real number, an MDF channel that does not cover the
+record, values that look like the wrong unit, a corrupt file) is an
+:class:`~tcsim.errors.InputError` naming the file, the column, the value and what was expected; the
+first problem found wins. The wrong-unit checks use the core's plausibility ranges
+(``speed_rad_s``, ``torque_nm``, ``sample_spacing_s`` for the median time step:
+:mod:`tcsim.models.plausibility`) and are overridable (``allow_implausible``); a record spanning
+more than :data:`MAX_TIME_SPAN_S` is always refused.
 """
 
 from __future__ import annotations
