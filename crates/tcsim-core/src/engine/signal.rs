@@ -97,6 +97,10 @@ impl Signal {
 /// slope; the origin is moved to the current sample and the sums recomputed from scratch once as
 /// many samples entered or left as the window holds, which keeps the rounding of the running sums
 /// bounded and the cost O(n) overall (each recomputation is paid for by as many updates).
+///
+/// A window of at most [`DIRECT_FIT_MAX_SAMPLES`] samples (the default 40 ms window up to a 1.5 kHz
+/// logger) is fitted directly instead, at a cost bounded by that number: its slope is then the
+/// same, bit for bit, as before the running sums, and results recorded with it do not move.
 fn smoothed_rate(t: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
     let n = t.len();
     if n < 2 {
@@ -115,12 +119,28 @@ fn smoothed_rate(t: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
                 sums.remove(t[a], y[a]);
                 a += 1;
             }
+            if b - a < DIRECT_FIT_MAX_SAMPLES {
+                return least_squares_slope(&t[a..=b], &y[a..=b]);
+            }
             if sums.updates > b - a + 1 {
                 sums = SlopeSums::over(&t[a..=b], &y[a..=b], t[i], y[i]);
             }
             sums.slope()
         })
         .collect()
+}
+
+/// The largest window (in samples) whose slope is fitted directly rather than from running sums.
+const DIRECT_FIT_MAX_SAMPLES: usize = 64;
+
+/// The slope of the least-squares line through the samples, fitted directly about their means.
+fn least_squares_slope(t: &[f64], y: &[f64]) -> f64 {
+    let m = t.len() as f64;
+    let tm = t.iter().sum::<f64>() / m;
+    let ym = y.iter().sum::<f64>() / m;
+    let (num, den) =
+        t.iter().zip(y).fold((0.0, 0.0), |(n, d), (&ti, &yi)| (n + (ti - tm) * (yi - ym), d + (ti - tm) * (ti - tm)));
+    num / den
 }
 
 /// The window `(a, b, i)` of each sample `i`: the samples within ±window/2 and at least one
@@ -230,19 +250,7 @@ mod tests {
 
     /// The slopes as they were computed before the running sums: each window fitted directly, O(n·w).
     fn direct_smoothed_rate(t: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
-        window_bounds(t, window_s)
-            .map(|(a, b, _)| {
-                let (t, y) = (&t[a..=b], &y[a..=b]);
-                let m = t.len() as f64;
-                let tm = t.iter().sum::<f64>() / m;
-                let ym = y.iter().sum::<f64>() / m;
-                let (num, den) = t
-                    .iter()
-                    .zip(y)
-                    .fold((0.0, 0.0), |(n, d), (&ti, &yi)| (n + (ti - tm) * (yi - ym), d + (ti - tm) * (ti - tm)));
-                num / den
-            })
-            .collect()
+        window_bounds(t, window_s).map(|(a, b, _)| least_squares_slope(&t[a..=b], &y[a..=b])).collect()
     }
 
     /// A reproducible uniform number in [0, 1) (xorshift64*).
@@ -257,7 +265,15 @@ mod tests {
     fn running_slopes_agree_with_the_direct_fit_on_irregular_noisy_samples_far_from_zero() {
         let mut state = 0x9E37_79B9_7F4A_7C15u64;
         for &(offset, step, window, n) in
-            &[(0.0, 1e-3, 0.04, 5000), (1e5, 1e-3, 0.04, 5000), (1e5, 1e-2, 0.5, 3000), (-3e4, 2e-4, 0.0, 4000)]
+            // windows of ~400, ~500, every sample (running sums), ~50 and 3 samples (direct fits)
+            &[
+                (0.0, 1e-4, 0.04, 20_000),
+                (1e5, 1e-4, 0.04, 20_000),
+                (1e5, 1e-3, 0.5, 5000),
+                (-3e4, 1e-3, 1e300, 3000),
+                (1e5, 1e-2, 0.5, 3000),
+                (-3e4, 2e-4, 0.0, 4000),
+            ]
         {
             let mut t = vec![offset];
             for _ in 1..n {
