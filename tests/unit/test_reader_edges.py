@@ -308,3 +308,33 @@ def test_an_empty_converter_toml_is_an_input_error(tmp_path, text):
     path = tmp_path / "c.toml"
     path.write_text(text)
     refused(lambda: load_converter(path), "missing")
+
+
+@pytest.mark.parametrize(
+    ("value", "words"),
+    [
+        ({"a": 1.0}, ["1x1 struct", "numeric vector"]),
+        (np.array([[1.0], "x"], dtype=object), ["cell array"]),
+        (np.ones((N, 2)), [f"{N}x2 matrix"]),
+    ],
+    ids=["struct", "cell", "matrix"],
+)
+def test_a_mat_variable_that_is_no_vector_is_named_not_missing(tmp_path, value, words):
+    path = tmp_path / "m.mat"
+    scipy.io.savemat(path, {"time_s": TIME_S, "pump_torque_nm": value, "turbine_speed_rad_s": TIME_S})
+    err = refused(lambda: read_measurement(path), "pump_torque_nm", *words)
+    assert err.value != "missing"
+
+
+def test_a_table_value_that_overflows_when_parsed_is_named_as_written(tmp_path):
+    path = tmp_path / "t.vtcc"
+    path.write_text("Speed Ratio, Torque Ratio, MP1000\n0,2,1e400\n0.5,1.5,100\n")
+    err = refused(lambda: load_converter(path), "line 2, mp1000_nm", "'1e400'", "a finite number")
+    assert err.value == "1e400"
+
+
+def test_csv_columns_without_a_name_are_not_duplicates(tmp_path):
+    path = tmp_path / "m.csv"
+    rows = "\n".join(f"{t},{p},{w},," for t, p, w in zip(TIME_S, *CHANNELS.values(), strict=True))
+    path.write_text("time_s,pump_torque_nm,turbine_speed_rad_s,,\n" + rows + "\n")
+    assert len(read_measurement(path).time_s) == N

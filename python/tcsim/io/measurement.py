@@ -276,7 +276,8 @@ def read_csv_frame(path: Path, what: str = "CSV") -> pd.DataFrame:
             raise InputError(str(path), "(file)", "empty", "a header line and at least two data rows") from None
 
     frame, header = _guarded(path, what, read)
-    names = [str(c).strip() for c in header.iloc[0]]
+    # an empty name gets pandas' own (``Unnamed: 3``), which --channel can map
+    names = [str(c).strip() or f"Unnamed: {i}" for i, c in enumerate(header.iloc[0])]
     refuse_duplicates(path, names)
     frame.columns = names
     return frame
@@ -313,12 +314,23 @@ def _read_mat_v5(path: Path, pick: _Chooser) -> _Loaded:
     import scipy.io  # noqa: PLC0415  lazy: start-up time
 
     variables = _guarded(path, "MATLAB .mat", lambda: scipy.io.loadmat(path))
-    vectors = {
-        k: v
-        for k, v in variables.items()
-        if not k.startswith("__") and isinstance(v, np.ndarray) and _is_vector(v.shape, v.dtype)
-    }
-    return {c: vectors[c].ravel() for c in pick(list(vectors))}, {}
+    variables = {k: v for k, v in variables.items() if not k.startswith("__")}
+    columns = pick(list(variables))
+    for c in columns:
+        _require_vector(path, c, variables[c])
+    return {c: variables[c].ravel() for c in columns}, {}
+
+
+def _require_vector(path: Path, name: str, value: object) -> None:
+    """An InputError unless the MATLAB variable ``name`` is a numeric vector (its shape and kind
+    named: a matrix, a struct, a cell array, text)."""
+    shape = getattr(value, "shape", ())
+    dtype = getattr(value, "dtype", np.dtype(object))
+    if isinstance(value, np.ndarray) and _is_vector(shape, dtype):
+        return
+    kind = {"O": "cell array", "V": "struct", "U": "char array", "S": "char array"}.get(dtype.kind, "matrix")
+    size = "x".join(str(n) for n in shape) or "scalar"
+    raise InputError(str(path), name, f"a {size} {kind}", "a numeric vector (one row or one column)")
 
 
 def _read_mat_v73(path: Path, pick: _Chooser) -> _Loaded:
@@ -327,14 +339,18 @@ def _read_mat_v73(path: Path, pick: _Chooser) -> _Loaded:
 
     def read() -> dict[str, np.ndarray]:
         with h5py.File(path, "r") as f:
-            datasets = {
-                k: v
-                for k, v in f.items()
-                if isinstance(v, h5py.Dataset)
-                and _is_vector(v.shape, v.dtype)
-                and v.attrs.get("MATLAB_class", b"double") not in (b"char", b"logical")
-            }
-            return {c: np.asarray(datasets[c][()]).ravel() for c in pick(list(datasets))}
+            datasets = {k: v for k, v in f.items() if isinstance(v, h5py.Dataset)}
+            columns = pick(list(datasets))
+            for c in columns:
+                matlab_class = datasets[c].attrs.get("MATLAB_class", b"double")
+                if matlab_class in (b"char", b"logical", b"cell", b"struct"):
+                    kind = matlab_class.decode()
+                    shape = "x".join(str(n) for n in datasets[c].shape)
+                    raise InputError(
+                        str(path), c, f"a {shape} {kind} array", "a numeric vector (one row or one column)"
+                    )
+                _require_vector(path, c, np.empty(datasets[c].shape, datasets[c].dtype))
+            return {c: np.asarray(datasets[c][()]).ravel() for c in columns}
 
     loaded = _guarded(path, "MATLAB v7.3 (HDF5) .mat", read)
     return {c: v["real"] + 1j * v["imag"] if _is_complex_compound(v.dtype) else v for c, v in loaded.items()}, {}
