@@ -7,6 +7,7 @@ wrong is a failure of tcsim or of a solver (exit code 1).
 
 from __future__ import annotations
 
+import unicodedata
 from collections.abc import Mapping
 from typing import Any
 
@@ -22,7 +23,7 @@ class InputError(Exception):
         super().__init__(str(self))
 
     def __str__(self) -> str:
-        return f"{self.source}: {self.field} = {_show(self.value)}: expected {self.expected}"
+        return escape_controls(f"{self.source}: {self.field} = {_show(self.value)}: expected {self.expected}")
 
 
 class TcsimWarning(UserWarning):
@@ -32,6 +33,28 @@ class TcsimWarning(UserWarning):
 class CoreText(str):
     """A value as the core wrote it, already in the file's notation (``"1930"``, ``7 values``): shown
     as it is, not quoted again."""
+
+
+#: Escapes of the control characters that have a short one; the others are shown as ``\\xNN``/``\\uNNNN``.
+_SHORT_ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def escape_controls(text: str) -> str:
+    """``text`` with every control or format character (a newline, a tab, an escape sequence, a
+    line or paragraph separator, a right-to-left override) and every lone surrogate (an
+    undecodable byte of a file name) written as a Python-style escape (``\\n``, ``\\x1b``,
+    ``\\u2028``), so that a message is one line of printable text whatever a file or a key holds.
+    Spaces, including non-breaking ones, are kept."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or unicodedata.category(c) == "Zs" else _escape(c) for c in text)
+
+
+def _escape(c: str) -> str:
+    if c in _SHORT_ESCAPES:
+        return _SHORT_ESCAPES[c]
+    code = ord(c)
+    return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}" if code < 0x10000 else f"\\U{code:08x}"
 
 
 def _show(value: Any) -> str:

@@ -105,7 +105,9 @@ def test_error_metrics_known_errors_and_flat_channel():
 def test_metric_windows_cover_every_sample_once():
     t = np.cumsum(np.full(1234, 0.0037))
     windows = metric_windows(t, 0.5)
-    masks = np.array([m for *_, m in windows[1:]])
+    masks = np.zeros((len(windows) - 1, len(t)), dtype=bool)
+    for row, (*_, samples) in zip(masks, windows[1:], strict=True):
+        row[samples] = True
     assert (masks.sum(axis=0) == 1).all()
     assert windows[-1][2] == pytest.approx(t[-1])
 

@@ -52,8 +52,16 @@ pub const RANGES: &[PlausibleRange] = &[
         quantity: "sample_spacing_s",
         unit: "s",
         low: 1e-6,
-        high: 1.0,
-        why: "median time step of a measurement logged at 1 Hz to 1 MHz; milliseconds read as seconds give more",
+        high: 0.1,
+        why: "median time step of a measurement logged at 10 Hz to 1 MHz; milliseconds read as seconds give more",
+    },
+    PlausibleRange {
+        quantity: "scenario_duration_s",
+        unit: "s",
+        low: 0.1,
+        high: 3600.0,
+        why: "pedal scenarios from a tip-in to an hour-long drive cycle (WLTC: 1800 s); a time_ms column read as \
+              seconds gives more, seconds read as milliseconds less",
     },
     PlausibleRange {
         quantity: "radius_m",
@@ -135,6 +143,9 @@ mod tests {
         assert!(density.contains(840.0) && !density.contains(8.4e-292));
         let spacing = range("sample_spacing_s").unwrap();
         assert!(spacing.contains(0.01) && !spacing.contains(10.0), "10 ms logged as 10 s");
+        assert!(!spacing.contains(1.0), "1 kHz logged in milliseconds");
+        let duration = range("scenario_duration_s").unwrap();
+        assert!(duration.contains(30.0) && duration.contains(1800.0) && !duration.contains(30_000.0));
         let angle = range("blade_angle_deg").unwrap();
         assert!(angle.contains(-50.0) && angle.contains(60.0) && !angle.contains(89.999999999));
     }

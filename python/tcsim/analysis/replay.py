@@ -8,7 +8,7 @@ with the measured ones without feedback errors from the rest of a driveline.
 
     tcsim replay CONVERTER MEASUREMENT [--model M ...] [--out DIR] [--drive pump-torque|speeds]
                  [--channel TARGET=COLUMN ...] [--initial NAME=VALUE ...] [--window S]
-                 [--metrics-window S]
+                 [--metrics-window S] [--allow-implausible]
 
 Input channels
 --------------
@@ -19,7 +19,8 @@ unit-suffixed names (``time_s``, ``pump_torque_nm``, ``pump_speed_rad_s``, ``tur
 ``turbine_speed_rpm``, ``pump_torque_knm``, ...; converted), or through an explicit mapping
 ``--channel TARGET=COLUMN`` (repeatable, e.g. ``--channel pump_torque_nm=EngTrq``). MDF4 channel
 units decide the conversion when present. Missing channels, NaN, time going backwards and values
-that look like the wrong unit (a speed column in rpm named ``*_rad_s``) are input errors (exit 2).
+that look like the wrong unit (a speed column in rpm named ``*_rad_s``: the plausibility ranges,
+overridable with ``--allow-implausible``) are input errors (exit 2).
 
 Drives
 ------
@@ -56,8 +57,9 @@ A prescribed speed enters the equations with its derivative (the inertia and sha
 terms). ``--window S`` (default :data:`tcsim.models.drives.DERIVATIVE_WINDOW_S`, 0.04 s) sets the
 smoothing of that derivative: at each sample, the slope of the straight line fitted by least
 squares to all samples within ±S/2 (at least the neighbouring samples; a first-order
-Savitzky–Golay filter on non-uniform samples). ``--window 0`` gives the central difference.
-The *same* local least-squares slope, with the same window, differentiates the measured speeds
+Savitzky–Golay filter on non-uniform samples). ``--window 0`` gives the central difference, as
+does any window shorter than the sample spacing. A window longer than the record's span is refused
+(the default never is). The *same* local least-squares slope, with the same window, differentiates the measured speeds
 for the measured effective torques below (:func:`tcsim.analysis.effective.smoothed_rate`).
 
 Outputs (in DIR, default ``replay``; written all at once, nothing on error)
@@ -74,7 +76,9 @@ Outputs (in DIR, default ``replay``; written all at once, nothing on error)
 * ``metrics.csv`` when the measurement has reference outputs: one row per model × channel × window
   with ``model, channel, window, window_start_s, window_end_s, rmse, nrmse, max_abs_error,
   max_abs_error_time_s, n``. ``window`` is ``all`` for the whole record, else the number of a
-  consecutive window of ``--metrics-window`` seconds (default 1 s; the last one may be shorter).
+  consecutive window of ``--metrics-window`` seconds (default 1 s; the last one may be shorter;
+  windows without a sample are left out). An explicit ``--metrics-window`` shorter than the
+  median sample spacing or longer than the record's span is refused (:func:`check_record_windows`).
   The error is simulated − measured; RMSE = √mean(error²); NRMSE = RMSE / (max − min of the
   measured channel in the window), NaN when that range is zero; ``n`` is the number of samples.
 * Plots (PNG): ``inputs.png`` (the input signals, thesis figures 3.11/3.12); per reference output
@@ -203,6 +207,39 @@ def check_window(option: str, value: float, positive: bool) -> float:
     return float(value)
 
 
+def check_record_windows(meas: Measurement, window_s: float | None, metrics_window_s: float | None) -> None:
+    """Refuse windows the record cannot hold (an :class:`InputError` naming the option):
+
+    * ``--window`` (the derivative window, s) longer than the record's span (a window shorter than
+      the sample spacing is allowed: it uses the neighbouring samples, the central difference);
+    * ``--metrics-window`` (s) shorter than the median sample spacing (windows of one sample or
+      none) or longer than the record's span, unless it is the default
+      :data:`METRICS_WINDOW_S` (a record shorter than that has one window).
+
+    ``None`` is the default derivative window, or no metric windows; both are never refused."""
+    t = meas.time_s
+    span = float(t[-1] - t[0])
+    spacing = float(np.median(np.diff(t)))
+    where = f"the record's span {span:g} s of {meas.source}"
+    slack = 1.0 + 1e-9  # time stamps written in decimal: a window "equal" to the span or the spacing is in
+    if window_s is not None and math.isfinite(window_s) and window_s > span * slack:
+        raise InputError(
+            "command line",
+            "--window",
+            window_s,
+            f"a derivative window from 0 s to {where} (shorter than the sample spacing uses the neighbouring samples)",
+        )
+    if metrics_window_s is None or metrics_window_s == METRICS_WINDOW_S or not math.isfinite(metrics_window_s):
+        return
+    if not (spacing <= metrics_window_s * slack and metrics_window_s <= span * slack):
+        raise InputError(
+            "command line",
+            "--metrics-window",
+            metrics_window_s,
+            f"a metrics window from the median sample spacing {spacing:g} s to {where}",
+        )
+
+
 # ---------------------------------------------------------------------------------------------
 # runs
 
@@ -266,20 +303,45 @@ def _stats(time_s: np.ndarray, measured: np.ndarray, simulated: np.ndarray) -> d
     }
 
 
-def metric_windows(time_s: np.ndarray, window_s: float | None) -> list[tuple[str, float, float, np.ndarray]]:
-    """("all", start, end, mask) then consecutive windows of ``window_s`` from the first sample:
-    [start, start + window_s), the last one closed at the last sample; empty windows left out."""
+def _window_stats(time_s: np.ndarray, measured: np.ndarray, simulated: np.ndarray, starts: np.ndarray) -> pd.DataFrame:
+    """:func:`_stats` of consecutive segments beginning at the indices ``starts`` (the first 0), all
+    at once: O(n) whatever the number of segments."""
+    err = simulated - measured
+    counts = np.diff(np.append(starts, len(err)))
+    rmse = np.sqrt(np.add.reduceat(err * err, starts) / counts)
+    span = np.maximum.reduceat(measured, starts) - np.minimum.reduceat(measured, starts)
+    size = np.abs(err)
+    key = np.where(np.isnan(size), np.inf, size)  # the first NaN is the largest, as for np.argmax
+    segment = np.repeat(np.arange(len(starts)), counts)
+    hits = np.flatnonzero(key == np.maximum.reduceat(key, starts)[segment])
+    first = hits[np.unique(segment[hits], return_index=True)[1]]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        nrmse = np.where(span > 0, rmse / np.where(span > 0, span, 1.0), math.nan)
+    return pd.DataFrame(
+        {
+            "rmse": rmse,
+            "nrmse": nrmse,
+            "max_abs_error": size[first],
+            "max_abs_error_time_s": time_s[first],
+            "n": counts,
+        }
+    )
+
+
+def metric_windows(time_s: np.ndarray, window_s: float | None) -> list[tuple[str, float, float, slice]]:
+    """("all", start, end, samples) then consecutive windows of ``window_s`` from the first sample:
+    [start, start + window_s), the last one closed at the last sample; empty windows left out.
+    ``samples`` is the slice of the samples in the window. O(n) whatever the window."""
     t = np.asarray(time_s, dtype=float)
-    out = [("all", float(t[0]), float(t[-1]), np.ones(len(t), dtype=bool))]
+    out = [("all", float(t[0]), float(t[-1]), slice(0, len(t)))]
     if not window_s or len(t) < 2:
         return out
     count = max(1, math.ceil((t[-1] - t[0]) / window_s - 1e-9))
-    k = np.clip(np.floor((t - t[0]) / window_s + 1e-9).astype(int), 0, count - 1)
-    for w in range(count):
-        mask = k == w
-        if mask.any():
-            start = float(t[0] + w * window_s)
-            out.append((str(w + 1), start, float(min(start + window_s, t[-1])), mask))
+    k = np.clip(np.floor((t - t[0]) / window_s + 1e-9), 0, count - 1).astype(np.int64)
+    starts = np.flatnonzero(np.diff(k, prepend=-1))
+    for lo, hi in zip(starts, np.append(starts[1:], len(t)), strict=True):
+        start = float(t[0] + int(k[lo]) * window_s)
+        out.append((str(int(k[lo]) + 1), start, float(min(start + window_s, t[-1])), slice(int(lo), int(hi))))
     return out
 
 
@@ -291,11 +353,16 @@ def error_metrics(time_s, measured, simulated, window_s: float | None = METRICS_
     t, m, s = (np.asarray(a, dtype=float) for a in (time_s, measured, simulated))
     if not (len(t) == len(m) == len(s)) or len(t) == 0:
         raise ValueError(f"time, measured and simulated need the same non-zero length ({len(t)}, {len(m)}, {len(s)})")
-    rows = [
-        {"window": name, "window_start_s": a, "window_end_s": b, **_stats(t[mask], m[mask], s[mask])}
-        for name, a, b, mask in metric_windows(t, window_s)
-    ]
-    return pd.DataFrame(rows, columns=METRIC_COLUMNS[2:])
+    windows = metric_windows(t, window_s)
+    whole = pd.DataFrame([{"window": "all", "window_start_s": t[0], "window_end_s": t[-1], **_stats(t, m, s)}])
+    if len(windows) == 1:
+        return whole[METRIC_COLUMNS[2:]]
+    names, starts, ends, segments = zip(*windows[1:], strict=True)
+    parts = _window_stats(t, m, s, np.array([seg.start for seg in segments]))
+    parts.insert(0, "window", list(names))
+    parts.insert(1, "window_start_s", list(starts))
+    parts.insert(2, "window_end_s", list(ends))
+    return pd.concat([whole, parts], ignore_index=True)[METRIC_COLUMNS[2:]]
 
 
 def metrics_table(
@@ -362,12 +429,14 @@ def replay_measurement(
     models: Sequence[str] = (),
     kind: DriveKind = DRIVES["pump-torque"],
     initial: dict[str, float] | None = None,
-    window_s: float = DERIVATIVE_WINDOW_S,
+    window_s: float | None = None,
     metrics_window_s: float | None = METRICS_WINDOW_S,
 ) -> Replay:
     """Run the replay of a measurement read with the channels of ``kind`` (no files): simulate every
-    model, measure the errors."""
-    window_s = check_window("--window", window_s, positive=False)
+    model, measure the errors. ``window_s`` (s) defaults to :data:`DERIVATIVE_WINDOW_S`; both
+    windows are checked against the record (:func:`check_record_windows`)."""
+    check_record_windows(meas, window_s, metrics_window_s)
+    window_s = DERIVATIVE_WINDOW_S if window_s is None else check_window("--window", window_s, positive=False)
     if metrics_window_s is not None:
         metrics_window_s = check_window("--metrics-window", metrics_window_s, positive=True)
     dyn = select_models(conv, models)

@@ -12,7 +12,7 @@ from typing import Annotated, Any
 
 import typer
 
-from .app import ChannelOpt, ModelOpt, OutOpt, say
+from .app import AllowImplausibleOpt, ChannelOpt, ModelOpt, OutOpt, say
 
 #: The command's ``--help`` text.
 HELP = "Fit the pump and turbine shape effects to a transient measurement; sweep plots like thesis figs 4.1–4.2."
@@ -27,6 +27,7 @@ def shape_fit_command(
     channels: Sequence[str] = (),
     drive: str = "pump-torque",
     equal: bool = False,
+    allow_implausible: bool = False,
 ) -> str:
     """Fit the shape effects of ``converter``'s ``model`` to ``measurement``.
 
@@ -34,7 +35,8 @@ def shape_fit_command(
     ``speeds`` (b): time_s, pump_speed_rad_s, turbine_speed_rad_s. The target needs
     turbine_torque_nm (and pump_torque_nm, pump_speed_rad_s for the effective TR). Writes
     DIR/shape_fit.json, DIR/shape_fit.md, DIR/shape_sweep.csv and the sweep plots (with the fitted
-    pair), all or nothing. Returns a one-line summary.
+    pair), all or nothing. Returns a one-line summary. Measured values outside the plausibility
+    ranges are refused unless ``allow_implausible``.
     """
     from ..analysis import shape_fit as sf
     from ..analysis.effective import measured_effective_torques
@@ -58,6 +60,7 @@ def shape_fit_command(
         parse_channel_map(channels),
         required=sf.required_channels(target, drive),
         optional=("pump_speed_rad_s", "pump_torque_nm"),
+        allow_implausible=allow_implausible,
     )
     inputs = [converter, measurement, conv.path, meas.source]
     check_output_dir(out, inputs)
@@ -99,6 +102,7 @@ def fit_shapes(
     channel: ChannelOpt = None,
     drive: Annotated[str, typer.Option("--drive", help="pump-torque | speeds")] = "pump-torque",
     equal: Annotated[bool, typer.Option("--equal", help="fit one shape effect, S_p = S_t")] = False,
+    allow_implausible: AllowImplausibleOpt = False,
 ) -> None:
     """The command; its help is :data:`HELP`."""
-    say(shape_fit_command(converter, measurement, out, model, target, channel or [], drive, equal))
+    say(shape_fit_command(converter, measurement, out, model, target, channel or [], drive, equal, allow_implausible))

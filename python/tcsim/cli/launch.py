@@ -65,7 +65,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .app import ModelsOpt, OutOpt, stdout
+from .app import AllowImplausibleOpt, ModelsOpt, OutOpt, stdout
 
 if TYPE_CHECKING:
     from ..analysis.launch import Launch
@@ -87,10 +87,13 @@ def launch_files(
     threads: int = 0,
     options: dict[str, Any] | None = None,
     progress: bool = False,
+    allow_implausible: bool = False,
 ) -> Launch:
     """Run the launch (no files written): the vehicle (bundled name, file or :class:`Vehicle`), the
     scenario (``flip-flop``, ``part-pedal``, a file or a :class:`Scenario`), every model, then the
-    optional shape-effect sweep; ``progress`` shows a progress display on a terminal."""
+    optional shape-effect sweep; ``progress`` shows a progress display on a terminal. A scenario
+    file's implausible values (:func:`tcsim.io.scenario.read_scenario`) are refused unless
+    ``allow_implausible``."""
     from ..analysis.launch import run_comparison
     from ..io.scenario import scenario_from_option
     from ..models.vehicle import Vehicle, load_vehicle
@@ -98,7 +101,7 @@ def launch_files(
     from ..simulation.scenarios import Scenario
 
     veh = vehicle if isinstance(vehicle, Vehicle) else load_vehicle(vehicle)
-    scen = scenario if isinstance(scenario, Scenario) else scenario_from_option(scenario)
+    scen = scenario if isinstance(scenario, Scenario) else scenario_from_option(scenario, allow_implausible)
     with progress_display(progress) as display:
         task = display.add_task("launch", total=None)
         return run_comparison(
@@ -137,6 +140,7 @@ def launch(
             "--sweep-shape-effects", help="also sweep S_p = S_t of the dynamic models (like thesis figs 4.3–4.6)"
         ),
     ] = False,
+    allow_implausible: AllowImplausibleOpt = False,
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..io.outputs import check_output_dir, output_dir
@@ -144,7 +148,9 @@ def launch(
     from ..reports.format import rich_text
 
     check_output_dir(out, [p for p in (vehicle, scenario) if p])
-    result = launch_files(vehicle, scenario, model or [], sweep_shape_effects, progress=True)
+    result = launch_files(
+        vehicle, scenario, model or [], sweep_shape_effects, progress=True, allow_implausible=allow_implausible
+    )
     inputs = [p for p in (vehicle, scenario, result.vehicle.path, result.vehicle.converter.path) if p]
     with output_dir(out, inputs) as stage, progress_display(True) as display:
         display.add_task(rich_text(f"writing {out}/ (files and plots)"), total=None)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .app import ChannelOpt, ModelsOpt, OutOpt, stdout
+from .app import AllowImplausibleOpt, ChannelOpt, ModelsOpt, OutOpt, stdout
 
 if TYPE_CHECKING:
     from ..analysis.replay import Replay
@@ -27,24 +27,29 @@ def replay_files(
     initial: dict[str, float] | None = None,
     window_s: float | None = None,
     metrics_window_s: float | None = 1.0,
+    allow_implausible: bool = False,
 ) -> Replay:
     """Run the replay (no files written): read the converter (a :class:`~tcsim.models.converter.
     Converter`, bundled name or file) and the measurement, simulate every model, measure the errors.
-    ``window_s`` defaults to :data:`tcsim.models.drives.DERIVATIVE_WINDOW_S`."""
+    ``window_s`` (s) defaults to :data:`tcsim.models.drives.DERIVATIVE_WINDOW_S`; it may not exceed
+    the record's span, nor ``metrics_window_s`` (s; ``None``: the whole record only) unless it is
+    the default 1 s, and ``metrics_window_s`` may not be shorter than the median sample spacing.
+    Measured values outside the plausibility ranges are refused unless ``allow_implausible``."""
     from ..analysis.replay import check_window, drive_kind, replay_measurement
     from ..io.measurement import read_measurement
     from ..models.converter import load_converter
-    from ..models.drives import DERIVATIVE_WINDOW_S
     from ..models.dynamic import select_models
 
-    window_s = DERIVATIVE_WINDOW_S if window_s is None else window_s
     kind = drive_kind(drive)
-    check_window("--window", window_s, positive=False)
+    if window_s is not None:
+        check_window("--window", window_s, positive=False)
     if metrics_window_s is not None:
         check_window("--metrics-window", metrics_window_s, positive=True)
     conv = converter if not isinstance(converter, (str, Path)) else load_converter(converter)
     select_models(conv, models)  # a bad --model is reported before the measurement is read
-    meas = read_measurement(measurement, channels, required=kind.inputs, optional=kind.outputs)
+    meas = read_measurement(
+        measurement, channels, required=kind.inputs, optional=kind.outputs, allow_implausible=allow_implausible
+    )
     return replay_measurement(conv, meas, models, kind, initial, window_s, metrics_window_s)
 
 
@@ -79,12 +84,19 @@ def replay(
     window: Annotated[
         float | None,
         typer.Option(
-            "--window", help="derivative smoothing window S, s: local least-squares slope over ±S/2 [default: 0.04]"
+            "--window",
+            help="derivative smoothing window S, s: local least-squares slope over ±S/2, at most the record's span "
+            "[default: 0.04]",
         ),
     ] = None,
     metrics_window: Annotated[
-        float, typer.Option("--metrics-window", help="width of the consecutive metric windows, s")
+        float,
+        typer.Option(
+            "--metrics-window",
+            help="width of the consecutive metric windows, s: from the median sample spacing to the record's span",
+        ),
     ] = 1.0,
+    allow_implausible: AllowImplausibleOpt = False,
 ) -> None:
     """Isolated converter driven by measured signals: DIR/<model>.csv, events, metrics, plots."""
     from ..analysis.replay import parse_initial
@@ -102,6 +114,7 @@ def replay(
         parse_initial(initial or []),
         window,
         metrics_window,
+        allow_implausible,
     )
     inputs = [converter, measurement, result.measurement.source]
     with output_dir(out, inputs) as stage:

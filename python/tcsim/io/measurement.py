@@ -12,24 +12,33 @@ A unit in the file's metadata (MDF4 channels carry one) decides the conversion w
 unconvertible unit is an error. Without one, a mapped column's own unit suffix is used if it has
 one of the target's quantity, otherwise the values are taken as SI.
 
-Everything the user can get wrong (a missing channel, NaN, time going backwards, values that look
-like the wrong unit, a corrupt file) is an :class:`~tcsim.errors.InputError` naming the file, the
-column, the value and what was expected; the first problem found wins.
+Everything the user can get wrong (a missing channel, NaN, time going backwards, a column name
+that appears twice, a cell that holds no real number, an MDF channel that does not cover the
+record, values that look like the wrong unit, a corrupt file) is an
+:class:`~tcsim.errors.InputError` naming the file, the column, the value and what was expected; the
+first problem found wins. The wrong-unit checks use the core's plausibility ranges
+(``speed_rad_s``, ``torque_nm``, ``sample_spacing_s`` for the median time step:
+:mod:`tcsim.models.plausibility`) and are overridable (``allow_implausible``); a record spanning
+more than :data:`MAX_TIME_SPAN_S` is always refused.
 """
 
 from __future__ import annotations
 
 import contextlib
+import gc
 import math
+import sys
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TypeVar
 
 import numpy as np
 import pandas as pd
 
 from ..errors import InputError
 from ..models.measurement import Measurement
+from ..models.plausibility import check_plausible
 from ..units import LBF_FT_IN_NM, RAD_S_PER_RPM
 
 #: Name suffix -> factor to SI, per quantity; the first suffix of each is the SI one.
@@ -69,13 +78,9 @@ _QUANTITY: dict[str, str] = {
 
 INPUT_CHANNELS: tuple[str, ...] = tuple(_QUANTITY)
 
-#: |value| in SI above which a channel's unit is probably wrong, and what to say then.
-_PLAUSIBLE_MAX = {"speed": 1500.0, "torque": 20_000.0}
-_IMPLAUSIBLE = {
-    "speed": "a speed in rad/s (values look like rpm; name the column *_rpm or map it with --channel)",
-    "torque": "a torque in N·m below 20 000 N·m (values look like another unit, e.g. N·mm; "
-    "check the column's unit or map it with --channel)",
-}
+#: Quantity -> its plausibility range (``tcsim.models.plausibility``, owned by the core).
+_RANGE_OF = {"speed": "speed_rad_s", "torque": "torque_nm"}
+#: The longest record, s: a longer one is almost surely milliseconds read as seconds.
 MAX_TIME_SPAN_S = 1e6
 
 _MDF_TIME = "time_s"  # the virtual column holding an MDF file's time base
@@ -171,7 +176,9 @@ class _Picker:
     def __call__(self, names: Sequence[str]) -> list[str]:
         picks = (self._pick(canonical, names) for canonical in self.wanted)
         self.picks = [p for p in picks if p is not None]
-        return list(dict.fromkeys(p.column for p in self.picks))
+        columns = list(dict.fromkeys(p.column for p in self.picks))
+        refuse_duplicates(self.path, names, columns)
+        return columns
 
     def _pick(self, canonical: str, names: Sequence[str]) -> _Pick | None:
         quantity = _QUANTITY[canonical]
@@ -206,69 +213,147 @@ class _Picker:
 
 _Loaded = tuple[dict[str, np.ndarray], dict[str, str]]
 _Chooser = Callable[[Sequence[str]], list[str]]
+_T = TypeVar("_T")
 
 
-@contextlib.contextmanager
-def _reading(path: Path, what: str) -> Iterator[None]:
-    """Turn any failure of a third-party reader into an InputError naming the file."""
+def _guarded(path: Path, what: str, read: Callable[[], _T]) -> _T:
+    """``read()``, with any failure of a third-party reader turned into an InputError naming the
+    file. The InputError is raised once the library's exception is gone (it is not chained to it),
+    so that the objects its frames held are cleaned up before the message is printed."""
     try:
-        yield
+        return read()
     except InputError:
         raise
     except Exception as e:  # noqa: BLE001 - a corrupt file can fail in any way inside a library
-        raise InputError(str(path), "(file)", f"{type(e).__name__}: {e}", f"a readable {what} file") from None
+        failure = f"{type(e).__name__}: {e}"
+    gc.collect()
+    raise InputError(str(path), "(file)", failure, f"a readable {what} file")
+
+
+@contextlib.contextmanager
+def _quiet_mdf_cleanup() -> Iterator[None]:
+    """asammdf's ``MDF4.__del__`` fails on an object whose constructor failed (a corrupt file): the
+    interpreter would print that failure as "Exception ignored ..." with a traceback after tcsim's
+    message. Silence exactly those (objects of asammdf) while an MDF file is read."""
+    previous = sys.unraisablehook
+
+    def hook(unraisable) -> None:
+        where = unraisable.object  # the failing __del__ method, or the object
+        module = getattr(where, "__module__", None) or type(where).__module__
+        if not str(module).startswith("asammdf"):
+            previous(unraisable)
+
+    sys.unraisablehook = hook
+    try:
+        yield
+    finally:
+        gc.collect()
+        sys.unraisablehook = previous
+
+
+def refuse_duplicates(path: Path, names: Sequence[str], columns: Sequence[str] | None = None) -> None:
+    """An InputError naming the first column name that appears more than once in ``names`` (among
+    ``columns`` only, when given): a duplicated header makes it ambiguous which column is meant."""
+    seen: set[str] = set()
+    for name in names:
+        if name in seen and (columns is None or name in columns):
+            count = sum(n == name for n in names)
+            raise InputError(str(path), name, f"{count} columns", "each column name at most once in the file")
+        seen.add(name)
+
+
+def read_csv_frame(path: Path, what: str = "CSV") -> pd.DataFrame:
+    """A CSV file as a DataFrame: ``#`` comments, a UTF-8 byte-order mark and blanks after the
+    commas allowed, the header's names stripped; an InputError for an empty or unreadable file and
+    for a column name that appears twice (pandas would rename the second one silently)."""
+    options: dict = {"comment": "#", "skipinitialspace": True, "encoding": "utf-8-sig"}
+
+    def read() -> tuple[pd.DataFrame, pd.DataFrame]:
+        try:
+            header = pd.read_csv(path, header=None, nrows=1, dtype=str, keep_default_na=False, **options)
+            return pd.read_csv(path, **options), header
+        except pd.errors.EmptyDataError:
+            raise InputError(str(path), "(file)", "empty", "a header line and at least two data rows") from None
+
+    frame, header = _guarded(path, what, read)
+    # an empty name gets pandas' own (``Unnamed: 3``), which --channel can map
+    names = [str(c).strip() or f"Unnamed: {i}" for i, c in enumerate(header.iloc[0])]
+    refuse_duplicates(path, names)
+    frame.columns = names
+    return frame
 
 
 def _read_csv(path: Path, pick: _Chooser) -> _Loaded:
-    with _reading(path, "CSV"):
-        try:
-            frame = pd.read_csv(path, comment="#", skipinitialspace=True, encoding="utf-8-sig")
-        except pd.errors.EmptyDataError:
-            raise InputError(str(path), "(file)", "empty", "a header line and at least two data rows") from None
-    frame.columns = [str(c).strip() for c in frame.columns]
+    frame = read_csv_frame(path)
     return {c: frame[c].to_numpy() for c in pick(list(frame.columns))}, {}
 
 
 def _read_parquet(path: Path, pick: _Chooser) -> _Loaded:
     import pyarrow.parquet as pq  # noqa: PLC0415  lazy: start-up time
 
-    with _reading(path, "Parquet"):
-        columns = pick(pq.read_schema(path).names)
-        frame = pq.read_table(path, columns=columns).to_pandas()
-    return {c: frame[c].to_numpy() for c in columns}, {}
+    names = _guarded(path, "Parquet", lambda: pq.read_schema(path).names)
+    refuse_duplicates(path, names)
+    columns = pick(names)
+    table = _guarded(path, "Parquet", lambda: pq.read_table(path, columns=columns))
+    # a column of lists or structs becomes an object array, refused by check_numeric
+    return {c: _guarded(path, "Parquet", table.column(c).to_numpy) for c in columns}, {}
 
 
 def _is_vector(shape: tuple[int, ...], dtype: np.dtype) -> bool:
-    """A MATLAB variable tcsim reads: numeric, with at most one dimension longer than 1."""
-    return dtype.kind in "iuf" and sum(n > 1 for n in shape) <= 1
+    """A MATLAB variable tcsim reads: numeric (complex ones too, refused by :func:`check_numeric`
+    with their own message), with at most one dimension longer than 1."""
+    return (dtype.kind in "iufc" or _is_complex_compound(dtype)) and sum(n > 1 for n in shape) <= 1
+
+
+def _is_complex_compound(dtype: np.dtype) -> bool:
+    """How MATLAB v7.3 (HDF5) stores a complex variable: a compound of ``real`` and ``imag``."""
+    return dtype.names is not None and set(dtype.names) == {"real", "imag"}
 
 
 def _read_mat_v5(path: Path, pick: _Chooser) -> _Loaded:
     import scipy.io  # noqa: PLC0415  lazy: start-up time
 
-    with _reading(path, "MATLAB .mat"):
-        variables = scipy.io.loadmat(path)
-    vectors = {
-        k: v
-        for k, v in variables.items()
-        if not k.startswith("__") and isinstance(v, np.ndarray) and _is_vector(v.shape, v.dtype)
-    }
-    return {c: vectors[c].ravel() for c in pick(list(vectors))}, {}
+    variables = _guarded(path, "MATLAB .mat", lambda: scipy.io.loadmat(path))
+    variables = {k: v for k, v in variables.items() if not k.startswith("__")}
+    columns = pick(list(variables))
+    for c in columns:
+        _require_vector(path, c, variables[c])
+    return {c: variables[c].ravel() for c in columns}, {}
+
+
+def _require_vector(path: Path, name: str, value: object) -> None:
+    """An InputError unless the MATLAB variable ``name`` is a numeric vector (its shape and kind
+    named: a matrix, a struct, a cell array, text)."""
+    shape = getattr(value, "shape", ())
+    dtype = getattr(value, "dtype", np.dtype(object))
+    if isinstance(value, np.ndarray) and _is_vector(shape, dtype):
+        return
+    kind = {"O": "cell array", "V": "struct", "U": "char array", "S": "char array"}.get(dtype.kind, "matrix")
+    size = "x".join(str(n) for n in shape) or "scalar"
+    raise InputError(str(path), name, f"a {size} {kind}", "a numeric vector (one row or one column)")
 
 
 def _read_mat_v73(path: Path, pick: _Chooser) -> _Loaded:
     """MATLAB v7.3 is HDF5: one dataset per variable, (1, N) or (N, 1); char and logical left out."""
     import h5py  # noqa: PLC0415  lazy: start-up time
 
-    with _reading(path, "MATLAB v7.3 (HDF5) .mat"), h5py.File(path, "r") as f:
-        datasets = {
-            k: v
-            for k, v in f.items()
-            if isinstance(v, h5py.Dataset)
-            and _is_vector(v.shape, v.dtype)
-            and v.attrs.get("MATLAB_class", b"double") not in (b"char", b"logical")
-        }
-        return {c: np.asarray(datasets[c][()]).ravel() for c in pick(list(datasets))}, {}
+    def read() -> dict[str, np.ndarray]:
+        with h5py.File(path, "r") as f:
+            datasets = {k: v for k, v in f.items() if isinstance(v, h5py.Dataset)}
+            columns = pick(list(datasets))
+            for c in columns:
+                matlab_class = datasets[c].attrs.get("MATLAB_class", b"double")
+                if matlab_class in (b"char", b"logical", b"cell", b"struct"):
+                    kind = matlab_class.decode()
+                    shape = "x".join(str(n) for n in datasets[c].shape)
+                    raise InputError(
+                        str(path), c, f"a {shape} {kind} array", "a numeric vector (one row or one column)"
+                    )
+                _require_vector(path, c, np.empty(datasets[c].shape, datasets[c].dtype))
+            return {c: np.asarray(datasets[c][()]).ravel() for c in columns}
+
+    loaded = _guarded(path, "MATLAB v7.3 (HDF5) .mat", read)
+    return {c: v["real"] + 1j * v["imag"] if _is_complex_compound(v.dtype) else v for c, v in loaded.items()}, {}
 
 
 def _read_mat(path: Path, pick: _Chooser) -> _Loaded:
@@ -280,25 +365,69 @@ def _read_mat(path: Path, pick: _Chooser) -> _Loaded:
 
 def _read_mdf(path: Path, pick: _Chooser) -> _Loaded:
     """ASAM MDF: the first picked data channel's timestamps are the time base (``time_s``), the
-    other channels are linearly interpolated onto it; units come from the channel metadata."""
+    other channels are linearly interpolated onto it; units come from the channel metadata. Every
+    picked channel must cover the time span of the others (:func:`_check_coverage`)."""
     from asammdf import MDF  # noqa: PLC0415  lazy: start-up time
 
-    with _reading(path, "ASAM MDF"), MDF(path) as mdf:
-        first = {}  # channel name -> (group, index) of its first occurrence, masters left out
-        for name, occurrences in mdf.channels_db.items():
-            data = [(g, i) for g, i in occurrences if mdf.masters_db.get(g) != i]
-            if data:
-                first[name] = data[0]
-        virtual_time = _MDF_TIME not in first
-        columns = pick([*first, _MDF_TIME] if virtual_time else list(first))
-        signals = {c: mdf.get(group=first[c][0], index=first[c][1]) for c in columns if c in first}
+    def read() -> tuple[dict, list[str], bool]:
+        with MDF(path) as mdf:
+            found = {}  # channel name -> its (group, index) occurrences, masters left out
+            for name, occurrences in mdf.channels_db.items():
+                data = [(g, i) for g, i in occurrences if mdf.masters_db.get(g) != i]
+                if data:
+                    found[name] = data
+            virtual_time = _MDF_TIME not in found
+            columns = pick([*found, _MDF_TIME] if virtual_time else list(found))
+            signals = {c: _one_mdf_signal(path, mdf, c, found[c]) for c in columns if c in found}
+            return signals, columns, virtual_time
+
+    with _quiet_mdf_cleanup():
+        signals, columns, virtual_time = _guarded(path, "ASAM MDF", read)
     if not signals:
         raise InputError(str(path), "(file)", "no data channel picked", "at least one measured channel")
+    _check_coverage(path, {c: np.asarray(s.timestamps, dtype=float) for c, s in signals.items()})
     base = np.asarray(next(iter(signals.values())).timestamps)
     out = {c: _resample(s.samples, s.timestamps, base) for c, s in signals.items()}
     if virtual_time and _MDF_TIME in columns:
         out[_MDF_TIME] = base
     return out, {c: str(s.unit or "") for c, s in signals.items()}
+
+
+def _one_mdf_signal(path: Path, mdf, name: str, occurrences: Sequence[tuple[int, int]]):
+    """The channel ``name``: its first occurrence, and an InputError if another channel group holds
+    a channel of that name with other samples (which one is meant would be a guess)."""
+    signal = mdf.get(group=occurrences[0][0], index=occurrences[0][1])
+    for group, index in occurrences[1:]:
+        other = mdf.get(group=group, index=index)
+        same = np.array_equal(other.timestamps, signal.timestamps) and np.array_equal(other.samples, signal.samples)
+        if not same:
+            raise InputError(
+                str(path),
+                name,
+                f"{len(occurrences)} channels (groups {', '.join(str(g) for g, _ in occurrences)})",
+                "each channel name at most once in the file, or in several channel groups with the same samples",
+            )
+    return signal
+
+
+def _check_coverage(path: Path, timestamps: Mapping[str, np.ndarray]) -> None:
+    """Refuse a channel whose samples do not span the record (the span of all the picked channels)
+    within one sample step (the largest median step of the channels): it would be held constant
+    before its first sample or after its last."""
+    spans = {c: (float(t[0]), float(t[-1])) for c, t in timestamps.items() if len(t) >= 2}
+    if len(spans) < 2:
+        return
+    start, end = min(a for a, _ in spans.values()), max(b for _, b in spans.values())
+    step = max(float(np.median(np.diff(timestamps[c]))) for c in spans)
+    for column, (a, b) in spans.items():
+        if a > start + step or b < end - step:
+            raise InputError(
+                str(path),
+                column,
+                f"samples from {a:g} s to {b:g} s",
+                f"a channel covering the record, {start:g} s to {end:g} s, within one sample step "
+                f"({step:g} s); a channel is not held beyond its samples",
+            )
 
 
 def _resample(samples: np.ndarray, timestamps: np.ndarray, base: np.ndarray) -> np.ndarray:
@@ -340,12 +469,25 @@ def _at(row: int, time_s: np.ndarray | None) -> str:
 
 
 def check_numeric(path: Path, column: str, values: np.ndarray, time_s: np.ndarray | None) -> np.ndarray:
-    """``values`` as float64, or an InputError naming the first value that is not a number."""
+    """``values`` as float64, or an InputError naming the first value that is not a real number
+    (text, a boolean, a date, a list or a structure of a Parquet column, a complex number)."""
     if values.dtype.kind in "iuf":
         return values.astype(np.float64)
+    if values.dtype.kind == "c":
+        bad = np.flatnonzero(values.imag != 0)
+        if not len(bad):
+            return values.real.astype(np.float64)
+        row = int(bad[0])
+        raise InputError(str(path), column, f"{values[row]} at {_at(row, time_s)}", "real numbers, not complex values")
     row = 0  # booleans, dates, ...
     if values.dtype.kind in "OUS":
         series = pd.Series(values)
+        objects = values if values.dtype.kind == "O" else ()
+        nested = np.flatnonzero([not np.isscalar(v) and v is not None for v in objects])
+        if len(nested):
+            row = int(nested[0])
+            value = values[row].tolist() if isinstance(values[row], np.ndarray) else values[row]
+            raise InputError(str(path), column, f"{value!r} at {_at(row, time_s)}", "numbers only, one per row")
         parsed = pd.to_numeric(series, errors="coerce")
         bad = np.flatnonzero(parsed.isna() & series.notna())
         if not len(bad):
@@ -378,9 +520,17 @@ def check_increasing(path: Path, column: str, time: np.ndarray) -> None:
 
 
 def _plausible(
-    path: Path, column: str, canonical: str, values_si: np.ndarray, converted: bool, time_s: np.ndarray | None
+    path: Path,
+    column: str,
+    canonical: str,
+    values_si: np.ndarray,
+    time_s: np.ndarray | None,
+    allow_implausible: bool,
 ) -> None:
-    """Values that suggest the wrong unit: a time span over 1e6 s, speeds or torques far too large."""
+    """Values that suggest the wrong unit: a time span over :data:`MAX_TIME_SPAN_S` or a median
+    time step outside ``sample_spacing_s`` (milliseconds read as seconds), speeds outside
+    ``speed_rad_s`` (rpm read as rad/s), torques outside ``torque_nm``: the core's plausibility
+    ranges, overridable with ``allow_implausible`` (``--allow-implausible``)."""
     quantity = _QUANTITY[canonical]
     if quantity == "time":
         span = values_si[-1] - values_si[0]
@@ -392,17 +542,14 @@ def _plausible(
                 f"time in seconds (a span under {MAX_TIME_SPAN_S:g} s; name the column time_ms "
                 "or map it with --channel)",
             )
+        step = float(np.median(np.diff(values_si)))
+        check_plausible("sample_spacing_s", step, str(path), f"{column} (median time step, s)", allow_implausible)
         return
-    limit = _PLAUSIBLE_MAX.get(quantity)
-    row = int(np.argmax(np.abs(values_si)))
-    if limit is not None and abs(values_si[row]) > limit:
-        si_unit = "rad/s" if quantity == "speed" else "N·m"
-        expected = (
-            f"|{canonical}| at most {limit:g} {si_unit} after conversion (check the column's unit)"
-            if converted
-            else _IMPLAUSIBLE[quantity]
-        )
-        raise InputError(str(path), column, f"{values_si[row]:g} {si_unit} at {_at(row, time_s)}", expected)
+    if quantity not in _RANGE_OF:
+        return
+    check_plausible(
+        _RANGE_OF[quantity], values_si, str(path), column, allow_implausible, locate=lambda row: _at(row, time_s)
+    )
 
 
 # --------------------------------------------------------------------------------------------
@@ -413,12 +560,15 @@ def read_measurement(
     channels: Mapping[str, str] | None = None,
     required: Sequence[str] = ("pump_torque_nm", "turbine_speed_rad_s"),
     optional: Sequence[str] = ("pump_speed_rad_s", "turbine_torque_nm"),
+    allow_implausible: bool = False,
 ) -> Measurement:
     """Read a measured time series (CSV, Parquet, .mat v5/v7.3, MDF4) into SI channels.
 
     ``channels`` maps canonical names to columns of the file (see :func:`parse_channel_map`);
     ``required`` channels must be found, ``optional`` ones are left out when absent. Raises
-    :class:`InputError` for anything wrong with the file, the first problem found.
+    :class:`InputError` for anything wrong with the file, the first problem found; values outside
+    the plausibility ranges (speeds, torques, the median time step) are refused unless
+    ``allow_implausible`` (then a warning).
     """
     channels = dict(channels or {})
     for name in [*required, *optional]:
@@ -450,7 +600,7 @@ def read_measurement(
         factor = _unit_factor(path, p.column, unit, p.canonical) if unit else p.name_factor
         if factor != 1.0:
             values = values * factor
-        _plausible(path, p.column, p.canonical, values, factor != 1.0, time_s)
+        _plausible(path, p.column, p.canonical, values, time_s, allow_implausible)
         out[p.canonical] = values
     time_s = out.pop("time_s")
     return Measurement(str(path), time_s, out)

@@ -9,8 +9,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import InputError
+from ..models.plausibility import check_plausible
 from ..simulation.scenarios import Scenario, brake_release_time, flip_flop, part_pedal
-from .measurement import check_finite, check_increasing, check_numeric, reader_for
+from .measurement import check_finite, check_increasing, check_numeric, reader_for, refuse_duplicates
 
 _PEDALS = ("accelerator_pedal", "brake_pedal")
 _TIME_COLUMNS = {"time_s": 1.0, "time_ms": 1e-3}
@@ -58,10 +59,14 @@ class _ScenarioPicker:
             self._one(pedal, _pedal_columns(pedal), names)
         if "engine_torque_nm" in names:  # optional: a logged engine torque to replay
             self.picks["engine_torque_nm"] = ("engine_torque_nm", 1.0)
-        return list(dict.fromkeys(c for c, _ in self.picks.values()))
+        columns = list(dict.fromkeys(c for c, _ in self.picks.values()))
+        refuse_duplicates(self.path, names, columns)
+        return columns
 
 
-def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float | None = None) -> Scenario:
+def read_scenario(
+    path, stop_speed_m_s: float | None = None, end_time_s: float | None = None, allow_implausible: bool = False
+) -> Scenario:
     """A user scenario from a CSV, Parquet, ``.mat`` or MDF4 file (the formats of
     :func:`tcsim.measurement.read_measurement`): ``time_s`` (or ``time_ms``), ``accelerator_pedal``
     and ``brake_pedal`` from 0 to 1 (or ``*_percent`` from 0 to 100; MDF4 ``%`` units are read),
@@ -70,7 +75,12 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
     Time strictly increasing, no NaN, pedals within range; each problem an InputError naming the
     file, the column, the row and the value. Runs to ``end_time_s`` (default the last time stamp)
     or ``stop_speed_m_s``; the brake release time is :func:`brake_release_time`. Times are
-    shifted so that the first sample is time 0 (runs start at time 0, braked and at rest)."""
+    shifted so that the first sample is time 0 (runs start at time 0, braked and at rest).
+
+    Plausibility (refused unless ``allow_implausible``, then a warning): the time span against
+    ``scenario_duration_s`` (a ``time_ms`` column read as seconds spans a thousand times too long;
+    the rows of a pedal scenario may be far apart, so their spacing is not checked) and a logged
+    engine torque against ``torque_nm``."""
     path = Path(path)
     reader = reader_for(path, "scenario")
     picker = _ScenarioPicker(path)
@@ -93,6 +103,7 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
         unit_factor = _unit_scale(path, column, units.get(column, ""), canonical == "time_s")
         scale = unit_factor if unit_factor is not None else factor
         if canonical == "engine_torque_nm":
+            check_plausible("torque_nm", values, str(path), column, allow_implausible, _locate(time_s))
             out[canonical] = values
             continue
         if canonical != "time_s":
@@ -111,6 +122,8 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
         out[canonical] = values
         if canonical == "time_s":
             time_s = values
+            span = f"{column} (time span, s)"
+            check_plausible("scenario_duration_s", values[-1] - values[0], str(path), span, allow_implausible)
     t = out["time_s"] - out["time_s"][0]
     end = float(t[-1]) if end_time_s is None else end_time_s
     release = brake_release_time(t, out["brake_pedal"])
@@ -127,8 +140,13 @@ def read_scenario(path, stop_speed_m_s: float | None = None, end_time_s: float |
     )
 
 
-def scenario_from_option(value: str) -> Scenario:
-    """``--scenario``: ``flip-flop``, ``part-pedal`` or a scenario file."""
+def _locate(time_s: np.ndarray | None):
+    return lambda row: f"row {row + 1}" + (f" (time_s {time_s[row]:g})" if time_s is not None else "")
+
+
+def scenario_from_option(value: str, allow_implausible: bool = False) -> Scenario:
+    """``--scenario``: ``flip-flop``, ``part-pedal`` or a scenario file (its implausible values
+    refused unless ``allow_implausible``: :func:`read_scenario`)."""
     if value == "flip-flop":
         return flip_flop()
     if value == "part-pedal":
@@ -140,4 +158,4 @@ def scenario_from_option(value: str) -> Scenario:
             value,
             "flip-flop, part-pedal, or an existing scenario file (.csv, .parquet, .mat, .mf4/.mdf)",
         )
-    return read_scenario(value)
+    return read_scenario(value, allow_implausible=allow_implausible)

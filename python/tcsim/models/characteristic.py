@@ -87,6 +87,15 @@ class Characteristic:
                     source, name(col, int(bad[0])), float(v[bad[0]]), "a positive value in drive (speed ratio below 1)"
                 )
         cf = np.asarray(_core.capacity_to_cf(convention, np.ascontiguousarray(cap)))
+        bad = np.flatnonzero(~np.isfinite(cf) | (drive & (cf <= 0)))
+        if bad.size:  # the file's value overflows (or underflows) on conversion: name it as written
+            i = int(bad[0])
+            raise InputError(
+                source,
+                name(convention, i),
+                float(cap[i]),
+                f"a {convention} whose capacity factor is a finite positive number (it converts to {cf[i]:g} N·m·s²)",
+            )
         try:
             _core.table_check(sr, tr, cf)
         except _core.CoreInputError as e:  # pragma: no cover - the checks above come first

@@ -257,7 +257,7 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
 
 def read_converter_toml(path: Path) -> Converter:
     try:
-        text = path.read_text(encoding="utf-8")
+        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark is skipped, as in the CSV readers
     except (OSError, UnicodeDecodeError) as e:
         raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
     try:

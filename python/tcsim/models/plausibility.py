@@ -15,12 +15,13 @@ say. ``docs/guarantees.md`` lists the ranges.
 from __future__ import annotations
 
 import warnings
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
 from .. import _core
-from ..errors import InputError, TcsimWarning
+from ..errors import CoreText, InputError, TcsimWarning
 
 #: The command-line option that turns a refusal of :func:`check_plausible` into a warning.
 OVERRIDE_OPTION = "--allow-implausible"
@@ -46,28 +47,37 @@ class PlausibleRange:
 RANGES: dict[str, PlausibleRange] = {r[0]: PlausibleRange(*r) for r in _core.plausibility_ranges()}
 
 
-def _first_outside(quantity: str, values: object) -> tuple[PlausibleRange, float | None]:
+def _first_outside(quantity: str, values: object) -> tuple[PlausibleRange, float | None, int]:
     rng = RANGES[quantity]
     v = np.atleast_1d(np.asarray(values, dtype=float))
     outside = np.flatnonzero(np.isfinite(v) & ((v < rng.low) | (v > rng.high)))
-    return rng, (float(v[outside[0]]) if len(outside) else None)
+    return rng, (float(v[outside[0]]) if len(outside) else None), (int(outside[0]) if len(outside) else -1)
 
 
-def check_plausible(quantity: str, values: object, source: str, field: str, allow: bool = False) -> None:
+def check_plausible(
+    quantity: str,
+    values: object,
+    source: str,
+    field: str,
+    allow: bool = False,
+    locate: Callable[[int], str] | None = None,
+) -> None:
     """Refuse the first of ``values`` outside the range of ``quantity`` (an :class:`InputError` of
     ``source``/``field`` naming the range and :data:`OVERRIDE_OPTION`), or with ``allow`` warn.
-    Non-finite values are the readers' to refuse and are skipped here."""
-    rng, bad = _first_outside(quantity, values)
+    ``locate(i)`` says where the ``i``-th value is (``row 5 (time_s 0.04)``), shown after the value
+    and its unit. Non-finite values are the readers' to refuse and are skipped here."""
+    rng, bad, index = _first_outside(quantity, values)
     if bad is None:
         return
+    shown: object = bad if locate is None else CoreText(f"{bad:.6g} {rng.unit} at {locate(index)}".replace("  ", " "))
     if not allow:
-        raise InputError(source, field, bad, f"a plausible value, {rng.describe()}; {OVERRIDE_OPTION} runs it anyway")
+        raise InputError(source, field, shown, f"a plausible value, {rng.describe()}; {OVERRIDE_OPTION} runs it anyway")
     _warn(rng, bad, source, field)
 
 
 def warn_implausible(quantity: str, values: object, source: str, field: str) -> None:
     """Warn (a :class:`TcsimWarning`) about the first of ``values`` outside the range of ``quantity``."""
-    rng, bad = _first_outside(quantity, values)
+    rng, bad, _ = _first_outside(quantity, values)
     if bad is not None:
         _warn(rng, bad, source, field)
 

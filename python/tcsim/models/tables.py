@@ -13,6 +13,7 @@ torque at 1000 rpm input speed in N·m (negative in overrun); ``#`` starts a com
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 
 from ..errors import InputError
@@ -38,9 +39,12 @@ def _rows(path: Path) -> list[tuple[int, list[str]]]:
 
 def _number(path: Path, lineno: int, column: str, text: str) -> float:
     try:
-        return float(text)
+        value = float(text)
     except ValueError:
         raise InputError(str(path), f"line {lineno}, {column}", text, "a number") from None
+    if not math.isfinite(value):  # "nan", "inf", or "1e400", which overflows: named as written
+        raise InputError(str(path), f"line {lineno}, {column}", text, "a finite number")
+    return value
 
 
 def _columns(path: Path, rows, names: list[str]):
@@ -63,6 +67,11 @@ def _columns(path: Path, rows, names: list[str]):
 def read_table_csv(path: Path) -> Characteristic:
     rows = _rows(path)
     header_line, header = rows[0]
+    twice = [h for i, h in enumerate(header) if h in header[:i]]
+    if twice:
+        raise InputError(
+            str(path), f"line {header_line} (header)", twice[0], "each column name once (this one appears twice)"
+        )
     for required in ("speed_ratio", "torque_ratio"):
         if required not in header:
             raise InputError(str(path), f"line {header_line} (header)", ",".join(header), f"a {required} column")

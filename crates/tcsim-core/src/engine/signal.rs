@@ -88,31 +88,52 @@ impl Signal {
     }
 }
 
-/// Local least-squares slopes over ±window/2 (at least the neighbouring samples).
+/// Local least-squares slopes over ±window/2 (at least the neighbouring samples), in O(n).
+///
+/// The window `[a, b]` of sample `i` only moves forward as `i` grows, so the sums of the
+/// least-squares fit are kept running: a sample is added when it enters the window and removed
+/// when it leaves. The sums are taken about a local origin (a time and a value of a sample near
+/// the window) so that large time stamps (1e5 s) or offsets do not cancel the digits of the
+/// slope; the origin is moved to the current sample and the sums recomputed from scratch once as
+/// many samples entered or left as the window holds, which keeps the rounding of the running sums
+/// bounded and the cost O(n) overall (each recomputation is paid for by as many updates).
+///
+/// A window of at most [`DIRECT_FIT_MAX_SAMPLES`] samples (the default 40 ms window up to a 1.5 kHz
+/// logger) is fitted directly instead, at a cost bounded by that number: its slope is then the
+/// same, bit for bit, as before the running sums, and results recorded with it do not move.
 fn smoothed_rate(t: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
     let n = t.len();
     if n < 2 {
         return vec![0.0; n];
     }
-    // samples at exactly ±window/2 are in, whatever the rounding of the time stamps
-    let half = 0.5 * window_s * (1.0 + 1e-9);
-    let (mut lo, mut hi) = (0usize, 0usize);
-    (0..n)
-        .map(|i| {
-            while t[i] - t[lo] > half {
-                lo += 1;
+    let mut sums = SlopeSums::new(t[0], y[0]);
+    let (mut a, mut b) = (0usize, 0usize); // the samples in `sums`: a..=b
+    sums.add(t[0], y[0]);
+    window_bounds(t, window_s)
+        .map(|(lo, hi, i)| {
+            while b < hi {
+                b += 1;
+                sums.add(t[b], y[b]);
             }
-            while hi + 1 < n && t[hi + 1] - t[i] <= half {
-                hi += 1;
+            while a < lo {
+                sums.remove(t[a], y[a]);
+                a += 1;
             }
-            // at least one neighbour on each side where there is one
-            let a = lo.min(i.saturating_sub(1));
-            let b = hi.max((i + 1).min(n - 1));
-            least_squares_slope(&t[a..=b], &y[a..=b])
+            if b - a < DIRECT_FIT_MAX_SAMPLES {
+                return least_squares_slope(&t[a..=b], &y[a..=b]);
+            }
+            if sums.updates > b - a + 1 {
+                sums = SlopeSums::over(&t[a..=b], &y[a..=b], t[i], y[i]);
+            }
+            sums.slope()
         })
         .collect()
 }
 
+/// The largest window (in samples) whose slope is fitted directly rather than from running sums.
+const DIRECT_FIT_MAX_SAMPLES: usize = 64;
+
+/// The slope of the least-squares line through the samples, fitted directly about their means.
 fn least_squares_slope(t: &[f64], y: &[f64]) -> f64 {
     let m = t.len() as f64;
     let tm = t.iter().sum::<f64>() / m;
@@ -120,6 +141,75 @@ fn least_squares_slope(t: &[f64], y: &[f64]) -> f64 {
     let (num, den) =
         t.iter().zip(y).fold((0.0, 0.0), |(n, d), (&ti, &yi)| (n + (ti - tm) * (yi - ym), d + (ti - tm) * (ti - tm)));
     num / den
+}
+
+/// The window `(a, b, i)` of each sample `i`: the samples within ±window/2 and at least one
+/// neighbour on each side where there is one. Both ends never move back.
+fn window_bounds(t: &[f64], window_s: f64) -> impl Iterator<Item = (usize, usize, usize)> + '_ {
+    let n = t.len();
+    // samples at exactly ±window/2 are in, whatever the rounding of the time stamps
+    let half = 0.5 * window_s * (1.0 + 1e-9);
+    let (mut lo, mut hi) = (0usize, 0usize);
+    (0..n).map(move |i| {
+        while t[i] - t[lo] > half {
+            lo += 1;
+        }
+        while hi + 1 < n && t[hi + 1] - t[i] <= half {
+            hi += 1;
+        }
+        (lo.min(i.saturating_sub(1)), hi.max((i + 1).min(n - 1)), i)
+    })
+}
+
+/// Running sums of a least-squares line fit about a local origin `(t0, y0)`.
+struct SlopeSums {
+    t0: f64,
+    y0: f64,
+    count: f64,
+    st: f64,
+    sy: f64,
+    stt: f64,
+    sty: f64,
+    /// Samples added or removed since the sums were last computed from scratch.
+    updates: usize,
+}
+
+impl SlopeSums {
+    fn new(t0: f64, y0: f64) -> Self {
+        Self { t0, y0, count: 0.0, st: 0.0, sy: 0.0, stt: 0.0, sty: 0.0, updates: 0 }
+    }
+
+    /// The sums over the samples `t`, `y`, about `(t0, y0)`.
+    fn over(t: &[f64], y: &[f64], t0: f64, y0: f64) -> Self {
+        let mut s = Self::new(t0, y0);
+        t.iter().zip(y).for_each(|(&ti, &yi)| s.add(ti, yi));
+        s.updates = 0;
+        s
+    }
+
+    fn add(&mut self, t: f64, y: f64) {
+        self.update(t, y, 1.0);
+    }
+
+    fn remove(&mut self, t: f64, y: f64) {
+        self.update(t, y, -1.0);
+    }
+
+    fn update(&mut self, t: f64, y: f64, sign: f64) {
+        let (dt, dy) = (t - self.t0, y - self.y0);
+        self.count += sign;
+        self.st += sign * dt;
+        self.sy += sign * dy;
+        self.stt += sign * dt * dt;
+        self.sty += sign * dt * dy;
+        self.updates += 1;
+    }
+
+    /// The slope of the least-squares line through the samples in the sums (at least two).
+    fn slope(&self) -> f64 {
+        let (tm, ym) = (self.st / self.count, self.sy / self.count);
+        (self.sty - self.count * tm * ym) / (self.stt - self.count * tm * tm)
+    }
 }
 
 #[cfg(test)]
@@ -155,6 +245,65 @@ mod tests {
         let s = Signal::new("w", t.clone(), parabola, DEFAULT_DERIVATIVE_WINDOW_S).unwrap();
         for &i in &[25usize, 290, 500, 975] {
             assert!((s.rate(t[i]) - 2.0 * t[i]).abs() < 1e-9, "{}: {}", t[i], s.rate(t[i]));
+        }
+    }
+
+    /// The slopes as they were computed before the running sums: each window fitted directly, O(n·w).
+    fn direct_smoothed_rate(t: &[f64], y: &[f64], window_s: f64) -> Vec<f64> {
+        window_bounds(t, window_s).map(|(a, b, _)| least_squares_slope(&t[a..=b], &y[a..=b])).collect()
+    }
+
+    /// A reproducible uniform number in [0, 1) (xorshift64*).
+    fn uniform(state: &mut u64) -> f64 {
+        *state ^= *state >> 12;
+        *state ^= *state << 25;
+        *state ^= *state >> 27;
+        (state.wrapping_mul(0x2545_F491_4F6C_DD1D) >> 11) as f64 / (1u64 << 53) as f64
+    }
+
+    #[test]
+    fn running_slopes_agree_with_the_direct_fit_on_irregular_noisy_samples_far_from_zero() {
+        let mut state = 0x9E37_79B9_7F4A_7C15u64;
+        for &(offset, step, window, n) in
+            // windows of ~400, ~500, every sample (running sums), ~50 and 3 samples (direct fits)
+            &[
+                (0.0, 1e-4, 0.04, 20_000),
+                (1e5, 1e-4, 0.04, 20_000),
+                (1e5, 1e-3, 0.5, 5000),
+                (-3e4, 1e-3, 1e300, 3000),
+                (1e5, 1e-2, 0.5, 3000),
+                (-3e4, 2e-4, 0.0, 4000),
+            ]
+        {
+            let mut t = vec![offset];
+            for _ in 1..n {
+                let dt = step * (0.2 + 1.6 * uniform(&mut state));
+                t.push(t.last().unwrap() + dt);
+            }
+            // a fast ramp with an offset, a slow oscillation and noise of the logger's size
+            let y: Vec<f64> = t
+                .iter()
+                .map(|&ti| {
+                    300.0 + 50.0 * (ti - offset) + 20.0 * (3.0 * (ti - offset)).sin() + uniform(&mut state) - 0.5
+                })
+                .collect();
+            let fast = smoothed_rate(&t, &y, window);
+            let direct = direct_smoothed_rate(&t, &y, window);
+            let scale = direct.iter().fold(0.0f64, |m, r| m.max(r.abs()));
+            for (i, (f, d)) in fast.iter().zip(&direct).enumerate() {
+                assert!((f - d).abs() <= 1e-9 * scale, "offset {offset}, sample {i}: {f} vs {d}");
+            }
+        }
+    }
+
+    #[test]
+    fn running_slopes_are_exact_on_a_line_for_any_window() {
+        let t: Vec<f64> = (0..20_000).map(|i| 1e5 + i as f64 * 1e-3 + 3e-4 * ((i * 7919) % 13) as f64 / 13.0).collect();
+        let line: Vec<f64> = t.iter().map(|t| -7.0 + 2.5 * (t - 1e5)).collect();
+        for window in [0.0, 0.04, 1.0, 1e300] {
+            for (i, r) in smoothed_rate(&t, &line, window).iter().enumerate() {
+                assert!((r - 2.5).abs() < 1e-9, "window {window}, sample {i}: {r}");
+            }
         }
     }
 

@@ -1,0 +1,340 @@
+"""The readers' edges (issue 10, defects 6, 8, 10): every malformed column, header, unit mistake and
+encoding is an InputError naming the file, the column and the value, on one line; nothing is
+silently held, renamed, dropped or read in the wrong unit."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
+import pytest
+import scipy.io
+from asammdf import MDF, Signal
+
+from tcsim import errors
+from tcsim.errors import InputError, TcsimWarning
+from tcsim.io.measurement import read_measurement
+from tcsim.io.scenario import read_scenario
+from tcsim.models.converter import load_converter
+from tcsim.models.tables import read_table
+from tcsim.models.vehicle import load_vehicle
+
+REPO = Path(__file__).resolve().parents[2]
+BUNDLED_CONVERTER = REPO / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016.toml"
+BUNDLED_VEHICLE = REPO / "python" / "tcsim" / "data" / "vehicles" / "midsize-awd-8at.toml"
+
+N = 200
+TIME_S = np.linspace(0.0, 2.0, N)  # 100 Hz
+CHANNELS = {"pump_torque_nm": 150.0 + 40.0 * np.sin(3.0 * TIME_S), "turbine_speed_rad_s": 90.0 * TIME_S}
+
+
+def refused(read, *words: str) -> InputError:
+    """The InputError of ``read()``: one line, holding ``words``."""
+    with pytest.raises(InputError) as excinfo:
+        read()
+    text = str(excinfo.value)
+    assert "\n" not in text and "\r" not in text, text
+    for word in words:
+        assert word in text, (word, text)
+    return excinfo.value
+
+
+# --------------------------------------------------------------------------------------------
+# defect 8: column types that escaped as ValueError or TypeError
+
+
+def _parquet(path: Path, **columns) -> Path:
+    pq.write_table(pa.table({"time_s": TIME_S, **CHANNELS, **columns}), path)
+    return path
+
+
+@pytest.mark.parametrize(
+    ("column", "words"),
+    [
+        (pa.array([[1.0, 2.0]] * N), ["[1.0, 2.0]", "row 1", "one per row"]),
+        (pa.array([{"a": 1.0}] * N), ["{'a': 1.0}", "row 1"]),
+        (pa.array([True] * N), ["True", "numbers only"]),
+        (pa.array(["12,5"] * N), ["'12,5'", "numbers only"]),
+    ],
+    ids=["list", "struct", "bool", "string"],
+)
+def test_a_parquet_column_that_holds_no_numbers_is_named(tmp_path, column, words):
+    path = tmp_path / "m.parquet"
+    pq.write_table(
+        pa.table({"time_s": TIME_S, "pump_torque_nm": column, "turbine_speed_rad_s": CHANNELS["turbine_speed_rad_s"]}),
+        path,
+    )
+    err = refused(lambda: read_measurement(path), str(path), *words)
+    assert err.field == "pump_torque_nm"
+
+
+def test_an_empty_or_row_less_parquet_file_is_refused(tmp_path):
+    empty = tmp_path / "empty.parquet"
+    empty.write_bytes(b"")
+    refused(lambda: read_measurement(empty), "readable Parquet")
+    no_rows = tmp_path / "no_rows.parquet"
+    pq.write_table(
+        pa.table({"time_s": pa.array([], pa.float64()), **{c: pa.array([], pa.float64()) for c in CHANNELS}}), no_rows
+    )
+    refused(lambda: read_measurement(no_rows), "0 rows", "at least 2")
+
+
+# --------------------------------------------------------------------------------------------
+# defect 10: duplicated column names
+
+
+def test_a_duplicated_csv_column_is_refused_by_name(tmp_path):
+    path = tmp_path / "m.csv"
+    rows = "\n".join(f"{t},{p},{w},{p + 1}" for t, p, w in zip(TIME_S, *CHANNELS.values(), strict=True))
+    path.write_text("time_s,pump_torque_nm,turbine_speed_rad_s,pump_torque_nm\n" + rows + "\n")
+    err = refused(lambda: read_measurement(path), "pump_torque_nm", "2 columns", "at most once")
+    assert err.field == "pump_torque_nm"
+
+
+def test_a_duplicated_parquet_column_is_refused_by_name(tmp_path):
+    path = tmp_path / "m.parquet"
+    table = pa.Table.from_arrays(
+        [pa.array(TIME_S), pa.array(CHANNELS["pump_torque_nm"]), pa.array(TIME_S), pa.array(TIME_S)],
+        names=["time_s", "pump_torque_nm", "turbine_speed_rad_s", "turbine_speed_rad_s"],
+    )
+    pq.write_table(table, path)
+    refused(lambda: read_measurement(path), "turbine_speed_rad_s", "2 columns")
+
+
+def test_a_duplicated_scenario_column_is_refused(tmp_path):
+    path = tmp_path / "s.csv"
+    path.write_text("time_s,accelerator_pedal,brake_pedal,brake_pedal\n0,0,1,0\n1,1,0,1\n")
+    refused(lambda: read_scenario(path), "brake_pedal", "2 columns")
+
+
+def test_a_duplicated_table_header_is_named_not_blamed_on_torque_ratio(tmp_path):
+    path = tmp_path / "t.csv"
+    path.write_text("speed_ratio,torque_ratio,speed_ratio,capacity_factor_nm_s2\n0,2,0,1e-3\n0.5,1.5,0.5,1e-3\n")
+    err = refused(lambda: read_table(path), "line 1 (header)", "'speed_ratio'", "once")
+    assert err.value == "speed_ratio"
+
+
+def test_an_mdf_channel_name_in_two_groups_with_other_samples_is_refused(tmp_path):
+    path = tmp_path / "m.mf4"
+    mdf = MDF(version="4.10")
+    mdf.append([Signal(v, TIME_S, name=k) for k, v in CHANNELS.items()])
+    mdf.append([Signal(CHANNELS["pump_torque_nm"] * 2, TIME_S, name="pump_torque_nm")])
+    mdf.save(path, overwrite=True)
+    mdf.close()
+    refused(lambda: read_measurement(path), "pump_torque_nm", "2 channels", "same samples")
+
+
+# --------------------------------------------------------------------------------------------
+# defect 10: complex .mat values
+
+
+def test_a_complex_mat_v5_channel_is_called_complex_not_missing(tmp_path):
+    path = tmp_path / "m.mat"
+    scipy.io.savemat(
+        path,
+        {
+            "time_s": TIME_S,
+            "pump_torque_nm": CHANNELS["pump_torque_nm"] * (1 + 1j),
+            "turbine_speed_rad_s": CHANNELS["turbine_speed_rad_s"],
+        },
+    )
+    err = refused(lambda: read_measurement(path), "complex values", "row 1")
+    assert err.field == "pump_torque_nm"
+
+
+def test_a_complex_mat_v73_channel_is_called_complex_and_a_zero_imaginary_part_is_read(tmp_path):
+    path = tmp_path / "m.mat"
+    pair = np.dtype([("real", "<f8"), ("imag", "<f8")])
+    with h5py.File(path, "w", userblock_size=512) as f:
+        for name, values in {"time_s": TIME_S, **CHANNELS}.items():
+            data = np.zeros((N, 1), pair)
+            data["real"][:, 0] = values
+            data["imag"][:, 0] = 1.0 if name == "pump_torque_nm" else 0.0
+            f.create_dataset(name, data=data).attrs["MATLAB_class"] = np.bytes_("double")
+    refused(lambda: read_measurement(path), "pump_torque_nm", "complex values")
+    with h5py.File(path, "r+") as f:
+        f["pump_torque_nm"][:, 0] = np.array([(v, 0.0) for v in CHANNELS["pump_torque_nm"]], pair)
+    np.testing.assert_array_equal(read_measurement(path).channels["pump_torque_nm"], CHANNELS["pump_torque_nm"])
+
+
+# --------------------------------------------------------------------------------------------
+# defect 6: unit mistakes in measured data, against the core's plausibility ranges
+
+
+def _csv(path: Path, time_s=TIME_S, **changes) -> Path:
+    pd.DataFrame({"time_s": time_s, **CHANNELS, **changes}).to_csv(path, index=False)
+    return path
+
+
+def test_rpm_in_a_rad_s_column_below_1500_is_refused_and_can_be_allowed(tmp_path):
+    rpm = 1400.0 * TIME_S / 2.0  # a take-off to 1400 rpm, written in a rad/s column
+    path = _csv(tmp_path / "m.csv", turbine_speed_rad_s=rpm)
+    err = refused(lambda: read_measurement(path), "turbine_speed_rad_s", "rad/s at row", "--allow-implausible")
+    assert err.field == "turbine_speed_rad_s"
+    with pytest.warns(TcsimWarning, match="outside the plausible"):
+        m = read_measurement(path, allow_implausible=True)
+    np.testing.assert_array_equal(m.channels["turbine_speed_rad_s"], rpm)
+
+
+def test_a_torque_far_outside_the_range_is_refused(tmp_path):
+    path = _csv(tmp_path / "m.csv", pump_torque_nm=CHANNELS["pump_torque_nm"] * 100)
+    refused(lambda: read_measurement(path), "pump_torque_nm", "N·m at row", "--allow-implausible")
+
+
+def test_milliseconds_in_a_time_s_column_are_refused_by_the_median_step(tmp_path):
+    t_ms = np.arange(N) * 1.0  # 1 kHz logged in ms: a 0.2 s record read as 199 s
+    path = _csv(tmp_path / "m.csv", time_s=t_ms)
+    err = refused(lambda: read_measurement(path), "time_s (median time step, s)", "= 1:", "--allow-implausible")
+    assert err.value == 1.0
+    with pytest.warns(TcsimWarning):
+        read_measurement(path, allow_implausible=True)
+
+
+def test_a_scenario_with_a_time_ms_column_read_as_seconds_is_refused(tmp_path):
+    path = tmp_path / "s.csv"
+    t = np.arange(0.0, 30_001.0, 500.0)  # a 30 s take-off written in ms under time_s
+    pd.DataFrame({"time_s": t, "accelerator_pedal": 1.0, "brake_pedal": 0.0}).to_csv(path, index=False)
+    refused(lambda: read_scenario(path), "time_s (time span, s)", "30000", "scenario", "--allow-implausible")
+    with pytest.warns(TcsimWarning):
+        assert read_scenario(path, allow_implausible=True).end_time_s == 30_000.0
+    slow = tmp_path / "slow.csv"  # rows far apart are fine in a pedal scenario
+    pd.DataFrame({"time_s": [0.0, 60.0, 600.0], "accelerator_pedal": 0.5, "brake_pedal": 0.0}).to_csv(slow, index=False)
+    assert read_scenario(slow).end_time_s == 600.0
+
+
+def test_a_scenario_engine_torque_outside_the_range_is_refused(tmp_path):
+    path = tmp_path / "s.csv"
+    frame = pd.DataFrame({"time_s": [0.0, 1.0, 2.0], "accelerator_pedal": 1.0, "brake_pedal": 0.0})
+    frame.assign(engine_torque_nm=[100.0, 3e5, 100.0]).to_csv(path, index=False)
+    refused(lambda: read_scenario(path), "engine_torque_nm", "300000 N·m at row 2")
+
+
+# --------------------------------------------------------------------------------------------
+# defect 6: an MDF channel that covers part of the record
+
+
+def test_an_mdf_channel_covering_a_tenth_of_the_record_is_refused(tmp_path):
+    path = tmp_path / "m.mf4"
+    mdf = MDF(version="4.10")
+    mdf.append([Signal(CHANNELS["pump_torque_nm"], TIME_S, name="pump_torque_nm")])
+    short = TIME_S[: N // 10]
+    mdf.append([Signal(CHANNELS["turbine_speed_rad_s"][: N // 10], short, name="turbine_speed_rad_s")])
+    mdf.save(path, overwrite=True)
+    mdf.close()
+    err = refused(lambda: read_measurement(path), "turbine_speed_rad_s", "from 0 s to 0.19", "0 s to 2 s")
+    assert err.field == "turbine_speed_rad_s"
+
+
+def test_mdf_channels_at_other_rates_that_cover_the_record_are_read(tmp_path):
+    path = tmp_path / "m.mf4"
+    slow = np.linspace(0.0, 1.95, 40)  # 20 Hz, ending within one of its steps of the 100 Hz channel
+    mdf = MDF(version="4.10")
+    mdf.append([Signal(CHANNELS["pump_torque_nm"], TIME_S, name="pump_torque_nm")])
+    mdf.append([Signal(90.0 * slow, slow, name="turbine_speed_rad_s")])
+    mdf.save(path, overwrite=True)
+    mdf.close()
+    assert len(read_measurement(path).time_s) == N
+
+
+# --------------------------------------------------------------------------------------------
+# defect 10: messages on one line, the file's own values, a byte-order mark in TOML
+
+
+def test_a_toml_key_with_a_newline_gives_one_line(tmp_path):
+    path = tmp_path / "c.toml"
+    path.write_text('"pump\\nkg_m2" = 0.1\n' + BUNDLED_CONVERTER.read_text())
+    text = str(refused(lambda: load_converter(path)))
+    assert "pump\\nkg_m2" in text
+
+
+def test_error_messages_escape_control_characters_and_undecodable_bytes():
+    err = InputError("a\udcffb.csv", "x\ny", "v\x1b[2J", "z\u2028w")
+    assert str(err) == "a\\udcffb.csv: x\\ny = 'v\\x1b[2J': expected z\\u2028w"
+    assert errors.escape_controls("±10 500 rpm · ü") == "±10 500 rpm · ü"
+
+
+@pytest.mark.parametrize(("key", "value"), [("k_factor_rpm_per_sqrt_nm", "1e-160"), ("capacity_nm_per_rpm2", "1e307")])
+def test_a_capacity_that_overflows_on_conversion_is_named_as_written(tmp_path, key, value):
+    table = tmp_path / "t.csv"
+    table.write_text(f"# a table\nspeed_ratio,torque_ratio,{key}\n0,2,{value}\n0.5,1.5,{value}\n")
+    err = refused(lambda: read_table(table), f"line 3, {key}", value.replace("e-", "e-").replace("1e307", "1e+307"))
+    assert err.field == f"line 3, {key}" and err.value == float(value)
+    toml = tmp_path / "c.toml"
+    toml.write_text(
+        f'name = "c"\nsource = "s"\n[characteristic]\nspeed_ratio = [0.0, 0.5]\n'
+        f"torque_ratio = [2.0, 1.5]\n{key} = [{value}, 1.0]\n"
+    )
+    err = refused(lambda: load_converter(toml), f"[characteristic].{key}[0]")
+    assert err.value == float(value) and not math.isinf(err.value)
+
+
+def test_a_byte_order_mark_is_accepted_in_converter_and_vehicle_toml(tmp_path):
+    conv = tmp_path / "c.toml"
+    conv.write_bytes(b"\xef\xbb\xbf" + BUNDLED_CONVERTER.read_bytes())
+    assert load_converter(conv).name == load_converter(BUNDLED_CONVERTER).name
+    vehicle = tmp_path / "v.toml"
+    vehicle.write_bytes(b"\xef\xbb\xbf" + BUNDLED_VEHICLE.read_bytes())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TcsimWarning)
+        assert load_vehicle(str(vehicle)).name == load_vehicle(str(BUNDLED_VEHICLE)).name
+
+
+@pytest.mark.parametrize(
+    "edit",
+    [
+        ("fluid_density_kg_m3 = 840.0", 'fluid_density_kg_m3 = "840"'),
+        ("fluid_density_kg_m3 = 840.0", "fluid_density_kg_m3 = true"),
+        ("fluid_density_kg_m3 = 840.0", "fluid_density_kg_m3 = { value = 840.0 }"),
+        ("fluid_density_kg_m3 = 840.0", "fluid_density_kg_m3 = [840.0]"),
+    ],
+    ids=["string", "boolean", "table", "array"],
+)
+def test_converter_toml_values_of_other_types_are_input_errors(tmp_path, edit):
+    text = BUNDLED_CONVERTER.read_text()
+    assert edit[0] in text
+    path = tmp_path / "c.toml"
+    path.write_text(text.replace(edit[0], edit[1]))
+    refused(lambda: load_converter(path), "[geometry].fluid_density_kg_m3")
+
+
+@pytest.mark.parametrize("text", ["", "\n# nothing\n"], ids=["empty", "comment only"])
+def test_an_empty_converter_toml_is_an_input_error(tmp_path, text):
+    path = tmp_path / "c.toml"
+    path.write_text(text)
+    refused(lambda: load_converter(path), "missing")
+
+
+@pytest.mark.parametrize(
+    ("value", "words"),
+    [
+        ({"a": 1.0}, ["1x1 struct", "numeric vector"]),
+        (np.array([[1.0], "x"], dtype=object), ["cell array"]),
+        (np.ones((N, 2)), [f"{N}x2 matrix"]),
+    ],
+    ids=["struct", "cell", "matrix"],
+)
+def test_a_mat_variable_that_is_no_vector_is_named_not_missing(tmp_path, value, words):
+    path = tmp_path / "m.mat"
+    scipy.io.savemat(path, {"time_s": TIME_S, "pump_torque_nm": value, "turbine_speed_rad_s": TIME_S})
+    err = refused(lambda: read_measurement(path), "pump_torque_nm", *words)
+    assert err.value != "missing"
+
+
+def test_a_table_value_that_overflows_when_parsed_is_named_as_written(tmp_path):
+    path = tmp_path / "t.vtcc"
+    path.write_text("Speed Ratio, Torque Ratio, MP1000\n0,2,1e400\n0.5,1.5,100\n")
+    err = refused(lambda: load_converter(path), "line 2, mp1000_nm", "'1e400'", "a finite number")
+    assert err.value == "1e400"
+
+
+def test_csv_columns_without_a_name_are_not_duplicates(tmp_path):
+    path = tmp_path / "m.csv"
+    rows = "\n".join(f"{t},{p},{w},," for t, p, w in zip(TIME_S, *CHANNELS.values(), strict=True))
+    path.write_text("time_s,pump_torque_nm,turbine_speed_rad_s,,\n" + rows + "\n")
+    assert len(read_measurement(path).time_s) == N
