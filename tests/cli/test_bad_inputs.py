@@ -23,7 +23,7 @@ BASE_ROOTS = (REPO / "python" / "tcsim" / "data", REPO / "tests" / "data", REPO 
 SUBPROCESS_TIMEOUT_S = 60.0
 CASE_KEYS = {
     *("id", "command", "exit", "file", "message", "files", "subprocess", "pending", "timeout", "tags"),
-    "writes",
+    *("writes", "warning"),
 }
 FILE_KEYS = {"text", "hex", "base", "replace", "prepend", "append", "make", "args", "dir"}
 COMMANDS = ("converters", "characterise", "fit", "study", "replay", "fit-shapes", "launch", "export-fmu")
@@ -142,6 +142,9 @@ def test_bad_input(cli, tmp_path, case):
     after = snapshot(tmp_path)
     if code == 0:  # a legal input that must work (``writes``: what it writes)
         assert not [ln for ln in err.splitlines() if ln.startswith(("error", "tcsim failed"))], err
+        if "warning" in case:  # a legal but implausible input: one warning names it
+            warned = [ln for ln in err.splitlines() if ln.startswith("warning: ")]
+            assert any(all(f in ln for f in case["warning"]) for ln in warned), (case["warning"], warned)
         for written in case["writes"]:
             assert written in after, f"{written} not written"
         new = [p for p in after if p not in before]

@@ -64,6 +64,13 @@ pub const RANGES: &[PlausibleRange] = &[
               seconds gives more, seconds read as milliseconds less",
     },
     PlausibleRange {
+        quantity: "torque_ratio",
+        unit: "",
+        low: 0.0,
+        high: 10.0,
+        why: "torque ratios of hydrodynamic converters; stall torque ratios are 1.5 to 3.5",
+    },
+    PlausibleRange {
         quantity: "radius_m",
         unit: "m",
         low: 0.02,

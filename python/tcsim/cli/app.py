@@ -41,7 +41,16 @@ ModelsOpt = Annotated[
         help="table | hrovat-tobler | quasi-dynamic, repeatable (default: every model the converter supports)",
     ),
 ]
-OutOpt = Annotated[Path, typer.Option("--out", "-o", help="output directory")]
+
+
+def _out_path(text: str) -> Path:
+    """``--out``: an empty name is a mistake (an unset shell variable), not the current folder."""
+    if not text.strip():
+        raise InputError("command line", "--out", text, "a directory name (an empty name is not the current folder)")
+    return Path(text)
+
+
+OutOpt = Annotated[Path, typer.Option("--out", "-o", help="output directory", parser=_out_path)]
 AllowImplausibleOpt = Annotated[
     bool,
     typer.Option(

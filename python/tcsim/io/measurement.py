@@ -131,7 +131,7 @@ def _unit_factor(path: Path, column: str, unit: str, canonical: str) -> float:
 _MAP_EXPECTED = f"TARGET=SOURCE with TARGET one of {', '.join(INPUT_CHANNELS)}"
 
 
-def parse_channel_map(items: Sequence[str], source: str = "--channel") -> dict[str, str]:
+def parse_channel_map(items: Sequence[str], source: str = "command line") -> dict[str, str]:
     """``["pump_torque_nm=EngTrq_Nm", ...]`` (TARGET=COLUMN) -> ``{"pump_torque_nm": "EngTrq_Nm"}``."""
     mapping: dict[str, str] = {}
     for item in items:

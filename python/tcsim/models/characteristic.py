@@ -10,6 +10,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError, TcsimWarning, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
+from .plausibility import warn_implausible
 
 CAPACITY_KEYS = tuple(_core.capacity_conventions())
 
@@ -96,6 +97,7 @@ class Characteristic:
                 float(cap[i]),
                 f"a {convention} whose capacity factor is a finite positive number (it converts to {cf[i]:g} N·m·s²)",
             )
+        warn_implausible("torque_ratio", tr, source, lambda i: name("torque_ratio", i))
         try:
             _core.table_check(sr, tr, cf)
         except _core.CoreInputError as e:  # pragma: no cover - the checks above come first

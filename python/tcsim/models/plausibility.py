@@ -75,11 +75,12 @@ def check_plausible(
     _warn(rng, bad, source, field)
 
 
-def warn_implausible(quantity: str, values: object, source: str, field: str) -> None:
-    """Warn (a :class:`TcsimWarning`) about the first of ``values`` outside the range of ``quantity``."""
-    rng, bad, _ = _first_outside(quantity, values)
+def warn_implausible(quantity: str, values: object, source: str, field: str | Callable[[int], str]) -> None:
+    """Warn (a :class:`TcsimWarning`) about the first of ``values`` outside the range of ``quantity``;
+    ``field`` is the field's name, or gives the name of the ``i``-th value (``line 6, torque_ratio``)."""
+    rng, bad, index = _first_outside(quantity, values)
     if bad is not None:
-        _warn(rng, bad, source, field)
+        _warn(rng, bad, source, field(index) if callable(field) else field)
 
 
 def _warn(rng: PlausibleRange, value: float, source: str, field: str) -> None:
