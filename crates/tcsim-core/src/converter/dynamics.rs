@@ -105,23 +105,7 @@ impl Inertias {
     }
 }
 
-/// Six significant digits, like C's `%.6g` without the exponent form for ordinary magnitudes.
-pub fn sig(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let digits = 5 - x.abs().log10().floor() as i32;
-    if (-5..=15).contains(&digits) {
-        let s = format!("{:.*}", digits.max(0) as usize, x);
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
-    } else {
-        format!("{x:.5e}")
-    }
-}
+pub use crate::error::sig;
 
 fn signed_square(w: f64) -> f64 {
     w * w.abs()
@@ -295,12 +279,15 @@ impl HtDynamics {
         let terms = b.shape_terms_kg_m4;
         let i = (0..3).max_by(|&a, &b| terms[a].total_cmp(&terms[b])).unwrap_or(0);
         let bound = b.shape_effect_bounds()[i];
+        let s = self.shape_effect_m2[i].abs();
+        // at the bound six digits show the same number twice: say which side the value is on
+        let shown =
+            if sig(bound) == sig(s) { format!("{bound:e} (|S| = {s:e} is at or above it)") } else { sig(bound) };
         Err(CoreError::new(
             SHAPE_KEYS[i],
             self.shape_effect_m2[i],
             format!(
-                "|S| < {} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
-                sig(bound),
+                "|S| < {shown} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
                 sig(b.inertance_kg_m4),
                 sig(terms.iter().sum::<f64>())
             ),
