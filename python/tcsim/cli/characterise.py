@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..units import DEFAULT_PUMP_SPEED_RPM
-from .app import ModelOpt, OutOpt, stdout
+from .app import AllowImplausibleOpt, ModelOpt, OutOpt, stdout
 
 
 def characterise(
@@ -16,6 +16,7 @@ def characterise(
     model: ModelOpt = "",
     pump_speed_rpm: Annotated[float, typer.Option(help="fixed pump speed of the sweep")] = DEFAULT_PUMP_SPEED_RPM,
     out: OutOpt = Path("characteristic"),
+    allow_implausible: AllowImplausibleOpt = False,
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
     from ..io.outputs import output_dir
@@ -28,7 +29,7 @@ def characterise(
     conv = load_converter(converter)
     model = model or ("hrovat-tobler" if "hrovat-tobler" in conv.models else "table")
     conv.require(model)
-    df = run(conv, model, pump_speed_rpm)
+    df = run(conv, model, pump_speed_rpm, allow_implausible=allow_implausible)
     cp = coupling_point(conv) if model == "hrovat-tobler" else None
     with output_dir(out) as stage:
         write_frames({"characteristic.csv": df}, stage)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .app import ChannelOpt, ModelsOpt, OutOpt, stdout
+from .app import AllowImplausibleOpt, ChannelOpt, ModelsOpt, OutOpt, stdout
 
 if TYPE_CHECKING:
     from ..analysis.replay import Replay
@@ -85,6 +85,7 @@ def replay(
     metrics_window: Annotated[
         float, typer.Option("--metrics-window", help="width of the consecutive metric windows, s")
     ] = 1.0,
+    allow_implausible: AllowImplausibleOpt = False,
 ) -> None:
     """Isolated converter driven by measured signals: DIR/<model>.csv, events, metrics, plots."""
     from ..analysis.replay import parse_initial
@@ -98,7 +99,7 @@ def replay(
         model or [],
         drive,
         parse_channel_map(channel or []),
-        parse_initial(initial or []),
+        parse_initial(initial or [], allow_implausible),
         window,
         metrics_window,
     )
