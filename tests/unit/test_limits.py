@@ -21,16 +21,16 @@ T = np.linspace(0.0, 0.5, 51)
 
 
 def test_the_output_size_is_estimated_and_refused_before_running():
+    # small limits, so that a regression runs an ordinary launch instead of filling the memory
     v = load_vehicle()
     models = select_models(v, ["table"])
     with pytest.raises(InputError) as e:
-        run_launch(v, flip_flop(), models, options={"output_step_s": 1e-6})
+        run_launch(v, flip_flop(), models, options={"output_step_s": 1e-3, "max_output_bytes": 1e7})
     assert (e.value.core_source, e.value.field) == ("options", "output_samples")
-    assert "max_output_bytes = 2e9 bytes" in e.value.expected and "lower the sampling" in e.value.expected
-    # the same run fits under a raised limit's estimate check only if the limit is raised: a small
-    # limit refuses even the default sampling
-    with pytest.raises(InputError, match="max_output_bytes"):
+    assert "max_output_bytes = 1e7 bytes" in e.value.expected and "lower the sampling" in e.value.expected
+    with pytest.raises(InputError) as e:
         run_launch(v, flip_flop(), models, options={"max_output_bytes": 1e5})
+    assert (e.value.core_source, e.value.field) == ("scenario", "output_samples")  # the default step: its length
     with pytest.raises(InputError) as e:
         tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="table", times_s=T, max_output_bytes=100.0)
     assert (e.value.core_source, e.value.field, e.value.value) == ("drive", "output_samples", 51.0)
@@ -80,7 +80,9 @@ FIELDS = {
 @pytest.mark.parametrize("case", list(ABORTED))
 def test_calls_that_aborted_raise_an_input_error(case):
     """Each of these aborted the interpreter (SIGABRT, "memory allocation failed") before."""
-    code = "from tcsim import _core\nfrom tcsim.errors import InputError\ntry:\n"
+    # 3 GB of address space: a regression fails at once instead of taking the machine's memory
+    code = "import resource\nresource.setrlimit(resource.RLIMIT_AS, (3 << 30, 3 << 30))\n"
+    code += "from tcsim import _core\nfrom tcsim.errors import InputError\ntry:\n"
     code += textwrap.indent(textwrap.dedent(ABORTED[case]), "    ")
     code += "\nexcept InputError as e:\n    print('error', e.core_source, e.field)\n    raise SystemExit(2)\n"
     code += "except _core.CoreInputError as e:\n    print('error', e.args[4], e.args[1])\n    raise SystemExit(2)\n"
