@@ -625,7 +625,8 @@ fn smoothed_rate<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let t = slice(&time_s, "time_s")?.to_vec();
-        let s = Signal::new("values", t.clone(), slice(&values, "values")?.to_vec(), window_s).map_err(input_error)?;
+        let v = slice(&values, "values")?.to_vec();
+        let s = Signal::new_any_spacing("values", t.clone(), v, window_s).map_err(input_error)?;
         Ok(t.iter().map(|&ti| s.rate(ti)).collect::<Vec<_>>().into_pyarray(py))
     })
 }

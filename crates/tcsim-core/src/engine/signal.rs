@@ -79,6 +79,17 @@ impl Signal {
         Self::build(name, time_s, value, derivative_window_s, true)
     }
 
+    /// A signal whose samples are only differentiated, never integrated by the solver (the measured
+    /// effective torques): any strictly increasing time stamps.
+    pub fn new_any_spacing(
+        name: &str,
+        time_s: Vec<f64>,
+        value: Vec<f64>,
+        derivative_window_s: f64,
+    ) -> CoreResult<Self> {
+        Self::build(name, time_s, value, derivative_window_s, false)
+    }
+
     /// A host's communication interval `[t, t + h]` in co-simulation, with the values at its ends:
     /// any positive length (the host chooses its steps; the time resolution is for recorded signals).
     pub fn interval(name: &str, time_s: [f64; 2], value: [f64; 2]) -> CoreResult<Self> {
