@@ -115,6 +115,10 @@ def test_non_finite_results_are_written_with_a_warning_naming_file_and_columns(t
     )
     bad = ok.assign(pump_torque_nm=[np.inf, 1.0], flow_m3_s=[np.nan, 0.1], turbine_speed_rad_s=[-np.inf, 1.0])
     assert non_finite_columns(ok) == {}
+    # a coordinate one model of a combined frame lacks is NaN for its whole run: not reported
+    runs = pd.DataFrame({"model": ["table"] * 2 + ["hrovat-tobler"] * 2, "flow_m3_s": [np.nan, np.nan, 0.1, 0.2]})
+    assert non_finite_columns(runs) == {}
+    assert non_finite_columns(runs.assign(flow_m3_s=[np.nan, np.nan, 0.1, np.nan])) == {"flow_m3_s": 1}
     assert non_finite_columns(bad) == {"pump_torque_nm": 1, "flow_m3_s": 1, "turbine_speed_rad_s": 1}
     with warnings.catch_warnings():
         warnings.simplefilter("error")

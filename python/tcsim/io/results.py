@@ -21,24 +21,40 @@ from ..models.converter import Converter, parse_converter
 
 #: Columns that may hold ±inf by definition: the K-factor is infinite where the capacity is zero.
 INFINITE_ALLOWED: frozenset[str] = frozenset({"k_factor_rpm_per_sqrt_nm"})
-#: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies) that are never NaN
-#: in a run that succeeded; ratios, times not reached and metrics may be NaN where undefined.
+#: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies): a run that has
+#: such a quantity never leaves it NaN at some samples; ratios, times not reached and metrics may be
+#: NaN where undefined.
 NAN_NOT_EXPECTED: tuple[str, ...] = ("_rad_s", "_nm", "_m3_s", "_w", "_j")
+
+
+def _partly_nan(df: pd.DataFrame, name: str) -> np.ndarray:
+    """NaN cells of a physical quantity in a run that has the quantity at other samples (a column
+    that is NaN for a whole run, per ``model`` when the frame has one, is a coordinate the model
+    lacks)."""
+    nan = df[name].isna().to_numpy()
+    runs = df.groupby("model", sort=False)[name] if "model" in df.columns else [(None, df[name])]
+    partly = np.zeros(len(df), dtype=bool)
+    for _, col in runs:
+        if not col.isna().all():
+            partly[df.index.get_indexer(col.index)] = col.isna().to_numpy()
+    return nan & partly
 
 
 def non_finite_columns(df: pd.DataFrame) -> dict[str, int]:
     """Columns of ``df`` that hold a value a result file must not hold silently, with their count:
-    ±inf anywhere but in :data:`INFINITE_ALLOWED`, NaN in a physical quantity
-    (:data:`NAN_NOT_EXPECTED`)."""
+    ±inf anywhere but in :data:`INFINITE_ALLOWED`; NaN in a physical quantity
+    (:data:`NAN_NOT_EXPECTED`) of a run that has it at other samples."""
     out = {}
+    df = df.reset_index(drop=True)
     for name in df.columns:
         col = df[name]
-        if not pd.api.types.is_numeric_dtype(col) or pd.api.types.is_bool_dtype(col):
+        if name == "model" or not pd.api.types.is_numeric_dtype(col) or pd.api.types.is_bool_dtype(col):
             continue
-        v = col.to_numpy(dtype=float)
-        bad = np.isnan(v) & str(name).endswith(NAN_NOT_EXPECTED)
+        bad = np.zeros(len(df), dtype=bool)
+        if str(name).endswith(NAN_NOT_EXPECTED):
+            bad |= _partly_nan(df, name)
         if name not in INFINITE_ALLOWED:
-            bad |= np.isinf(v)
+            bad |= np.isinf(col.to_numpy(dtype=float))
         if bad.any():
             out[str(name)] = int(bad.sum())
     return out
