@@ -15,11 +15,13 @@ from typing import Any
 class InputError(Exception):
     """Bad user input: a file, a field in it, the offending value and what was expected."""
 
-    def __init__(self, source: str, field: str, value: Any, expected: str):
+    def __init__(self, source: str, field: str, value: Any, expected: str, core_source: str | None = None):
         self.source = str(source)
         self.field = field
         self.value = value
         self.expected = expected
+        #: The input the core blamed (``tcsim._core.input_sources()``), as data, when the core found it.
+        self.core_source = core_source
         super().__init__(str(self))
 
     def __str__(self) -> str:
@@ -91,7 +93,7 @@ def core_input_error(
     :data:`CORE_SOURCE_NAMES`): shown as ``files[source]`` (the file the caller read that input
     from), else by the input's name."""
     where = files.get(source) or CORE_SOURCE_NAMES.get(source, source)
-    return InputError(where, field_prefix + field, core_value(value), expected)
+    return InputError(where, field_prefix + field, core_value(value), expected, core_source=source)
 
 
 def from_core(exc: Exception, files: Mapping[str, str] | str, field_prefix: str = "") -> InputError:

@@ -28,7 +28,7 @@ fn main() {
     for _ in 0..200 {
         let start = Instant::now();
         let traj = simulate(&model, &drive, &t, &InitialState::default(), &SolverOptions::default()).unwrap();
-        let cols = columns(&model, &traj);
+        let cols = columns(&model, &traj).expect("the columns fit in memory");
         times.push(start.elapsed().as_secs_f64());
         steps = traj.steps;
         std::hint::black_box(cols);

@@ -181,7 +181,7 @@ pub fn run_transient_job(job: &TransientJob) -> crate::engine::options::Transien
     catch_panic(|| {
         let traj =
             crate::engine::isolated::simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
-        Ok((crate::engine::outputs::columns(job.model.as_ref(), &traj), traj.events))
+        Ok((crate::engine::outputs::columns(job.model.as_ref(), &traj)?, traj.events))
     })
 }
 

@@ -42,6 +42,13 @@ pub const RANGES: &[PlausibleRange] = &[
         why: "shaft speeds within ±10 500 rpm; engines redline below 9 000 rpm",
     },
     PlausibleRange {
+        quantity: "flow_m3_s",
+        unit: "m³/s",
+        low: -20.0,
+        high: 20.0,
+        why: "torus through-flow of converters up to 1 m across at up to 10 500 rpm (0.08 m³/s at stall and 2000 rpm for the thesis's)",
+    },
+    PlausibleRange {
         quantity: "torque_nm",
         unit: "N·m",
         low: -10_000.0,
@@ -126,8 +133,42 @@ pub fn range(quantity: &str) -> Option<&'static PlausibleRange> {
     RANGES.iter().find(|r| r.quantity == quantity)
 }
 
+/// Of `values` (`(value, quantity)`), the index of the one farthest outside its range, measured
+/// as the factor by which it misses the range (its magnitude for a range that contains zero):
+/// the value to blame when their combination makes a model's numbers non-finite. None when every
+/// value is inside.
+pub fn farthest_outside(values: &[(f64, &str)]) -> Option<usize> {
+    let miss = |v: f64, q: &str| -> f64 {
+        let Some(r) = range(q) else { return 0.0 };
+        if r.contains(v) {
+            return 0.0;
+        }
+        if !v.is_finite() {
+            return f64::INFINITY;
+        }
+        let (lo, hi, a) = (r.low.abs().max(f64::MIN_POSITIVE), r.high.abs().max(f64::MIN_POSITIVE), v.abs());
+        if r.low > 0.0 && v > 0.0 && v < r.low {
+            (lo / a).ln()
+        } else if v > r.high {
+            (a / hi).ln().max(f64::MIN_POSITIVE)
+        } else {
+            (a / lo).ln().max(f64::MIN_POSITIVE)
+        }
+    };
+    let (i, m) = values.iter().enumerate().map(|(i, &(v, q))| (i, miss(v, q))).max_by(|a, b| a.1.total_cmp(&b.1))?;
+    (m > 0.0).then_some(i)
+}
+
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn the_farthest_value_is_blamed() {
+        let v = [(840.0, "fluid_density_kg_m3"), (8.4e-292, "fluid_density_kg_m3"), (1e6, "radius_m")];
+        assert_eq!(super::farthest_outside(&v), Some(1));
+        assert_eq!(super::farthest_outside(&v[..1]), None);
+        assert_eq!(super::farthest_outside(&[(0.12, "radius_m"), (1e6, "radius_m")]), Some(1));
+    }
+
     use super::*;
 
     #[test]

@@ -18,7 +18,7 @@ fn col<'a>(cols: &'a [Vec<f64>], name: &str) -> &'a [f64] {
 
 fn run(model: &dyn ConverterDynamics, drive: &Drive, t: &[f64], init: InitialState) -> (Trajectory, Vec<Vec<f64>>) {
     let traj = simulate(model, drive, t, &init, &SolverOptions::default()).unwrap_or_else(|e| panic!("{e}"));
-    let cols = columns(model, &traj);
+    let cols = columns(model, &traj).unwrap_or_else(|e| panic!("{e}"));
     (traj, cols)
 }
 

@@ -35,9 +35,10 @@ use tcsim_core::converter::table::Characteristic;
 use tcsim_core::engine::converter_events::EventKind;
 use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
 use tcsim_core::engine::options::{SolverOptions, TransientError};
+use tcsim_core::engine::outputs::isolated_output_size;
 use tcsim_core::engine::signal::Signal;
 use tcsim_core::vehicle::file::{read_vehicle as read_vehicle_core, VehicleDocument};
-use tcsim_core::vehicle::launch::simulate_launch;
+use tcsim_core::vehicle::launch::{check_launch_output, simulate_launch, DEFAULT_OUTPUT_STEP_S};
 use tcsim_core::vehicle::outputs::launch_column_names;
 use tcsim_core::vehicle::parameters::Scenario;
 use tcsim_core::{CoreError, InputSource};
@@ -577,7 +578,9 @@ fn model_from(d: &Bound<'_, PyDict>) -> PyResult<Box<dyn ConverterDynamics + Sen
 fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal> {
     let t: Vec<f64> = item(d, "time_s")?;
     match d.get_item(key)? {
-        Some(v) if v.extract::<f64>().is_ok() => Ok(Signal::constant(v.extract::<f64>()?)),
+        Some(v) if v.extract::<f64>().is_ok() => {
+            Signal::constant_named(key, v.extract::<f64>()?).map_err(|e| input_error(e.about(InputSource::Drive)))
+        }
         _ => Signal::new(key, t, item(d, key)?, window).map_err(|e| input_error(e.about(InputSource::Drive))),
     }
 }
@@ -646,6 +649,11 @@ fn options_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<SolverOptions> {
         o.flow_atol_m3_s = opt_item(d, "flow_atol_m3_s")?.unwrap_or(o.flow_atol_m3_s);
         o.first_step_s = opt_item(d, "first_step_s")?.unwrap_or(o.first_step_s);
         o.max_events = opt_item(d, "max_events")?.unwrap_or(o.max_events);
+        o.max_output_bytes = opt_item(d, "max_output_bytes")?.unwrap_or(o.max_output_bytes);
+    }
+    if !(o.max_output_bytes.is_finite() && o.max_output_bytes > 0.0) {
+        let expected = "a finite, positive number of bytes";
+        return Err(input_error(CoreError::of(InputSource::Options, "max_output_bytes", o.max_output_bytes, expected)));
     }
     for (k, v) in [
         ("rtol", o.rtol),
@@ -675,7 +683,8 @@ fn smoothed_rate<'py>(
 ) -> PyResult<Bound<'py, PyArray1<f64>>> {
     guard(|| {
         let t = slice(&time_s, "time_s")?.to_vec();
-        let s = Signal::new("values", t.clone(), slice(&values, "values")?.to_vec(), window_s).map_err(input_error)?;
+        let v = slice(&values, "values")?.to_vec();
+        let s = Signal::new_any_spacing("values", t.clone(), v, window_s).map_err(input_error)?;
         Ok(t.iter().map(|&ti| s.rate(ti)).collect::<Vec<_>>().into_pyarray(py))
     })
 }
@@ -724,6 +733,10 @@ fn transient_runs<'py>(
                 })
             })
             .collect::<PyResult<Vec<_>>>()?;
+        let samples = jobs.iter().map(|j| j.times_s.len()).sum();
+        isolated_output_size(1, samples, &options)
+            .check(InputSource::Drive, options.max_output_bytes)
+            .map_err(input_error)?;
         let results = cancellable(py, |cancel| {
             run_transient_jobs_cancellable(&jobs, threads, cancel).into_iter().collect::<Option<Vec<_>>>()
         })?;
@@ -876,7 +889,8 @@ fn launch_columns() -> Vec<&'static str> {
 /// Launch runs: each model dict (as for transient_runs) in the same vehicle (a `Vehicle` from
 /// `read_vehicle`, validated there) and scenario, from the
 /// braked standstill, GIL released, `threads` workers. `options` takes the solver options of
-/// transient_runs and `output_step_s` (default 0.01). Returns one [`LaunchRun`] per model: its
+/// transient_runs and `output_step_s` (default 0.01, at least the time resolution). The output's
+/// size is estimated first and refused (CoreInputError) above `max_output_bytes`. Returns one [`LaunchRun`] per model: its
 /// columns and [`LaunchEvent`]s, or its [`RunError`].
 #[pyfunction]
 #[pyo3(signature = (models, vehicle, scenario, options=None, threads=0))]
@@ -893,15 +907,16 @@ fn launch_runs<'py>(
         let sc = scenario_from(&scenario)?;
         let solver = options_from(options.as_ref())?;
         let step: f64 = match options.as_ref() {
-            Some(o) => opt_item(o, "output_step_s")?.unwrap_or(0.01),
-            None => 0.01,
+            Some(o) => opt_item(o, "output_step_s")?.unwrap_or(DEFAULT_OUTPUT_STEP_S),
+            None => DEFAULT_OUTPUT_STEP_S,
         };
         let parsed = models.iter().map(|m| model_from(m)).collect::<PyResult<Vec<_>>>()?;
+        check_launch_output(&sc, step, parsed.len(), &solver).map_err(input_error)?;
         let results = cancellable(py, |cancel| {
             tcsim_core::batch::parallel_map_cancellable(&parsed, threads, cancel, |m| {
                 tcsim_core::batch::catch_panic(|| {
                     let traj = simulate_launch(m.as_ref(), &v, &sc, step, &solver)?;
-                    Ok((tcsim_core::vehicle::outputs::launch_columns(m.as_ref(), &sc, &traj), traj.events))
+                    Ok((tcsim_core::vehicle::outputs::launch_columns(m.as_ref(), &sc, &traj)?, traj.events))
                 })
             })
             .into_iter()

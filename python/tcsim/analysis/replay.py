@@ -122,6 +122,7 @@ from ..models.converter import Converter
 from ..models.drives import DERIVATIVE_WINDOW_S, Drive
 from ..models.dynamic import DynamicModel, select_models
 from ..models.measurement import Measurement
+from ..models.plausibility import check_plausible
 from ..simulation import transient
 from .effective import measured_effective_torques
 
@@ -182,8 +183,10 @@ def drive_kind(name: str) -> DriveKind:
     return DRIVES[name]
 
 
-def parse_initial(items: Sequence[str]) -> dict[str, float]:
-    """``["pump_speed_rad_s=150", ...]`` -> ``{"pump_speed_rad_s": 150.0}``; finite values, known keys."""
+def parse_initial(items: Sequence[str], allow_implausible: bool = False) -> dict[str, float]:
+    """``["pump_speed_rad_s=150", ...]`` -> ``{"pump_speed_rad_s": 150.0}``; finite values, known keys,
+    speeds and flows in their plausible ranges (``speed_rad_s``, ``flow_m3_s``) unless
+    ``allow_implausible`` (``--allow-implausible``), which warns instead."""
     expected = f"NAME=VALUE with NAME one of {', '.join(INITIAL_KEYS)} (each at most once) and VALUE a finite number"
     out: dict[str, float] = {}
     for item in items:
@@ -194,6 +197,8 @@ def parse_initial(items: Sequence[str]) -> dict[str, float]:
             value = math.nan
         if not sep or key not in INITIAL_KEYS or key in out or not math.isfinite(value):
             raise InputError("command line", "--initial", item, expected)
+        quantity = "flow_m3_s" if key == "flow_m3_s" else "speed_rad_s"
+        check_plausible(quantity, value, "command line", f"--initial {key}", allow_implausible)
         out[key] = value
     return out
 
@@ -257,18 +262,18 @@ def _warn_ignored_initial(initial: dict[str, float], drive: DriveKind, models: S
 
 
 def run_models(
-    models: Sequence[DynamicModel], drive: Drive, initial: dict[str, float] | None = None
+    models: Sequence[DynamicModel], drive: Drive, initial: dict[str, float] | None = None, drive_file: str = "drive"
 ) -> dict[str, transient.TransientResult]:
-    """Each model under the drive, sampled at the drive's time stamps. An error about the initial
-    state is reported against ``--initial``."""
+    """Each model under the drive, sampled at the drive's time stamps. An error the core finds in
+    the drive's samples (its ``core_source`` ``drive``) names ``drive_file``, the measurement; one
+    in a value of ``initial`` names ``--initial`` on the command line."""
     results = {}
     for m in models:
         try:
-            results[m.name] = transient.simulate(m, drive, initial=initial or None)
+            results[m.name] = transient.simulate(m, drive, initial=initial or None, files={"drive": drive_file})
         except InputError as e:
-            if e.field.startswith("initial state"):
-                key = e.field.partition(":")[2].strip() or e.field
-                raise InputError("command line", f"--initial {key}", e.value, e.expected) from None
+            if e.core_source == "initial":
+                raise InputError("command line", f"--{e.field}", e.value, e.expected, core_source="initial") from None
             raise
     return results
 
@@ -441,7 +446,7 @@ def replay_measurement(
         metrics_window_s = check_window("--metrics-window", metrics_window_s, positive=True)
     dyn = select_models(conv, models)
     _warn_ignored_initial(initial or {}, kind, dyn)
-    results = run_models(dyn, kind.make(meas, window_s), initial)
+    results = run_models(dyn, kind.make(meas, window_s), initial, meas.source)
     inertia = dyn[0].spec["inertia_kg_m2"]
     effective = {
         k: v

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..units import DEFAULT_PUMP_SPEED_RPM
-from .app import ModelOpt, OutOpt, say
+from .app import AllowImplausibleOpt, ModelOpt, OutOpt, say
 
 
 def characterise(
@@ -16,6 +16,7 @@ def characterise(
     model: ModelOpt = "",
     pump_speed_rpm: Annotated[float, typer.Option(help="fixed pump speed of the sweep")] = DEFAULT_PUMP_SPEED_RPM,
     out: OutOpt = Path("characteristic"),
+    allow_implausible: AllowImplausibleOpt = False,
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
     from ..io.outputs import check_output_dir, output_dir
@@ -31,7 +32,7 @@ def characterise(
     check_output_dir(out, inputs)
     model = model or ("hrovat-tobler" if "hrovat-tobler" in conv.models else "table")
     conv.require(model)
-    df = run(conv, model, pump_speed_rpm)
+    df = run(conv, model, pump_speed_rpm, allow_implausible=allow_implausible)
     cp = coupling_point(conv) if model == "hrovat-tobler" else None
     with output_dir(out, inputs) as stage:
         write_frames({"characteristic.csv": df}, stage)

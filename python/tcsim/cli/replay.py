@@ -111,7 +111,7 @@ def replay(
         model or [],
         drive,
         parse_channel_map(channel or []),
-        parse_initial(initial or []),
+        parse_initial(initial or [], allow_implausible),
         window,
         metrics_window,
         allow_implausible,

@@ -5,23 +5,77 @@
 from __future__ import annotations
 
 import json
+import warnings
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import tomli_w
 
 from ..analysis.fitting import FitResult
 from ..analysis.launch import Launch
 from ..analysis.replay import Replay
+from ..errors import TcsimWarning
 from ..models.characteristic import Characteristic
 from ..models.converter import Converter, parse_converter
 
+#: Columns that may hold ±inf by definition: the K-factor is infinite where the capacity is zero.
+INFINITE_ALLOWED: frozenset[str] = frozenset({"k_factor_rpm_per_sqrt_nm"})
+#: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies): a run that has
+#: such a quantity never leaves it NaN at some samples; ratios, times not reached and metrics may be
+#: NaN where undefined.
+NAN_NOT_EXPECTED: tuple[str, ...] = ("_rad_s", "_nm", "_m3_s", "_w", "_j")
+
+
+def _partly_nan(df: pd.DataFrame, name: str) -> np.ndarray:
+    """NaN cells of a physical quantity in a run that has the quantity at other samples (a column
+    that is NaN for a whole run, per ``model`` when the frame has one, is a coordinate the model
+    lacks)."""
+    nan = df[name].isna().to_numpy()
+    runs = df.groupby("model", sort=False)[name] if "model" in df.columns else [(None, df[name])]
+    partly = np.zeros(len(df), dtype=bool)
+    for _, col in runs:
+        if not col.isna().all():
+            partly[df.index.get_indexer(col.index)] = col.isna().to_numpy()
+    return nan & partly
+
+
+def non_finite_columns(df: pd.DataFrame) -> dict[str, int]:
+    """Columns of ``df`` that hold a value a result file must not hold silently, with their count:
+    ±inf anywhere but in :data:`INFINITE_ALLOWED`; NaN in a physical quantity
+    (:data:`NAN_NOT_EXPECTED`) of a run that has it at other samples."""
+    out = {}
+    df = df.reset_index(drop=True)
+    for name in df.columns:
+        col = df[name]
+        if name == "model" or not pd.api.types.is_numeric_dtype(col) or pd.api.types.is_bool_dtype(col):
+            continue
+        bad = np.zeros(len(df), dtype=bool)
+        if str(name).endswith(NAN_NOT_EXPECTED):
+            bad |= _partly_nan(df, name)
+        if name not in INFINITE_ALLOWED:
+            bad |= np.isinf(col.to_numpy(dtype=float))
+        if bad.any():
+            out[str(name)] = int(bad.sum())
+    return out
+
 
 def write_frames(files: dict[str, pd.DataFrame], out_dir: Path) -> list[Path]:
-    """Each frame as ``out_dir/<name>`` (CSV, no index), in order; the paths written."""
+    """Each frame as ``out_dir/<name>`` (CSV, no index), in order; the paths written. A frame with
+    values a result must not hold silently (:func:`non_finite_columns`) is written as it is, with a
+    :class:`~tcsim.errors.TcsimWarning` naming the file, the columns and the count."""
     paths = []
     for filename, df in files.items():
         paths.append(Path(out_dir) / filename)
+        bad = non_finite_columns(df)
+        if bad:
+            listed = ", ".join(f"{k} ({n})" for k, n in bad.items())
+            warnings.warn(
+                f"{filename}: non-finite values (inf, or NaN in a physical quantity) in {listed}: the run overflowed "
+                "or its inputs were outside the model's range; check them before using the file",
+                TcsimWarning,
+                stacklevel=2,
+            )
         df.to_csv(paths[-1], index=False)
     return paths
 

@@ -20,6 +20,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from .. import _core
 from ..errors import InputError, from_core
 from .characteristic import CAPACITY_KEYS, Characteristic
+from .plausibility import warn_implausible
 from .tables import read_table
 
 MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
@@ -220,6 +221,33 @@ def _pydantic_to_input_error(err: ValidationError, path: str) -> InputError:
     return InputError(path, field_name, value, msg)
 
 
+#: The plausibility range (``tcsim._core.plausibility_ranges()``) of each design value of a converter
+#: file, by section and key suffix.
+_DESIGN_QUANTITIES: tuple[tuple[str, str], ...] = (
+    ("_radius_m", "radius_m"),
+    ("_angle_deg", "blade_angle_deg"),
+    ("fluid_density_kg_m3", "fluid_density_kg_m3"),
+    ("flow_area_m2", "flow_area_m2"),
+    ("fluid_length_m", "fluid_length_m"),
+    ("_kg_m2", "inertia_kg_m2"),
+    ("_loss", "loss_coefficient"),
+)
+
+
+def warn_implausible_design(doc: ConverterFile, path: str) -> None:
+    """A :class:`~tcsim.errors.TcsimWarning` for each design value of ``[inertia]``, ``[geometry]``
+    and ``[quasi_dynamic]`` outside its plausible range (a radius of 1e6 m, an angle of 89.99°): the
+    file runs, but the value is most likely a unit mistake or a typo."""
+    for section in ("inertia", "geometry", "quasi_dynamic"):
+        values = getattr(doc, section)
+        if values is None:
+            continue
+        for key, value in values.model_dump().items():
+            quantity = next((q for suffix, q in _DESIGN_QUANTITIES if key.endswith(suffix)), None)
+            if quantity is not None and value is not None:
+                warn_implausible(quantity, value, path, f"[{section}].{key}")
+
+
 def parse_converter(data: dict[str, Any], path: str) -> Converter:
     """Validate a parsed TOML document."""
     try:
@@ -242,6 +270,7 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
             _core.ht_check_geometry(doc.geometry.core_row())
         except _core.CoreInputError as e:
             raise from_core(e, path, "[geometry].") from None
+    warn_implausible_design(doc, path)
     return Converter(
         doc.name,
         doc.source,

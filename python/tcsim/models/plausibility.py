@@ -22,6 +22,7 @@ import numpy as np
 
 from .. import _core
 from ..errors import CoreText, InputError, TcsimWarning
+from ..units import RAD_S_PER_RPM
 
 #: The command-line option that turns a refusal of :func:`check_plausible` into a warning.
 OVERRIDE_OPTION = "--allow-implausible"
@@ -86,3 +87,16 @@ def warn_implausible(quantity: str, values: object, source: str, field: str | Ca
 def _warn(rng: PlausibleRange, value: float, source: str, field: str) -> None:
     message = f"{source}: {field} = {value:.6g} is outside the plausible {rng.describe()}"
     warnings.warn(message, TcsimWarning, stacklevel=3)
+
+
+def check_plausible_rpm(rpm: float, source: str, field: str, allow: bool = False) -> None:
+    """:func:`check_plausible` of a speed given in rpm (a command-line speed such as
+    ``--pump-speed-rpm``) against the range of ``speed_rad_s``, the message in rpm."""
+    rng = RANGES["speed_rad_s"]
+    rad_s = rpm * RAD_S_PER_RPM
+    if not np.isfinite(rad_s) or rng.low <= rad_s <= rng.high:
+        return
+    shown = f"{rng.low / RAD_S_PER_RPM:.0f} to {rng.high / RAD_S_PER_RPM:.0f} rpm, i.e. {rng.describe()}"
+    if not allow:
+        raise InputError(source, field, rpm, f"a plausible speed, {shown}; {OVERRIDE_OPTION} runs it anyway")
+    warnings.warn(f"{source}: {field} = {rpm:.6g} is outside the plausible {shown}", TcsimWarning, stacklevel=2)

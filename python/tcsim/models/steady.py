@@ -19,6 +19,7 @@ from .. import _core
 from ..errors import InputError, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .converter import Converter
+from .plausibility import check_plausible_rpm
 
 #: Codes of the ``stator_mode`` column of the core's steady states and their names (the core's).
 STATOR_MODES: dict[int, str] = _core.steady_mode_names()
@@ -53,10 +54,21 @@ def _derived(df: pd.DataFrame) -> pd.DataFrame:
     return df
 
 
-def _check_speed(pump_speed_rpm: float) -> float:
+def _check_speed(pump_speed_rpm: float, allow_implausible: bool = False) -> float:
+    """The pump speed in rad/s: finite and positive, and plausible (``speed_rad_s``) unless
+    ``allow_implausible`` (``--allow-implausible``), which warns instead."""
     if not (np.isfinite(pump_speed_rpm) and pump_speed_rpm > 0):
         raise InputError("command line", "--pump-speed-rpm", pump_speed_rpm, "a finite, positive pump speed in rpm")
+    check_plausible_rpm(pump_speed_rpm, "command line", "--pump-speed-rpm", allow_implausible)
     return pump_speed_rpm * RAD_S_PER_RPM
+
+
+def _speed_error(e: Exception, pump_speed_rpm: float, converter_file: str, field_prefix: str = "") -> InputError:
+    """A core error of a sweep: about the commanded speed (source ``drive``: the steady state
+    overflowed) it names ``--pump-speed-rpm``, else the converter file."""
+    if e.args[4] == "drive":
+        return InputError("command line", "--pump-speed-rpm", pump_speed_rpm, e.args[3], core_source="drive")
+    return from_core(e, converter_file, field_prefix)
 
 
 def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
@@ -67,7 +79,10 @@ def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
 
 
 def characterise_table(
-    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
+    conv: Converter,
+    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
+    speed_ratio: np.ndarray | None = None,
+    allow_implausible: bool = False,
 ) -> pd.DataFrame:
     """Steady state of the table model at a fixed pump speed over ``speed_ratio``.
 
@@ -75,7 +90,7 @@ def characterise_table(
     the ``extrapolated`` column says so (``docs/models.md``).
     """
     conv.require("table")
-    wp = _check_speed(pump_speed_rpm)
+    wp = _check_speed(pump_speed_rpm, allow_implausible)
     sr = table_speed_ratios(conv) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
     pump = np.full(sr.shape, wp)
     assert conv.characteristic is not None  # conv.require("table") checked it
@@ -83,7 +98,7 @@ def characterise_table(
     try:
         out = _core.table_steady_states(table_sr, table_tr, table_cf, pump, np.ascontiguousarray(sr * wp))
     except _core.CoreInputError as e:
-        raise from_core(e, conv.path) from None
+        raise _speed_error(e, pump_speed_rpm, conv.path) from None
     df = pd.DataFrame(
         {
             "speed_ratio": sr,
@@ -100,11 +115,14 @@ def characterise_table(
 
 
 def characterise_quasi_dynamic(
-    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
+    conv: Converter,
+    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
+    speed_ratio: np.ndarray | None = None,
+    allow_implausible: bool = False,
 ) -> pd.DataFrame:
     """The quasi-dynamic model at steady state is its table, for any shape effect."""
     conv.require("quasi-dynamic")
-    return characterise_table(conv, pump_speed_rpm, speed_ratio)
+    return characterise_table(conv, pump_speed_rpm, speed_ratio, allow_implausible)
 
 
 def hrovat_tobler_steady_state(
@@ -135,11 +153,16 @@ def coupling_point(conv: Converter) -> float | None:
 
 
 def characterise_hrovat_tobler(
-    conv: Converter, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio: np.ndarray | None = None
+    conv: Converter,
+    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
+    speed_ratio: np.ndarray | None = None,
+    allow_implausible: bool = False,
 ) -> pd.DataFrame:
-    """Closed-form steady state over SR 0–1 with the one-way clutch, coupling point included."""
+    """Closed-form steady state over SR 0–1 with the one-way clutch, coupling point included. A
+    steady state that overflows (pump speeds above about 1e150 rad/s) is an error about
+    ``--pump-speed-rpm``, never a ``no-flow`` point."""
     conv.require("hrovat-tobler")
-    wp = _check_speed(pump_speed_rpm)
+    wp = _check_speed(pump_speed_rpm, allow_implausible)
     if speed_ratio is None:
         sr = np.linspace(0.0, 1.0, 101)
         cp = coupling_point(conv)
@@ -159,7 +182,7 @@ def characterise_hrovat_tobler(
     try:
         out = hrovat_tobler_steady_state(conv.core_geometry(), pump, sr * wp)
     except _core.CoreInputError as e:
-        raise from_core(e, conv.path, "[geometry] at ") from None
+        raise _speed_error(e, pump_speed_rpm, conv.path, "[geometry] at ") from None
     tr = steady_torque_ratio(out)
     df = pd.DataFrame(
         {
@@ -207,7 +230,9 @@ def characterise(
     model: str = "hrovat-tobler",
     pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
     speed_ratio: np.ndarray | None = None,
+    allow_implausible: bool = False,
 ) -> pd.DataFrame:
-    """Steady-state characteristic of ``conv`` with ``model`` (``table``, ``hrovat-tobler``, ``quasi-dynamic``)."""
+    """Steady-state characteristic of ``conv`` with ``model`` (``table``, ``hrovat-tobler``, ``quasi-dynamic``).
+    A pump speed outside the plausible range (``speed_rad_s``) is refused unless ``allow_implausible``."""
     conv.require(model)
-    return CHARACTERISE[model](conv, pump_speed_rpm, speed_ratio)
+    return CHARACTERISE[model](conv, pump_speed_rpm, speed_ratio, allow_implausible)

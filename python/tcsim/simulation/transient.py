@@ -17,7 +17,7 @@ API tiers (after FMPy):
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -73,8 +73,11 @@ def _options(rtol: float | None, **extra) -> dict[str, Any]:
     return o
 
 
-def _unpack(run: _core.TransientRun, model: DynamicModel, index: int | None) -> TransientResult:
-    """The one reading of the core's result of a transient run (raises its error)."""
+def _unpack(
+    run: _core.TransientRun, model: DynamicModel, index: int | None, files: Mapping[str, str] | None = None
+) -> TransientResult:
+    """The one reading of the core's result of a transient run (raises its error, shown against
+    ``files[source]`` for the input the core blamed, the model's converter file by default)."""
     where = "" if index is None else f" (run {index})"
     err = run.error
     if err is None:
@@ -82,7 +85,8 @@ def _unpack(run: _core.TransientRun, model: DynamicModel, index: int | None) -> 
         return TransientResult(model.name, dict(run.columns), events)
     if err.kind == "input":
         assert err.source is not None and err.field is not None and err.expected is not None
-        raise core_input_error(err.source, err.field + where, err.value, err.expected, {"converter": model.source})
+        sources = {"converter": model.source, **(files or {})}
+        raise core_input_error(err.source, err.field + where, err.value, err.expected, sources)
     raise SolverError(f"{model.name}{where}: {err.message}")
 
 
@@ -104,16 +108,18 @@ def simulate(
     times_s: Sequence[float] | None = None,
     initial: dict[str, float] | None = None,
     rtol: float | None = None,
+    files: Mapping[str, str] | None = None,
     **solver_options,
 ) -> TransientResult:
     """Run one model under one drive; samples at ``times_s`` (default: the drive's time stamps).
 
     The initial state is the steady state consistent with the first input sample (drive c: with
     the turbine at rest) unless ``initial`` gives ``pump_speed_rad_s``, ``turbine_speed_rad_s``,
-    ``stator_speed_rad_s`` or ``flow_m3_s``.
+    ``stator_speed_rad_s`` or ``flow_m3_s``. ``files`` names the file of an input the core may
+    blame in an :class:`InputError` (``{"drive": "log.csv"}``; see :func:`simulate_batch`).
     """
     m = converter if isinstance(converter, DynamicModel) else dynamic_model(converter, model)
-    return simulate_batch([m], [drive], times_s, initial, rtol, threads=1, **solver_options)[0]
+    return simulate_batch([m], [drive], times_s, initial, rtol, threads=1, files=files, **solver_options)[0]
 
 
 def simulate_batch(
@@ -123,11 +129,19 @@ def simulate_batch(
     initial: dict[str, float] | None = None,
     rtol: float | None = None,
     threads: int = 0,
+    files: Mapping[str, str] | None = None,
     **solver_options,
 ) -> list[TransientResult]:
     """Run ``models[i]`` under ``drives[i]``; a sequence of length one is broadcast. The runs go to
     the core in one call, which releases the GIL and uses ``threads`` workers (0: all cores).
-    Raises :class:`InputError` or :class:`SolverError` for the first run that fails."""
+    Raises :class:`InputError` or :class:`SolverError` for the first run that fails.
+
+    An :class:`InputError` names the input the core blamed (``core_source``: ``converter``,
+    ``drive``, ``initial``, ``options``), shown as ``files[source]`` when given, else as the models'
+    converter file or the input's name. ``solver_options`` are the core's: ``rtol``,
+    ``speed_atol_rad_s``, ``flow_atol_m3_s``, ``first_step_s``, ``max_events`` and
+    ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs is refused above it
+    before anything runs)."""
     specs = []
     for d in drives:
         s = d.spec()
@@ -140,6 +154,7 @@ def simulate_batch(
         )
     except _core.CoreInputError as e:
         converters = {m.source for m in models}
-        raise from_core(e, {"converter": converters.pop() if len(converters) == 1 else "model"}) from None
+        sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
+        raise from_core(e, sources) from None
     n = len(raw)
-    return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None) for i, r in enumerate(raw)]
+    return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None, files) for i, r in enumerate(raw)]

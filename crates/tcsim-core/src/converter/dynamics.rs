@@ -105,23 +105,7 @@ impl Inertias {
     }
 }
 
-/// Six significant digits, like C's `%.6g` without the exponent form for ordinary magnitudes.
-pub fn sig(x: f64) -> String {
-    if x == 0.0 || !x.is_finite() {
-        return format!("{x}");
-    }
-    let digits = 5 - x.abs().log10().floor() as i32;
-    if (-5..=15).contains(&digits) {
-        let s = format!("{:.*}", digits.max(0) as usize, x);
-        if s.contains('.') {
-            s.trim_end_matches('0').trim_end_matches('.').to_string()
-        } else {
-            s
-        }
-    } else {
-        format!("{x:.5e}")
-    }
-}
+pub use crate::error::sig;
 
 fn signed_square(w: f64) -> f64 {
     w * w.abs()
@@ -295,16 +279,43 @@ impl HtDynamics {
         let terms = b.shape_terms_kg_m4;
         let i = (0..3).max_by(|&a, &b| terms[a].total_cmp(&terms[b])).unwrap_or(0);
         let bound = b.shape_effect_bounds()[i];
+        if !(bound.is_finite() && b.inertance_kg_m4.is_finite() && terms.iter().all(|t| t.is_finite())) {
+            return Err(self.overflowing_parameter());
+        }
+        let s = self.shape_effect_m2[i].abs();
+        // at the bound six digits show the same number twice: say which side the value is on
+        let shown =
+            if sig(bound) == sig(s) { format!("{bound:e} (|S| = {s:e} is at or above it)") } else { sig(bound) };
         Err(CoreError::new(
             SHAPE_KEYS[i],
             self.shape_effect_m2[i],
             format!(
-                "|S| < {} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
-                sig(bound),
+                "|S| < {shown} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
                 sig(b.inertance_kg_m4),
                 sig(terms.iter().sum::<f64>())
             ),
         ))
+    }
+
+    /// The error of parameters whose mass-matrix bound is not finite (a NaN bound, "|S| < NaN",
+    /// means the inputs were bad): it names the one farthest outside its plausible range.
+    fn overflowing_parameter(&self) -> CoreError {
+        let i = self.inertia_array();
+        let candidates = [
+            ("geometry.fluid_density_kg_m3", self.geometry.get(HtParam::FluidDensity), "fluid_density_kg_m3"),
+            ("geometry.flow_area_m2", self.geometry.get(HtParam::FlowArea), "flow_area_m2"),
+            ("geometry.fluid_length_m", self.fluid_length_m, "fluid_length_m"),
+            ("inertia.pump_kg_m2", i[0], "inertia_kg_m2"),
+            ("inertia.turbine_kg_m2", i[1], "inertia_kg_m2"),
+            ("inertia.stator_kg_m2", i[2], "inertia_kg_m2"),
+        ];
+        let pairs: Vec<(f64, &str)> = candidates.iter().map(|&(_, v, q)| (v, q)).collect();
+        let (field, value, _) = candidates[crate::plausibility::farthest_outside(&pairs).unwrap_or(0)];
+        CoreError::new(
+            field,
+            value,
+            "a value at which the mass matrix's bound on the shape effects is finite (these parameters overflow ρL_f/A or ρ²S²/I; see the plausible ranges)",
+        )
     }
 
     fn constants(g: &HtGeometry<f64>) -> HtConst {
@@ -580,6 +591,15 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn a_non_finite_shape_effect_bound_names_the_parameter() {
+        let g = HtGeometry::appendix_d();
+        let tiny = Inertias::new(1e-310, 0.05, 0.02).unwrap();
+        let e = HtDynamics::new(g, tiny, 0.3, [0.01, 0.001, 0.001]).unwrap_err();
+        assert_eq!(e.field, "inertia.pump_kg_m2", "{e}");
+        assert!(!e.expected.contains("NaN"), "{e}");
     }
 
     #[test]

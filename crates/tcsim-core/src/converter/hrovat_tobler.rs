@@ -25,7 +25,7 @@
 //!
 //! The solvers are generic over [`Scalar`] so that the same code yields exact derivatives.
 
-use crate::error::{CoreError, CoreResult};
+use crate::error::{CoreError, CoreResult, InputSource};
 use crate::scalar::{Dual, Scalar};
 
 /// The fifteen parameters of Table 2.2 that fix the steady state, in SI units (angles in
@@ -140,6 +140,7 @@ impl HtGeometry<f64> {
             }
         }
         let g = Self { values };
+        g.check_finite()?;
         let dissipation = g.dissipation_coefficient();
         if dissipation <= 0.0 {
             return Err(CoreError::new(
@@ -149,6 +150,35 @@ impl HtGeometry<f64> {
             ));
         }
         Ok(g)
+    }
+
+    /// The steady states at the reference pump speed (stall and SR 0.5) must be finite: parameters
+    /// that overflow them (a density of 1e300 kg/m³, radii of 1e100 m) are refused, naming the one
+    /// farthest outside its plausible range ([`crate::plausibility`]).
+    fn check_finite(&self) -> CoreResult<()> {
+        let wp = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
+        let finite = [0.0, 0.5].iter().all(|&sr| match steady_state(self, wp, sr * wp) {
+            Ok(s) => s.is_finite(),
+            Err(e) => e.source != InputSource::Drive, // no steady state is the dissipation check's
+        });
+        if finite && self.dissipation_coefficient().is_finite() {
+            return Ok(());
+        }
+        let quantity = |p: HtParam| match p {
+            HtParam::FlowArea => "flow_area_m2",
+            HtParam::FluidDensity => "fluid_density_kg_m3",
+            HtParam::PumpExitRadius | HtParam::TurbineExitRadius | HtParam::StatorExitRadius => "radius_m",
+            p if p.is_angle() => "blade_angle_deg",
+            _ => "loss_coefficient",
+        };
+        let shown = |p: HtParam| if p.is_angle() { self.get(p).to_degrees() } else { self.get(p) };
+        let values: Vec<(f64, &str)> = HtParam::ALL.iter().map(|&p| (shown(p), quantity(p))).collect();
+        let p = crate::plausibility::farthest_outside(&values).map_or(HtParam::FluidDensity, |i| HtParam::ALL[i]);
+        Err(CoreError::new(
+            p.key(),
+            self.get(p),
+            "a value at which the steady state is finite (these parameters overflow it at 2000 rpm; see the plausible ranges)",
+        ))
     }
 
     /// Appendix D reference values (Li & Sundén 2016, Table D.1).
@@ -430,19 +460,41 @@ pub fn locked_steady_state<T: Scalar>(
     solve_mode(g, pump_speed_rad_s, turbine_speed_rad_s, StatorMode::Locked)
 }
 
+/// The operating point's errors are about the speeds asked for ([`InputSource::Drive`]).
 fn check_operating_point(wp: f64, wt: f64) -> CoreResult<()> {
     if !(wp.is_finite() && wp > 0.0) {
-        return Err(CoreError::new("pump_speed_rad_s", wp, "a finite, positive pump speed"));
+        return Err(CoreError::of(InputSource::Drive, "pump_speed_rad_s", wp, "a finite, positive pump speed"));
     }
     let sr = wt / wp;
     if !(0.0..=1.0).contains(&sr) {
-        return Err(CoreError::new(
+        return Err(CoreError::of(
+            InputSource::Drive,
             "speed_ratio",
             sr,
             "a speed ratio from 0 to 1: the Hrovat & Tobler steady state does not yet cover reverse turbine rotation or overrun",
         ));
     }
     Ok(())
+}
+
+impl<T: Scalar> HtSteadyState<T> {
+    /// Whether every value is finite (the steady state overflows at pump speeds above about
+    /// 1e150 rad/s, where ω² does).
+    fn is_finite(&self) -> bool {
+        [self.flow_m3_s, self.stator_speed_rad_s, self.pump_torque_nm, self.turbine_torque_nm, self.stator_torque_nm]
+            .iter()
+            .all(|x| x.re().is_finite())
+    }
+}
+
+/// The error of a steady state that overflowed: never reported as a mode (it was `no-flow`).
+fn overflow(wp: f64) -> CoreError {
+    CoreError::of(
+        InputSource::Drive,
+        "pump_speed_rad_s",
+        wp,
+        "a pump speed at which the steady state of these parameters is finite (it overflows: its torques grow as the speed squared)",
+    )
 }
 
 /// Steady state with the one-way clutch: locked while it holds (T_s ≥ 0), free-wheeling past the
@@ -461,10 +513,14 @@ pub fn steady_state<T: Scalar>(
             "an operating point where the locked-stator head exceeds the shock losses (no steady state with positive flow for these parameters)",
         )
     })?;
+    if !locked.is_finite() {
+        return Err(overflow(wp.re()));
+    }
     if locked.stator_torque_nm.re() >= 0.0 {
         return Ok(locked);
     }
     match solve_mode(g, wp, wt, StatorMode::FreeWheeling) {
+        Some(free) if !free.is_finite() => Err(overflow(wp.re())),
         Some(free) if free.stator_speed_rad_s.re() >= 0.0 => Ok(free),
         _ => Ok(HtSteadyState {
             flow_m3_s: T::cst(0.0),
@@ -515,6 +571,21 @@ pub fn coupling_point(g: &HtGeometry<f64>) -> Option<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_overflowing_steady_state_is_an_error_not_no_flow() {
+        let g = HtGeometry::appendix_d();
+        for wp in [1e155, 1e200, 1e300] {
+            for sr in [0.0, 0.5, 0.95, 1.0] {
+                let e = steady_state(&g, wp, sr * wp).unwrap_err();
+                assert_eq!((e.field.as_str(), e.source), ("pump_speed_rad_s", InputSource::Drive), "{wp} {sr}");
+            }
+        }
+        // below the overflow the modes are those of ordinary speeds
+        let s = steady_state(&g, 1e100, 0.0).unwrap();
+        assert_eq!(s.mode, StatorMode::Locked);
+        assert!(s.is_finite());
+    }
 
     const WP: f64 = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
 

@@ -29,6 +29,54 @@ fn number(spec: &dyn ModelSpec, key: &str) -> CoreResult<f64> {
 /// The model a specification describes: `kind` is `table`, `quasi-dynamic` or `hrovat-tobler`;
 /// the keys are those of `tcsim.transient.DynamicModel.spec`.
 pub fn build_model(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics + Send>> {
+    let model = build_unchecked(spec)?;
+    check_finite_model(spec, model.as_ref())?;
+    Ok(model)
+}
+
+/// The model at its steady stall point at the reference pump speed must have finite torques and
+/// a finite stored energy: a density of 8.4e-292 kg/m³ makes the quasi-dynamic model's flow, and so
+/// its energy, overflow. The error names the parameter of `spec` farthest outside its plausible
+/// range.
+fn check_finite_model(spec: &dyn ModelSpec, model: &dyn ConverterDynamics) -> CoreResult<()> {
+    let wp = REFERENCE_PUMP_SPEED_RAD_S;
+    let finite = match model.steady_point(wp, 0.0) {
+        Ok(p) => {
+            let (u, m) = (p.u, model.mass());
+            let f = model.forces(&u, 1.0);
+            let energy: f64 = (0..4).map(|i| (0..4).map(|j| 0.5 * u[i] * m[i][j] * u[j]).sum::<f64>()).sum();
+            u.iter().chain(f.iter()).all(|x| x.is_finite()) && energy.is_finite()
+        }
+        Err(_) => true, // the model's own checks report a missing steady state
+    };
+    if finite {
+        return Ok(());
+    }
+    // (spec key, the names of its values in errors, as the models' own checks name them, quantity)
+    let keys: [(&str, &[&str], &str); 4] = [
+        ("fluid_density_kg_m3", &["fluid_density_kg_m3"], "fluid_density_kg_m3"),
+        ("pump_exit_radius_m", &["pump_exit_radius_m"], "radius_m"),
+        ("fluid_length_m", &["geometry.fluid_length_m"], "fluid_length_m"),
+        ("inertia_kg_m2", &["inertia.pump_kg_m2", "inertia.turbine_kg_m2", "inertia.stator_kg_m2"], "inertia_kg_m2"),
+    ];
+    let mut values: Vec<(String, f64, &str)> = Vec::new();
+    for (key, names, quantity) in keys {
+        for (name, v) in names.iter().zip(spec.numbers(key).unwrap_or_default()) {
+            values.push((name.to_string(), v, quantity));
+        }
+    }
+    let pairs: Vec<(f64, &str)> = values.iter().map(|(_, v, q)| (*v, *q)).collect();
+    let i = crate::plausibility::farthest_outside(&pairs).unwrap_or(0);
+    let (field, value) =
+        values.get(i).map_or(("fluid_density_kg_m3".to_string(), f64::NAN), |(k, v, _)| (k.clone(), *v));
+    Err(CoreError::new(
+        field,
+        value,
+        "a value at which the model's torques and stored energy are finite (they overflow at stall and 2000 rpm; see the plausible ranges)",
+    ))
+}
+
+fn build_unchecked(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics + Send>> {
     let kind = spec.kind()?;
     let i = numbers(spec, "inertia_kg_m2", Some(3))?;
     let inertia = Inertias::new(i[0], i[1], i[2])?;

@@ -13,7 +13,7 @@
 //! SR = 1 gives, above 1, the end-point capacity (for Table C.1 a small positive CF): the
 //! steady-state sweeps therefore stay inside the table, and overrun needs a table that has it.
 
-use crate::error::{CoreError, CoreResult};
+use crate::error::{CoreError, CoreResult, InputSource};
 use crate::interp;
 
 /// A torque-converter characteristic: TR and CF against SR.
@@ -152,6 +152,14 @@ impl Characteristic {
         let l = self.lookup(sr);
         let tp = l.capacity_factor_nm_s2 * pump_speed_rad_s * pump_speed_rad_s.abs();
         let t_delivered = l.torque_ratio * tp;
+        if !(tp.is_finite() && t_delivered.is_finite() && (t_delivered - tp).is_finite()) {
+            return Err(CoreError::of(
+                InputSource::Drive,
+                "pump_speed_rad_s",
+                pump_speed_rad_s,
+                "a pump speed at which the steady torques are finite (they grow as the speed squared and overflow)",
+            ));
+        }
         Ok(TableOperatingPoint {
             speed_ratio: sr,
             torque_ratio: l.torque_ratio,

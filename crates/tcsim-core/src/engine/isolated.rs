@@ -42,7 +42,7 @@ use crate::engine::converter_events::{EventKind, Mode, Sample};
 use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
 use crate::engine::segment::SmoothSegment;
 use crate::engine::signal::Signal;
-use crate::error::{CoreError, InputSource};
+use crate::error::{sig, CoreError, InputSource};
 
 /// How the converter is driven (issue: drives a, b, c).
 #[derive(Debug, Clone)]
@@ -401,7 +401,10 @@ fn flow_sign_at_zero(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: 
 ///   turbine speed (bisection on SR in (0, 1]; the pump torque of a steady state falls with SR);
 /// * drive (c): the same with the turbine speed from `init` (default 0, a vehicle at rest).
 ///
-/// Values in `init` override the steady state.
+/// Values in `init` override the steady state. Every error names the input it comes from as data:
+/// [`InputSource::Initial`] for a value of `init`, [`InputSource::Drive`] for a value of the drive's
+/// first sample, with the field `initial <coordinate>`. A state at which the model's torques,
+/// power or stored energy are not finite is refused before the solver starts.
 pub fn initial_state(
     model: &dyn ConverterDynamics,
     drive: &Drive,
@@ -411,13 +414,69 @@ pub fn initial_state(
     let given_wt = drive.given(TURBINE).map(|s| s.value(t0));
     let given_wp = drive.given(PUMP).map(|s| s.value(t0));
     let wt = given_wt.or(init.turbine_speed_rad_s).unwrap_or(0.0);
+    let wt_source = if given_wt.is_none() && init.turbine_speed_rad_s.is_some() {
+        InputSource::Initial
+    } else {
+        InputSource::Drive
+    };
+    check_initial_value(&[("turbine_speed_rad_s", wt)], wt_source)?;
     let wp = match (given_wp, init.pump_speed_rad_s) {
-        (Some(w), _) | (None, Some(w)) => w,
+        (Some(w), _) => w,
+        (None, Some(w)) => {
+            check_initial_value(&[("pump_speed_rad_s", w)], InputSource::Initial)?;
+            w
+        }
         (None, None) => {
             let tp = drive.pump_torque().map_or(0.0, |s| s.value(t0));
-            steady_pump_speed(model, tp, wt)?
+            steady_pump_speed(model, tp, wt, wt_source)?
         }
     };
+    // the speeds the steady state starts from: the drive's unless the user gave one
+    let from_init = (given_wp.is_none() && init.pump_speed_rad_s.is_some()) || wt_source == InputSource::Initial;
+    let speeds_source = if from_init { InputSource::Initial } else { InputSource::Drive };
+    let u = steady_start(model, wp, wt, init, speeds_source)?;
+    let source_of = |c: usize| {
+        let given_by_init = match c {
+            PUMP => given_wp.is_none() && init.pump_speed_rad_s.is_some(),
+            TURBINE => wt_source == InputSource::Initial,
+            STATOR => init.stator_speed_rad_s.is_some(),
+            _ => init.flow_m3_s.is_some(),
+        };
+        if given_by_init {
+            InputSource::Initial
+        } else {
+            speeds_source
+        }
+    };
+    for c in 0..4 {
+        if !u[c].is_finite() {
+            return Err(
+                CoreError::of(source_of(c), format!("initial {}", COORDINATES[c]), u[c], "a finite value").into()
+            );
+        }
+    }
+    if model.has_stator_clutch() && u[STATOR] < 0.0 {
+        return Err(CoreError::of(
+            InputSource::Initial,
+            "initial stator_speed_rad_s",
+            u[STATOR],
+            "zero or more: the one-way clutch stops backward rotation",
+        )
+        .into());
+    }
+    check_finite_state(model, &u, source_of)?;
+    Ok(u)
+}
+
+/// The steady state at the speeds `wp`, `wt` (an error about `source` when there is none), with
+/// the values of `init` and the absent coordinates zero.
+fn steady_start(
+    model: &dyn ConverterDynamics,
+    wp: f64,
+    wt: f64,
+    init: &InitialState,
+    source: InputSource,
+) -> TransientResult<Vec4> {
     let mut u = if init.flow_m3_s.is_some() && init.stator_speed_rad_s.is_some() {
         [wp, wt, 0.0, 0.0]
     } else {
@@ -425,8 +484,8 @@ pub fn initial_state(
             .steady_point(wp, wt)
             .map_err(|e| {
                 CoreError::of(
-                    InputSource::Initial,
-                    format!("initial state: {}", e.field),
+                    source,
+                    format!("initial {}", e.field),
                     e.value,
                     format!("{}; give the initial state explicitly", e.expected),
                 )
@@ -447,31 +506,55 @@ pub fn initial_state(
             u[c] = 0.0;
         }
     }
-    for (name, v) in [
-        ("initial pump_speed_rad_s", u[0]),
-        ("initial turbine_speed_rad_s", u[1]),
-        ("initial stator_speed_rad_s", u[2]),
-        ("initial flow_m3_s", u[3]),
-    ] {
-        if !v.is_finite() {
-            return Err(CoreError::of(InputSource::Initial, name, v, "a finite value").into());
-        }
-    }
-    if model.has_stator_clutch() && u[STATOR] < 0.0 {
-        return Err(CoreError::of(
-            InputSource::Initial,
-            "initial stator_speed_rad_s",
-            u[STATOR],
-            "zero or more: the one-way clutch stops backward rotation",
-        )
-        .into());
-    }
     Ok(u)
 }
 
+/// The coordinates' names, with units, in the order of `u`.
+const COORDINATES: [&str; 4] = ["pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s"];
+
+/// Finite values (a NaN or an infinite speed from a drive or `init`).
+fn check_initial_value(values: &[(&str, f64)], source: InputSource) -> TransientResult<()> {
+    match values.iter().find(|(_, v)| !v.is_finite()) {
+        Some((name, v)) => Err(CoreError::of(source, format!("initial {name}"), v, "a finite value").into()),
+        None => Ok(()),
+    }
+}
+
+/// The model's torques, power and stored energy at `u` must be finite (a speed of 1e300 rad/s is a
+/// finite number whose torques are not): the error blames the coordinate farthest outside its
+/// plausible range ([`crate::plausibility`]), whose source `source_of` gives.
+fn check_finite_state(
+    model: &dyn ConverterDynamics,
+    u: &Vec4,
+    source_of: impl Fn(usize) -> InputSource,
+) -> TransientResult<()> {
+    let f = model.forces(u, if u[FLOW] < 0.0 { -1.0 } else { 1.0 });
+    let m = model.mass();
+    let energy: f64 = (0..4).map(|i| (0..4).map(|j| 0.5 * u[i] * m[i][j] * u[j]).sum::<f64>()).sum();
+    let power: f64 = (0..4).map(|i| f[i] * u[i]).sum();
+    if f.iter().all(|x| x.is_finite()) && energy.is_finite() && power.is_finite() {
+        return Ok(());
+    }
+    let scale = |c: usize| {
+        let q = if c == FLOW { "flow_m3_s" } else { "speed_rad_s" };
+        crate::plausibility::range(q).map_or(1.0, |r| r.high)
+    };
+    let c = (0..4).max_by(|&a, &b| (u[a] / scale(a)).abs().total_cmp(&(u[b] / scale(b)).abs())).unwrap_or(PUMP);
+    let range = crate::plausibility::range(if c == FLOW { "flow_m3_s" } else { "speed_rad_s" });
+    let plausible =
+        range.map_or(String::new(), |r| format!(" (plausible: {} to {} {})", sig(r.low), sig(r.high), r.unit));
+    let expected = format!("a value at which the model's torques, power and stored energy are finite{plausible}");
+    Err(CoreError::of(source_of(c), format!("initial {}", COORDINATES[c]), u[c], expected).into())
+}
+
 /// The pump speed at which the steady-state pump torque equals `pump_torque_nm` at turbine
-/// speed `wt` ≥ 0.
-fn steady_pump_speed(model: &dyn ConverterDynamics, pump_torque_nm: f64, wt: f64) -> TransientResult<f64> {
+/// speed `wt` ≥ 0 (from the input `wt_source`).
+fn steady_pump_speed(
+    model: &dyn ConverterDynamics,
+    pump_torque_nm: f64,
+    wt: f64,
+    wt_source: InputSource,
+) -> TransientResult<f64> {
     let bad = |expected: &str| {
         TransientError::Input(CoreError::of(
             InputSource::Drive,
@@ -480,18 +563,40 @@ fn steady_pump_speed(model: &dyn ConverterDynamics, pump_torque_nm: f64, wt: f64
             expected.to_string(),
         ))
     };
-    if pump_torque_nm.is_nan() || pump_torque_nm <= 0.0 {
+    if !pump_torque_nm.is_finite() || pump_torque_nm <= 0.0 {
         return Err(bad(
             "a positive pump torque at the start for a steady initial state; give the initial pump speed explicitly",
         ));
     }
-    if wt.is_nan() || wt < 0.0 {
-        return Err(bad("a turbine speed of zero or more at the start for a steady initial state; give the initial pump speed explicitly"));
+    if wt < 0.0 {
+        return Err(CoreError::of(
+            wt_source,
+            "initial turbine_speed_rad_s",
+            wt,
+            "a turbine speed of zero or more at the start for a steady initial state; give the initial pump speed explicitly",
+        )
+        .into());
     }
-    let torque_at = |wp: f64| model.steady_point(wp, wt).map(|p| p.pump_torque_nm);
+    // a failure of the steady state itself: no steady state at this turbine speed
+    let torque_at = |wp: f64| {
+        model.steady_point(wp, wt).map(|p| p.pump_torque_nm).map_err(|e| {
+            TransientError::from(CoreError::of(
+                wt_source,
+                format!("initial {}", e.field),
+                e.value,
+                format!("{}; give the initial pump speed explicitly", e.expected),
+            ))
+        })
+    };
     if wt == 0.0 {
         let t1 = torque_at(1.0)?;
-        return Ok((pump_torque_nm / t1).sqrt());
+        let wp = (pump_torque_nm / t1).sqrt();
+        if !wp.is_finite() {
+            return Err(bad(
+                "a pump torque for which the steady pump speed is finite; give the initial pump speed explicitly",
+            ));
+        }
+        return Ok(wp);
     }
     // pump torque falls with SR: bisect on SR in (0, 1]
     let f = |sr: f64| -> TransientResult<f64> { Ok(torque_at(wt / sr)? - pump_torque_nm) };
@@ -524,17 +629,24 @@ pub fn simulate(
     init: &InitialState,
     options: &SolverOptions,
 ) -> TransientResult<Trajectory> {
-    check_times(times_s)?;
+    check_times(times_s, true)?;
     let t0 = times_s[0];
     let u0 = initial_state(model, drive, t0, init)?;
     let mode = initial_mode(model, drive, &u0, t0);
     simulate_from(model, drive, times_s, u0, mode, options)
 }
 
-fn check_times(times_s: &[f64]) -> TransientResult<()> {
+/// At least two finite, increasing output times; a run's own (`resolution`) also no closer than the
+/// time resolution ([`crate::engine::signal::check_time_stamps`]), which internal runs such as the
+/// co-simulation stepper's probe need not be.
+fn check_times(times_s: &[f64], resolution: bool) -> TransientResult<()> {
     if times_s.len() < 2 {
         let n = format!("{} samples", times_s.len());
         return Err(CoreError::of(InputSource::Drive, "time_s", n, "at least two output times").into());
+    }
+    if resolution {
+        return crate::engine::signal::check_time_stamps("time_s", times_s)
+            .map_err(|e| e.about(InputSource::Drive).into());
     }
     if let Some(i) = times_s.iter().position(|t| !t.is_finite()) {
         return Err(CoreError::of(InputSource::Drive, format!("time_s[{i}]"), times_s[i], "finite times").into());
@@ -555,15 +667,28 @@ pub fn simulate_from(
     mode0: Mode,
     options: &SolverOptions,
 ) -> TransientResult<Trajectory> {
-    check_times(times_s)?;
+    check_times(times_s, false)?;
     let t_end = *times_s.last().unwrap_or(&0.0);
-    let mut traj = Trajectory { samples: Vec::with_capacity(times_s.len()), ..Default::default() };
+    let mut traj = Trajectory::default();
+    crate::engine::options::try_reserve(&mut traj.samples, times_s.len())?;
     let (mut t, mut u, mut mode) = (times_s[0], u0, mode0);
     loop {
         let seg = Segment::new(model, drive, mode);
         let integrated = t < t_end;
         match run_segment(&seg, &u, t, t_end, times_s, options, &mut traj)? {
             None => {
+                if traj.samples.len() < times_s.len() {
+                    let t_last = traj.samples.last().map_or(times_s[0], |s| s.time_s);
+                    return Err(TransientError::Solver {
+                        time_s: t_last,
+                        state: u.to_vec(),
+                        message: format!(
+                            "the solver stopped before the last output time ({} of {} samples)",
+                            traj.samples.len(),
+                            times_s.len()
+                        ),
+                    });
+                }
                 traj.end_state = match traj.samples.last() {
                     Some(s) if integrated => s.u,
                     _ => u,

@@ -1,6 +1,6 @@
 //! Solver options and the error type of the transient engines (isolated converter and vehicle).
 
-use crate::error::CoreError;
+use crate::error::{sig, CoreError, CoreResult, InputSource};
 
 /// Tolerances and limits of the BDF solver.
 #[derive(Debug, Clone, Copy)]
@@ -18,6 +18,66 @@ pub struct SolverOptions {
     /// freshly switched zero (Q = 0, ω_s = 0) from firing the event back, and it is far below the
     /// tolerances of the results.
     pub hysteresis: Hysteresis,
+    /// The most memory a batch's outputs may take, bytes ([`DEFAULT_MAX_OUTPUT_BYTES`]): the
+    /// estimate of [`check_output_size`] is compared with it before anything runs.
+    pub max_output_bytes: f64,
+}
+
+/// Default of [`SolverOptions::max_output_bytes`]: 2 GB. A launch of 30 s sampled every 10 ms takes
+/// 0.6 MB, a replay of a million samples with three models about 1 GB.
+pub const DEFAULT_MAX_OUTPUT_BYTES: f64 = 2e9;
+
+/// Bytes of one output value (f64).
+pub const BYTES_PER_VALUE: usize = 8;
+
+/// The size of a batch's output before it runs: `runs` runs of at most `samples` samples each, each
+/// sample a trajectory state of `state_bytes` plus `columns` output values, and up to `max_events`
+/// events of `event_bytes` per run.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutputSize {
+    pub runs: usize,
+    pub samples: f64,
+    pub columns: usize,
+    pub state_bytes: usize,
+    pub max_events: usize,
+    pub event_bytes: usize,
+}
+
+impl OutputSize {
+    /// The estimate, bytes.
+    pub fn bytes(&self) -> f64 {
+        let per_sample = (self.columns * BYTES_PER_VALUE + self.state_bytes) as f64;
+        self.runs as f64 * (self.samples * per_sample + ((self.max_events + 1) * self.event_bytes) as f64)
+    }
+
+    /// Refuse an output above `limit` bytes: an error about `source` (the input whose length or
+    /// sampling makes the output: the drive's times, the scenario's end time, the output step) naming
+    /// the sizes, the limit, and how to raise it or lower the sampling.
+    pub fn check(&self, source: InputSource, limit: f64) -> CoreResult<()> {
+        let bytes = self.bytes();
+        if bytes <= limit {
+            return Ok(());
+        }
+        let expected = format!(
+            "an output of at most max_output_bytes = {} bytes, but {} run(s) × {} samples × ({} columns × {BYTES_PER_VALUE} + {} bytes of state) need {} bytes: lower the sampling (fewer output times, a larger output step, a shorter run) or raise the solver option max_output_bytes",
+            sig(limit),
+            self.runs,
+            sig(self.samples),
+            self.columns,
+            self.state_bytes,
+            sig(bytes)
+        );
+        Err(CoreError::of(source, "output_samples", format!("{:.0}", self.samples), expected))
+    }
+}
+
+/// Reserve room for `n` more items, an error instead of an abort when the memory is not there.
+pub fn try_reserve<T>(v: &mut Vec<T>, n: usize) -> TransientResult<()> {
+    v.try_reserve_exact(n).map_err(|_| {
+        let bytes = n as f64 * std::mem::size_of::<T>() as f64;
+        let expected = "an output that fits in memory (allocating it failed): lower the sampling or max_output_bytes";
+        TransientError::Input(CoreError::of(InputSource::Options, "output_bytes", sig(bytes), expected))
+    })
 }
 
 /// See [`SolverOptions::hysteresis`].
@@ -39,6 +99,7 @@ impl Default for SolverOptions {
             max_events: 10_000,
             max_steps: 2_000_000,
             hysteresis: Hysteresis { flow_m3_s: 1e-7, stator_speed_rad_s: 1e-4, stator_torque_nm: 1e-6, head_pa: 1e-3 },
+            max_output_bytes: DEFAULT_MAX_OUTPUT_BYTES,
         }
     }
 }
@@ -67,12 +128,56 @@ impl std::fmt::Display for TransientError {
                 let shown: Vec<String> = state
                     .iter()
                     .enumerate()
-                    .map(|(i, v)| format!("{} = {v:.6}", names.get(i).copied().unwrap_or("x")))
+                    .map(|(i, v)| format!("{} = {}", names.get(i).copied().unwrap_or("x"), sig(*v)))
                     .collect();
-                write!(f, "solver failed at t = {time_s:.6} s ({}): {message}", shown.join(", "))
+                write!(f, "solver failed at t = {} s ({}): {message}", sig(*time_s), shown.join(", "))
             }
         }
     }
 }
 
 pub type TransientResult<T> = Result<T, TransientError>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_output_size_is_estimated_and_capped() {
+        // two-row scenario of 1e5 s at 10 ms: 1e7 samples × 45 columns, 3.6 GB of columns alone
+        let size =
+            OutputSize { runs: 1, samples: 1e7 + 1.0, columns: 45, state_bytes: 0, max_events: 0, event_bytes: 0 };
+        assert!((size.bytes() - (1e7 + 1.0) * 360.0).abs() < 1.0);
+        let e = size.check(InputSource::Scenario, DEFAULT_MAX_OUTPUT_BYTES).unwrap_err();
+        assert_eq!(
+            (e.source, e.field.as_str(), e.value.as_str()),
+            (InputSource::Scenario, "output_samples", "10000001")
+        );
+        assert!(
+            e.expected.contains("max_output_bytes = 2e9 bytes") && e.expected.contains("need 3.6e9 bytes"),
+            "{}",
+            e.expected
+        );
+        assert!(size.check(InputSource::Scenario, 4e9).is_ok(), "raising the limit lets it run");
+        let small = OutputSize {
+            runs: 20,
+            samples: 3001.0,
+            columns: 45,
+            state_bytes: 400,
+            max_events: 10_000,
+            event_bytes: 48,
+        };
+        assert!(small.check(InputSource::Options, DEFAULT_MAX_OUTPUT_BYTES).is_ok());
+        let mut v: Vec<f64> = Vec::new();
+        let e = try_reserve(&mut v, usize::MAX / 8).unwrap_err();
+        assert!(matches!(e, TransientError::Input(ref c) if c.field == "output_bytes"), "{e}");
+        assert!(try_reserve(&mut v, 10).is_ok());
+    }
+
+    #[test]
+    fn solver_messages_print_six_digits() {
+        let e =
+            TransientError::Solver { time_s: 1e5 + 1e-9, state: vec![1e300, 50.0, 0.0, 0.0745], message: "m".into() };
+        assert_eq!(e.to_string(), "solver failed at t = 100000 s (ω_p = 1e300, ω_t = 50, ω_s = 0, Q = 0.0745): m");
+    }
+}

@@ -15,6 +15,7 @@
 use crate::converter::dynamics::{ConverterDynamics, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::Sample;
 use crate::engine::isolated::Trajectory;
+use crate::engine::options::{try_reserve, OutputSize, SolverOptions, TransientResult};
 
 /// Column names, in order.
 pub const COLUMNS: [&str; 27] = [
@@ -111,13 +112,32 @@ pub fn row(model: &dyn ConverterDynamics, s: &Sample) -> [f64; 27] {
     ]
 }
 
-/// The run as columns in the order of [`COLUMNS`] (see [`row`]).
-pub fn columns(model: &dyn ConverterDynamics, traj: &Trajectory) -> Vec<Vec<f64>> {
-    let mut cols: Vec<Vec<f64>> = (0..COLUMNS.len()).map(|_| Vec::with_capacity(traj.samples.len())).collect();
+/// The size of the output of `runs` isolated runs of `samples` output times each (see
+/// [`OutputSize`]): the binding checks a batch with it before running.
+pub fn isolated_output_size(runs: usize, samples: usize, options: &SolverOptions) -> OutputSize {
+    OutputSize {
+        runs,
+        samples: samples as f64,
+        columns: COLUMNS.len(),
+        state_bytes: std::mem::size_of::<Sample>(),
+        max_events: options.max_events,
+        event_bytes: std::mem::size_of::<crate::engine::isolated::Event>(),
+    }
+}
+
+/// The run as columns in the order of [`COLUMNS`] (see [`row`]); an error, not an abort, when
+/// their memory cannot be had.
+pub fn columns(model: &dyn ConverterDynamics, traj: &Trajectory) -> TransientResult<Vec<Vec<f64>>> {
+    let mut cols: Vec<Vec<f64>> = Vec::new();
+    for _ in 0..COLUMNS.len() {
+        let mut c = Vec::new();
+        try_reserve(&mut c, traj.samples.len())?;
+        cols.push(c);
+    }
     for s in &traj.samples {
         for (c, v) in cols.iter_mut().zip(row(model, s)) {
             c.push(v);
         }
     }
-    cols
+    Ok(cols)
 }

@@ -49,7 +49,7 @@ impl<M: ConverterDynamics> Stepper<M> {
     }
 
     fn drive(&self, t: [f64; 2], a: [f64; 2], b: [f64; 2]) -> TransientResult<Drive> {
-        let sig = |name: &str, i: usize| Signal::new(name, t.to_vec(), vec![a[i], b[i]], 0.0);
+        let sig = |name: &str, i: usize| Signal::interval(name, t, [a[i], b[i]]);
         Ok(match self.causality {
             Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
                 pump_torque_nm: sig("pump_torque_nm", 0)?,

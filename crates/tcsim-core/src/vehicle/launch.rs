@@ -10,7 +10,7 @@ use super::plant::{kinetic_energy, Coords, LaunchSample, Plant};
 use super::{GEARBOX_OUT, N_COORDS, SPEED, TORQUE_BOOST, TORQUE_FAST, TWIST_F, TWIST_R};
 use crate::converter::dynamics::{ConverterDynamics, PUMP, TURBINE};
 use crate::engine::converter_events::{self, Mode as ConverterMode};
-use crate::engine::options::{SolverOptions, TransientError, TransientResult};
+use crate::engine::options::{try_reserve, OutputSize, SolverOptions, TransientError, TransientResult};
 use crate::engine::segment::{run_segment, SmoothSegment};
 use crate::error::{CoreError, CoreResult, InputSource};
 
@@ -180,19 +180,53 @@ fn pending_switch(plant: &Plant, u: &Coords, t: f64) -> Option<Root> {
     None
 }
 
-/// The output times of a launch (validating the vehicle, the end time and the step).
-fn output_times(v: &Vehicle, sc: &Scenario, output_step_s: f64) -> TransientResult<Vec<f64>> {
-    v.validate().map_err(|e| e.about(InputSource::Vehicle))?;
+/// The default output step of a launch, s (the binding's `output_step_s`).
+pub const DEFAULT_OUTPUT_STEP_S: f64 = 0.01;
+
+/// The number of output samples of a launch of `sc` every `output_step_s` (validating the end time
+/// and the step, which must be no finer than the time resolution
+/// [`crate::engine::signal::time_resolution_s`] at the end time).
+pub fn launch_output_samples(sc: &Scenario, output_step_s: f64) -> CoreResult<f64> {
     if !(sc.end_time_s.is_finite() && sc.end_time_s > 0.0) {
-        let e = CoreError::of(InputSource::Scenario, "end_time_s", sc.end_time_s, "a finite, positive end time");
-        return Err(e.into());
+        return Err(CoreError::of(InputSource::Scenario, "end_time_s", sc.end_time_s, "a finite, positive end time"));
     }
-    if !(output_step_s.is_finite() && output_step_s > 0.0) {
-        let expected = "a finite, positive output step";
-        return Err(CoreError::of(InputSource::Options, "output_step_s", output_step_s, expected).into());
+    let resolution = crate::engine::signal::time_resolution_s(sc.end_time_s);
+    if !(output_step_s.is_finite() && output_step_s >= resolution) {
+        let expected = format!(
+            "a finite output step of at least {} s (the time resolution: 1 µs, or 1024 ulp of the end time when coarser)",
+            crate::error::sig(resolution)
+        );
+        return Err(CoreError::of(InputSource::Options, "output_step_s", output_step_s, expected));
     }
-    let n_out = (sc.end_time_s / output_step_s).round() as usize + 1;
-    Ok((0..n_out).map(|i| (i as f64 * output_step_s).min(sc.end_time_s)).collect())
+    Ok((sc.end_time_s / output_step_s).round() + 1.0)
+}
+
+/// The size of the output of `runs` launches of `sc` every `output_step_s`, checked against the
+/// limit of `options` before anything runs: an error about the scenario (its end time), or about
+/// the options when the output step is finer than the default.
+pub fn check_launch_output(sc: &Scenario, output_step_s: f64, runs: usize, options: &SolverOptions) -> CoreResult<()> {
+    let size = OutputSize {
+        runs,
+        samples: launch_output_samples(sc, output_step_s)?,
+        columns: super::outputs::launch_column_names().len(),
+        state_bytes: std::mem::size_of::<LaunchSample>(),
+        max_events: options.max_events,
+        event_bytes: std::mem::size_of::<VehicleEvent>(),
+    };
+    let source = if output_step_s < DEFAULT_OUTPUT_STEP_S { InputSource::Options } else { InputSource::Scenario };
+    size.check(source, options.max_output_bytes)
+}
+
+/// The output times of a launch (validating the vehicle, the end time, the step and the output's
+/// size).
+fn output_times(v: &Vehicle, sc: &Scenario, output_step_s: f64, options: &SolverOptions) -> TransientResult<Vec<f64>> {
+    v.validate().map_err(|e| e.about(InputSource::Vehicle))?;
+    check_launch_output(sc, output_step_s, 1, options)?;
+    let n_out = launch_output_samples(sc, output_step_s)? as usize;
+    let mut times = Vec::new();
+    try_reserve(&mut times, n_out)?;
+    times.extend((0..n_out).map(|i| (i as f64 * output_step_s).min(sc.end_time_s)));
+    Ok(times)
 }
 
 /// The mode of the braked standstill: first gear, lock-up open, the wheels held while the brake
@@ -217,10 +251,11 @@ pub fn simulate_launch(
     output_step_s: f64,
     options: &SolverOptions,
 ) -> TransientResult<LaunchTrajectory> {
-    let times = output_times(v, sc, output_step_s)?;
+    let times = output_times(v, sc, output_step_s, options)?;
     let u0 = initial_state(model, v, sc)?;
     let mut mode = initial_mode(model, sc);
     let mut traj = LaunchTrajectory::default();
+    try_reserve(&mut traj.samples, times.len())?;
     let (mut t, mut u, mut sync) = (0.0, u0, 1.0);
     let mut energy_before: Option<f64> = None;
     loop {

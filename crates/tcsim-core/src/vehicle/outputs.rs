@@ -5,6 +5,7 @@ use super::modes::LockupState;
 use super::parameters::Scenario;
 use super::{FRONT, GEARBOX_OUT, REAR, SPEED};
 use crate::converter::dynamics::ConverterDynamics;
+use crate::engine::options::{try_reserve, TransientResult};
 
 /// Columns of a launch after the converter's [`crate::engine::outputs::COLUMNS`] (whose `pump_*` refer to
 /// the converter pump, which turns with the engine).
@@ -42,9 +43,19 @@ pub fn launch_column_names() -> Vec<&'static str> {
 
 /// The run as columns in the order of [`launch_column_names`]. `gear` is 1-based (the off-going
 /// gear during a shift); `lockup_state` is 0 open, 1 slipping, 2 locked.
-pub fn launch_columns(model: &dyn ConverterDynamics, sc: &Scenario, traj: &LaunchTrajectory) -> Vec<Vec<f64>> {
+/// An error, not an abort, when their memory cannot be had.
+pub fn launch_columns(
+    model: &dyn ConverterDynamics,
+    sc: &Scenario,
+    traj: &LaunchTrajectory,
+) -> TransientResult<Vec<Vec<f64>>> {
     let names = launch_column_names();
-    let mut cols: Vec<Vec<f64>> = (0..names.len()).map(|_| Vec::with_capacity(traj.samples.len())).collect();
+    let mut cols: Vec<Vec<f64>> = Vec::new();
+    for _ in 0..names.len() {
+        let mut c = Vec::new();
+        try_reserve(&mut c, traj.samples.len())?;
+        cols.push(c);
+    }
     let mut booked = 0.0;
     let mut next_event = 0;
     for s in &traj.samples {
@@ -82,5 +93,5 @@ pub fn launch_columns(model: &dyn ConverterDynamics, sc: &Scenario, traj: &Launc
             c.push(*v);
         }
     }
-    cols
+    Ok(cols)
 }
