@@ -54,11 +54,21 @@ def _derived(df: pd.DataFrame) -> pd.DataFrame:
     return df
 
 
+#: The slowest pump speed of a characterisation, rpm: far below any use, and above the speeds whose
+#: torques (∝ ω²) underflow and leave the capacity factor 0/0.
+MIN_PUMP_SPEED_RPM = 1.0
+
+
 def _check_speed(pump_speed_rpm: float, allow_implausible: bool = False) -> float:
     """The pump speed in rad/s: finite and positive, and plausible (``speed_rad_s``) unless
     ``allow_implausible`` (``--allow-implausible``), which warns instead."""
-    if not (np.isfinite(pump_speed_rpm) and pump_speed_rpm > 0):
-        raise InputError("command line", "--pump-speed-rpm", pump_speed_rpm, "a finite, positive pump speed in rpm")
+    if not (np.isfinite(pump_speed_rpm) and pump_speed_rpm >= MIN_PUMP_SPEED_RPM):
+        raise InputError(
+            "command line",
+            "--pump-speed-rpm",
+            pump_speed_rpm,
+            f"a finite pump speed of at least {MIN_PUMP_SPEED_RPM:g} rpm (below it the torques underflow)",
+        )
     check_plausible_rpm(pump_speed_rpm, "command line", "--pump-speed-rpm", allow_implausible)
     return pump_speed_rpm * RAD_S_PER_RPM
 
