@@ -113,7 +113,8 @@ threads = next(l for l in Path("/proc/self/status").read_text().splitlines() if 
 print(threads.split()[1], flush=True)
 with _signals_raise() if sys.argv[1] == "SIGTERM" else nullcontext():  # Python's own Ctrl-C otherwise
     try:
-        _core.launch_runs([spec] * 200_000, veh.core, flip_flop().core_spec(), {"output_step_s": 0.5}, 0)
+        options = {"output_step_s": 0.5, "max_output_bytes": 1e13}  # hours of runs, never all in memory
+        _core.launch_runs([spec] * 200_000, veh.core, flip_flop().core_spec(), options, 0)
     except KeyboardInterrupt as e:
         print("raised by the call:", type(e).__name__, flush=True)
         sys.exit(3)

@@ -260,8 +260,8 @@ def _non_finite_input(drive, initial, rtol) -> bool:
     rtol=st.one_of(st.none(), st.sampled_from([1e-6, 1e-4]), refused),
 )
 def test_simulate_raises_only_input_or_solver_errors(model, drive, initial, rtol):
-    # defect 8 (issue 10): a non-finite drive or initial value can end as a SolverError; and defect 6:
-    # values beyond 1e6 give non-finite results; see the two xfail tests below
+    # non-finite drive or initial values (an input error since issue 10) and values beyond 1e6 (defect
+    # 6, non-finite results: the xfail test below) have their own tests
     assume(not _non_finite_input(drive, initial, rtol) and not _huge_input(drive, initial))
     simulate_outcome(model, drive, initial, rtol)
 
@@ -282,9 +282,6 @@ def test_simulate_refuses_huge_inputs_or_gives_finite_results(model, drive, init
     simulate_outcome(model, drive, initial, rtol)
 
 
-@pytest.mark.xfail(
-    strict=True, reason="defect 8 of issue 10: a NaN constant drive signal is a SolverError, not an input error"
-)
 @given(model=st.sampled_from(MODELS), drive=drives_api, initial=initials, rtol=st.none())
 @example(
     model="table",

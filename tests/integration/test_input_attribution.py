@@ -74,7 +74,9 @@ def test_a_scenario_that_makes_the_output_too_large_names_the_scenario_file(tmp_
     pd.DataFrame({"time_s": [0.0, 1e5], "accelerator_pedal": [0.0, 1.0], "brake_pedal": [1.0, 0.0]}).to_csv(
         scenario, index=False
     )
-    assert main(["launch", "--scenario", str(scenario), "--model", "table", "--out", str(tmp_path / "o")]) == 2
-    line = _error_line(capsys)
+    args = ["launch", "--scenario", str(scenario), "--model", "table", "--out", str(tmp_path / "o")]
+    assert main([*args, "--allow-implausible"]) == 2  # a 1e5 s scenario is implausible: past that, too big
+    warning, line = capsys.readouterr().err.strip().splitlines()  # the override's warning, then the error
+    assert warning.startswith(f"warning: {scenario}: time_s (time span, s) = 100000 is outside"), warning
     assert line.startswith(f"error: {scenario}: output_samples = 1e+07: expected an output of at most"), line
     assert "max_output_bytes" in line and not (tmp_path / "o").exists()

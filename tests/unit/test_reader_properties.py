@@ -72,8 +72,8 @@ def assert_finite(where: str, *arrays: Any) -> None:
 
 
 def capacity_underflow(conv: Converter | None) -> bool:
-    """The known defect (issue 10, found here): a positive capacity that underflows to a capacity
-    factor of 0 on conversion (MP1000 5e-324, a K-factor of 1e200) is accepted."""
+    """A positive capacity that underflowed to a capacity factor of 0 on conversion (MP1000 5e-324,
+    a K-factor of 1e200): accepted before issue 10, refused since."""
     c = conv.characteristic if conv is not None else None
     return c is not None and bool(np.any(c.capacity_factor_nm_s2[c.speed_ratio < 1.0] == 0.0))
 
@@ -206,7 +206,6 @@ def test_table_csv_is_read_or_refused_in_one_line(text):
         path = d / "table.csv"
         path.write_text(text, encoding="utf-8")
         conv = outcome(lambda: load_converter(path), str(path))
-        assume(not capacity_underflow(conv))  # the xfail test below
         if conv is not None:
             assert conv.characteristic is not None
             check_characteristic(conv.characteristic)
@@ -218,13 +217,11 @@ def test_vtcc_is_read_or_refused_in_one_line(text):
         path = d / "table.vtcc"
         path.write_text(text, encoding="utf-8")
         conv = outcome(lambda: load_converter(path), str(path))
-        assume(not capacity_underflow(conv))  # the xfail test below
         if conv is not None:
             assert conv.characteristic is not None
             check_characteristic(conv.characteristic)
 
 
-@pytest.mark.xfail(strict=True, reason="new (issue 10): a capacity that underflows to 0 on conversion is accepted")
 @given(text=st.sampled_from(["Speed Ratio, Torque Ratio,MP1000\n0.0,1.0,5e-324\n1,0.0,0.0\n"]))
 @example(text="speed_ratio,torque_ratio,k_factor_rad_s_per_sqrt_nm\n0.0,2.0,1e200\n0.5,1.5,15\n1.0,1.0,35\n")
 def test_capacity_underflowing_on_conversion_is_refused(text):
@@ -376,7 +373,7 @@ items = st.lists(st.text(max_size=30), max_size=3)
 
 @pytest.mark.parametrize(
     ("parse", "source"),
-    [(parse_initial, "command line"), (parse_channel_map, "--channel"), (parse_bounds, "command line")],
+    [(parse_initial, "command line"), (parse_channel_map, "command line"), (parse_bounds, "command line")],
     ids=["--initial", "--channel", "--bound"],
 )
 @given(values=items)
