@@ -18,13 +18,7 @@ from ..analysis.replay import Replay
 from ..errors import TcsimWarning
 from ..models.characteristic import Characteristic
 from ..models.converter import Converter, parse_converter
-
-#: Columns that may hold ±inf by definition: the K-factor is infinite where the capacity is zero.
-INFINITE_ALLOWED: frozenset[str] = frozenset({"k_factor_rpm_per_sqrt_nm"})
-#: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies): a run that has
-#: such a quantity never leaves it NaN at some samples; ratios, times not reached and metrics may be
-#: NaN where undefined.
-NAN_NOT_EXPECTED: tuple[str, ...] = ("_rad_s", "_nm", "_m3_s", "_w", "_j")
+from ..simulation.transient import INFINITE_ALLOWED, NAN_NOT_EXPECTED
 
 
 def _partly_nan(df: pd.DataFrame, name: str) -> np.ndarray:

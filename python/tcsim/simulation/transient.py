@@ -73,6 +73,29 @@ def _options(rtol: float | None, **extra) -> dict[str, Any]:
     return o
 
 
+#: Columns that may hold ±inf by definition: the K-factor is infinite where the capacity is zero.
+INFINITE_ALLOWED: frozenset[str] = frozenset({"k_factor_rpm_per_sqrt_nm"})
+#: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies): a run that has
+#: such a quantity never leaves it NaN at some samples; ratios, times not reached and metrics may be
+#: NaN where undefined.
+NAN_NOT_EXPECTED: tuple[str, ...] = ("_rad_s", "_nm", "_m3_s", "_w", "_j")
+
+
+def _overflow(columns: Mapping[str, np.ndarray]) -> tuple[str, float, float] | None:
+    """The first column of a run that overflowed (±inf, or NaN in a physical quantity the run has at
+    other samples): its name, the value and the time, s."""
+    time = np.asarray(columns.get("time_s", []), dtype=float)
+    for name, values in columns.items():
+        v = np.asarray(values, dtype=float)
+        bad = np.isinf(v) if name not in INFINITE_ALLOWED else np.zeros(v.shape, dtype=bool)
+        if name.endswith(NAN_NOT_EXPECTED) and not np.isnan(v).all():
+            bad |= np.isnan(v)
+        if bad.any():
+            i = int(np.flatnonzero(bad)[0])
+            return name, float(v[i]), float(time[i]) if i < len(time) else float("nan")
+    return None
+
+
 def _unpack(
     run: _core.TransientRun, model: DynamicModel, index: int | None, files: Mapping[str, str] | None = None
 ) -> TransientResult:
@@ -82,6 +105,16 @@ def _unpack(
     err = run.error
     if err is None:
         events = [Event(e.time_s, e.kind, e.stator_locked, e.flow_direction) for e in run.events]
+        overflow = _overflow(run.columns)
+        if overflow is not None:  # never a non-finite result without saying so: the drive is beyond the model
+            name, value, t = overflow
+            raise InputError(
+                (files or {}).get("drive") or "drive",
+                f"output {name}{where}",
+                value,
+                f"a drive whose run stays finite (it overflows at t = {t:.6g} s: check the drive's values and units)",
+                core_source="drive",
+            )
         return TransientResult(model.name, dict(run.columns), events)
     if err.kind == "input":
         assert err.source is not None and err.field is not None and err.expected is not None
