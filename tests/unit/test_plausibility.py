@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from pathlib import Path
 
 import pytest
 
@@ -41,3 +42,10 @@ def test_the_override_turns_the_refusal_into_one_warning():
 def test_design_values_only_warn():
     with pytest.warns(TcsimWarning, match=r"fluid_density_kg_m3 = 8.4e-292 is outside the plausible 600 to 1200"):
         warn_implausible("fluid_density_kg_m3", 8.4e-292, "c.toml", "[geometry].fluid_density_kg_m3")
+
+
+def test_the_guarantees_page_lists_every_range():
+    page = (Path(__file__).resolve().parents[2] / "docs" / "guarantees.md").read_text(encoding="utf-8")
+    for r in RANGES.values():
+        unit = f" {r.unit}" if r.unit else ""
+        assert f"| `{r.quantity}` | {r.low:g} to {r.high:g}{unit} | {r.why} |" in page, r.quantity
