@@ -95,35 +95,30 @@ def _raise_interrupted(signum, frame):
 
 
 @contextlib.contextmanager
-def _signals_raise() -> Iterator[None]:
-    """SIGINT and SIGTERM raise :class:`Interrupted` (and are recorded, also when the exception is
-    swallowed, e.g. raised in a ``__del__``) while the block runs; the previous handlers are restored
-    after."""
+def _signal_handlers(handler) -> Iterator[None]:
+    """SIGINT and SIGTERM go to ``handler`` while the block runs; the previous handlers are restored
+    after. Outside the main thread signals are not ours to handle, and nothing changes."""
     try:
-        previous = {sig: signal.signal(sig, _raise_interrupted) for sig in (signal.SIGINT, signal.SIGTERM)}
-    except ValueError:  # not the main thread: signals are not ours to handle
-        yield
-        return
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-
-
-@contextlib.contextmanager
-def _signals_ignored() -> Iterator[None]:
-    """SIGINT and SIGTERM ignored while the block runs (the previous handlers restored after)."""
-    try:
-        previous = {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+        previous = {sig: signal.signal(sig, handler) for sig in (signal.SIGINT, signal.SIGTERM)}
     except ValueError:  # not the main thread
         yield
         return
     try:
         yield
     finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+        for sig, old in previous.items():
+            signal.signal(sig, old)
+
+
+def _signals_raise() -> contextlib.AbstractContextManager[None]:
+    """SIGINT and SIGTERM raise :class:`Interrupted` (and are recorded, also when the exception is
+    swallowed, e.g. raised in a ``__del__``) while the block runs."""
+    return _signal_handlers(_raise_interrupted)
+
+
+def _signals_ignored() -> contextlib.AbstractContextManager[None]:
+    """SIGINT and SIGTERM ignored while the block runs."""
+    return _signal_handlers(signal.SIG_IGN)
 
 
 def _forget_unhandled_interrupt() -> None:
