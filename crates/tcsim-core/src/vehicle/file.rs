@@ -62,15 +62,17 @@ pub struct EngineSection {
     pub idle_speed_rad_s: f64,
     /// Speeds of the full-load curve, rad/s, ≥ 0, two or more, strictly increasing.
     pub full_load_speed_rad_s: Vec<f64>,
-    /// Full-load torque at those speeds, N·m, ≥ 0, one per speed.
+    /// Full-load torque at those speeds, N·m, from 0 to 100 000, one per speed
+    /// ([`super::parameters::ENGINE_TORQUE`]).
     pub full_load_torque_nm: Vec<f64>,
     /// Constant part of the drag, N·m, ≥ 0.
     pub drag_torque_nm: f64,
     /// Viscous part of the drag, N·m·s/rad, ≥ 0.
     pub drag_nm_s_per_rad: f64,
-    /// Time constant of the aspirated torque part, s, > 0.
+    /// Time constant of the aspirated torque part, s, ≥ 0.001
+    /// ([`super::parameters::ENGINE_TIME_CONSTANT`]).
     pub fast_time_constant_s: f64,
-    /// Time constant of the boost torque part ("time to torque"), s, > 0.
+    /// Time constant of the boost torque part ("time to torque"), s, ≥ 0.001.
     pub boost_time_constant_s: f64,
     /// Share of the pedal torque built up by boost, from 0 to 1.
     pub boost_fraction: f64,
@@ -82,16 +84,18 @@ pub struct EngineSection {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GearboxSection {
-    /// Ratio of each gear, gear 1 first, > 0, strictly decreasing, at least one.
+    /// Ratio of each gear, gear 1 first, > 0 and ≤ 30 ([`super::parameters::GEAR_RATIO`]), strictly
+    /// decreasing, at least one.
     pub ratios: Vec<f64>,
     /// Efficiency of each gear, > 0 and ≤ 1, one per gear.
     pub efficiencies: Vec<f64>,
     /// Inertia of each gear at the gearbox input, kg·m², ≥ 0, one per gear
     /// ([`super::parameters::GEARBOX_INPUT_INERTIA`]).
     pub input_inertia_kg_m2: Vec<f64>,
-    /// Output-side inertia, kg·m², > 0.
+    /// Output-side inertia, kg·m², ≥ 0.001 ([`super::parameters::GEARBOX_OUTPUT_INERTIA`]).
     pub output_inertia_kg_m2: f64,
-    /// Capacity of each shift clutch at the input, N·m, > 0.
+    /// Capacity of each shift clutch at the input, N·m, > 0 and ≤ 100 000
+    /// ([`super::parameters::CLUTCH_CAPACITY`]).
     pub shift_clutch_capacity_nm: f64,
     /// Torque handover time of a shift, s, > 0.
     pub shift_handover_s: f64,
@@ -111,7 +115,7 @@ pub struct GearboxSection {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LockupSection {
-    /// Kinetic friction capacity, N·m, > 0.
+    /// Kinetic friction capacity, N·m, > 0 and ≤ 100 000 ([`super::parameters::CLUTCH_CAPACITY`]).
     pub capacity_nm: f64,
     /// Static over kinetic capacity, ≥ 1.
     pub static_to_kinetic: f64,
@@ -130,19 +134,20 @@ pub struct LockupSection {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DrivelineSection {
-    /// Final drive ratio, > 0.
+    /// Final drive ratio, > 0 and ≤ 50 ([`super::parameters::FINAL_DRIVE_RATIO`]).
     pub final_drive_ratio: f64,
-    /// Front shaft torsional stiffness, N·m/rad, > 0.
+    /// Front shaft torsional stiffness, N·m/rad, > 0 and ≤ 1e7 ([`super::parameters::SHAFT_STIFFNESS`]).
     pub front_shaft_stiffness_nm_per_rad: f64,
-    /// Rear shaft torsional stiffness, N·m/rad, > 0.
+    /// Rear shaft torsional stiffness, N·m/rad, > 0 and ≤ 1e7.
     pub rear_shaft_stiffness_nm_per_rad: f64,
-    /// Front shaft damping, N·m·s/rad, ≥ 0.
+    /// Front shaft damping, N·m·s/rad, from 0 to 100 000 ([`super::parameters::SHAFT_DAMPING`]).
     pub front_shaft_damping_nm_s_per_rad: f64,
-    /// Rear shaft damping, N·m·s/rad, ≥ 0.
+    /// Rear shaft damping, N·m·s/rad, from 0 to 100 000.
     pub rear_shaft_damping_nm_s_per_rad: f64,
-    /// Front axle inertia (both wheels, hubs, brakes, half shafts), kg·m², > 0.
+    /// Front axle inertia (both wheels, hubs, brakes, half shafts), kg·m², ≥ 0.01
+    /// ([`super::parameters::AXLE_INERTIA`]).
     pub front_axle_inertia_kg_m2: f64,
-    /// Rear axle inertia, kg·m², > 0.
+    /// Rear axle inertia, kg·m², ≥ 0.01.
     pub rear_axle_inertia_kg_m2: f64,
 }
 
@@ -150,11 +155,12 @@ pub struct DrivelineSection {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct TyresSection {
-    /// Rolling radius, m, > 0.
+    /// Rolling radius, m, > 0 and ≤ 2 ([`super::parameters::ROLLING_RADIUS`]).
     pub rolling_radius_m: f64,
     /// Friction coefficient μ, > 0.
     pub friction_coefficient: f64,
-    /// Slip stiffness (dF_x/dκ over F_z at zero slip), > 0.
+    /// Slip stiffness (dF_x/dκ over F_z at zero slip), > 0 and ≤ 100
+    /// ([`super::parameters::SLIP_STIFFNESS`]).
     pub slip_stiffness: f64,
     /// Front axle's share of the static load, > 0 and < 1
     /// ([`super::parameters::FRONT_LOAD_FRACTION`]).
@@ -165,9 +171,9 @@ pub struct TyresSection {
 #[derive(Debug, Clone, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BodySection {
-    /// Vehicle mass, kg, > 0.
+    /// Vehicle mass, kg, > 0 and ≤ 200 000 ([`super::parameters::BODY_MASS`]).
     pub mass_kg: f64,
-    /// Drag area C_d·A, m², ≥ 0.
+    /// Drag area C_d·A, m², from 0 to 100 ([`super::parameters::DRAG_AREA`]).
     pub drag_area_m2: f64,
     /// Rolling resistance coefficient, ≥ 0.
     pub rolling_resistance: f64,

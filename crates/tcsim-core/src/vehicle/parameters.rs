@@ -109,6 +109,81 @@ pub const BRAKE_CAPACITY: Range = Range::POSITIVE;
 /// definite at 0 (the gearbox's inertia lumped into the turbine's): 0 is included.
 pub const GEARBOX_INPUT_INERTIA: Range = Range::NON_NEGATIVE;
 
+// The physical ranges: generous bounds from passenger cars to heavy trucks, where a value beyond
+// them is not a road vehicle and makes the launch's solver fail (the step size falls below its
+// minimum) instead of giving an answer. Each bound keeps a wide margin to the largest real
+// vehicle and to the value where the bundled vehicle's launch first fails (docs/vehicle.md).
+
+/// `[body].mass_kg`, kg: greater than 0, at most 200 000. The heaviest road vehicles (Nordic
+/// 60–76 t combinations, Australian road trains up to about 200 t) are at most 200 t, a 40 t
+/// truck is well inside. Beyond, the tyre forces (μ m g) against the axle inertias make the
+/// driveline so stiff that the solver fails (1.9e33 kg in the bundled vehicle): 1e30 kg is not a
+/// vehicle. The lower end stays open at 0 (a catalogued message names it); a mass of 1.9e-27 kg
+/// also makes the solver fail (the aerodynamic drag over the mass), and no road vehicle with a
+/// driver is below 50 kg.
+pub const BODY_MASS: Range = Range { low: Some((0.0, false)), high: Some((200_000.0, true)) };
+
+/// `[engine].full_load_torque_nm[k]`, N·m: from 0 to 100 000, both included. Heavy-truck diesels
+/// make up to about 3 500 N·m and the largest mining-truck engines about 20 000 N·m; 4e32 N·m
+/// makes the solver fail at the brake release.
+pub const ENGINE_TORQUE: Range = Range { low: Some((0.0, true)), high: Some((100_000.0, true)) };
+
+/// `[engine].fast_time_constant_s` and `[engine].boost_time_constant_s`, s: at least 0.001. An
+/// engine's torque cannot follow the pedal faster than a few firing intervals (a firing interval
+/// is 5 ms for a four-cylinder at 6 000 rpm), so 1 ms is already faster than any engine; a lag of
+/// 1e-32 s is no lag but a stiffness the solver cannot step over.
+pub const ENGINE_TIME_CONSTANT: Range = Range { low: Some((0.001, true)), high: None };
+
+/// `[gearbox].ratios[k]`: greater than 0, at most 30. Automatic gearboxes' first gears are 3–7 and
+/// heavy trucks' crawler gears up to about 20; at 5.25e6 the turbine is locked to a vehicle whose
+/// reflected inertia is 1e13 times its own and the solver fails.
+pub const GEAR_RATIO: Range = Range { low: Some((0.0, false)), high: Some((30.0, true)) };
+
+/// `[gearbox].output_inertia_kg_m2`, kg·m²: at least 0.001. An output shaft with its gear or
+/// flange is above 0.001 kg·m² even in a small car; at 5e-8 kg·m² the output coordinate between
+/// the shift clutch and the shafts is so stiff that the solver fails at the first shift.
+pub const GEARBOX_OUTPUT_INERTIA: Range = Range { low: Some((0.001, true)), high: None };
+
+/// `[gearbox].shift_clutch_capacity_nm` and `[lockup].capacity_nm`, N·m: greater than 0, at most
+/// 100 000. A clutch is sized to a small multiple of the engine torque (at most about 20 000 N·m,
+/// [`ENGINE_TORQUE`]); a lock-up clutch of 6e8 N·m or a shift clutch of 5e32 N·m makes the
+/// solver fail when it engages.
+pub const CLUTCH_CAPACITY: Range = Range { low: Some((0.0, false)), high: Some((100_000.0, true)) };
+
+/// `[driveline].final_drive_ratio`: greater than 0, at most 50. Passenger cars' final drives are
+/// 2.5–4.5, trucks' with hub reduction up to about 10 and mining trucks' wheel drives about 30;
+/// at 3.2e6 the solver fails at once.
+pub const FINAL_DRIVE_RATIO: Range = Range { low: Some((0.0, false)), high: Some((50.0, true)) };
+
+/// `[driveline].front_shaft_stiffness_nm_per_rad` and `rear_…`, N·m/rad at the propshaft side:
+/// greater than 0, at most 1e7. A heavy truck's axle is about 1e6 N·m/rad at the wheels, less at
+/// the propshaft side (divided by the final drive ratio squared); 1.6e33 makes the solver fail.
+pub const SHAFT_STIFFNESS: Range = Range { low: Some((0.0, false)), high: Some((1e7, true)) };
+
+/// `[driveline].front_shaft_damping_nm_s_per_rad` and `rear_…`, N·m·s/rad: from 0 to 100 000,
+/// both included. The critical damping `2√(kJ)` of a heavy truck's shaft-wheel mode is below
+/// about 10 000 N·m·s/rad and a shaft's own damping is a few per cent of it; 6e6 makes the solver
+/// fail at the brake release.
+pub const SHAFT_DAMPING: Range = Range { low: Some((0.0, true)), high: Some((100_000.0, true)) };
+
+/// `[driveline].front_axle_inertia_kg_m2` and `rear_…`, kg·m²: at least 0.01. Two wheels with
+/// tyres, hubs and brakes are above 0.5 kg·m² even on a small car; an axle of 2.8e-30 kg·m² makes
+/// the tyre slip so stiff that the solver fails at the brake release.
+pub const AXLE_INERTIA: Range = Range { low: Some((0.01, true)), high: None };
+
+/// `[tyres].rolling_radius_m`, m: greater than 0, at most 2. Passenger-car tyres are 0.28–0.38 m,
+/// truck tyres about 0.5 m and the largest mining-truck tyres (4 m diameter) 2 m; a wheel of
+/// 334 km makes the solver fail at the brake release.
+pub const ROLLING_RADIUS: Range = Range { low: Some((0.0, false)), high: Some((2.0, true)) };
+
+/// `[tyres].slip_stiffness` (dF_x/dκ over F_z): greater than 0, at most 100. Road tyres are
+/// 5–30; 1.5e7 makes the tyre force jump with slips of 1e-7 and the solver fails.
+pub const SLIP_STIFFNESS: Range = Range { low: Some((0.0, false)), high: Some((100.0, true)) };
+
+/// `[body].drag_area_m2` (C_d·A), m²: from 0 to 100, both included. A passenger car is 0.5–1 m²
+/// and a truck with trailers about 10 m²; 6.7e29 m² makes the solver fail when the vehicle moves.
+pub const DRAG_AREA: Range = Range { low: Some((0.0, true)), high: Some((100.0, true)) };
+
 /// A table `y(x)`, linear between points, ends held.
 #[derive(Debug, Clone)]
 pub struct Curve {
@@ -200,11 +275,11 @@ impl Engine {
         Range::POSITIVE.check(&f("inertia_kg_m2"), self.inertia_kg_m2)?;
         Range::POSITIVE.check(&f("idle_speed_rad_s"), self.idle_speed_rad_s)?;
         each(&f("full_load_speed_rad_s"), self.full_load.x(), Range::NON_NEGATIVE)?;
-        each(&f("full_load_torque_nm"), self.full_load.y(), Range::NON_NEGATIVE)?;
+        each(&f("full_load_torque_nm"), self.full_load.y(), ENGINE_TORQUE)?;
         Range::NON_NEGATIVE.check(&f("drag_torque_nm"), self.drag_torque_nm)?;
         Range::NON_NEGATIVE.check(&f("drag_nm_s_per_rad"), self.drag_nm_s_per_rad)?;
-        Range::POSITIVE.check(&f("fast_time_constant_s"), self.fast_time_constant_s)?;
-        Range::POSITIVE.check(&f("boost_time_constant_s"), self.boost_time_constant_s)?;
+        ENGINE_TIME_CONSTANT.check(&f("fast_time_constant_s"), self.fast_time_constant_s)?;
+        ENGINE_TIME_CONSTANT.check(&f("boost_time_constant_s"), self.boost_time_constant_s)?;
         Range::FRACTION.check(&f("boost_fraction"), self.boost_fraction)?;
         IDLE_GOVERNOR_GAIN.check(&f("idle_governor_gain_nm_s_per_rad"), self.idle_governor_gain_nm_s_per_rad)?;
         let speeds = self.full_load.x();
@@ -252,7 +327,7 @@ impl Gearbox {
         if n == 0 {
             return Err(CoreError::new(f("ratios"), "[]", "at least one gear"));
         }
-        each(&f("ratios"), &self.ratios, Range::POSITIVE)?;
+        each(&f("ratios"), &self.ratios, GEAR_RATIO)?;
         strictly(&f("ratios"), &self.ratios, false)?;
         let per_gear = format!("one per gear: ratios has {n}");
         length(&f("efficiencies"), &self.efficiencies, n, &per_gear)?;
@@ -288,8 +363,8 @@ impl Gearbox {
                 ));
             }
         }
-        Range::POSITIVE.check(&f("output_inertia_kg_m2"), self.output_inertia_kg_m2)?;
-        Range::POSITIVE.check(&f("shift_clutch_capacity_nm"), self.shift_clutch_capacity_nm)?;
+        GEARBOX_OUTPUT_INERTIA.check(&f("output_inertia_kg_m2"), self.output_inertia_kg_m2)?;
+        CLUTCH_CAPACITY.check(&f("shift_clutch_capacity_nm"), self.shift_clutch_capacity_nm)?;
         Range::POSITIVE.check(&f("shift_handover_s"), self.shift_handover_s)?;
         Ok(())
     }
@@ -312,7 +387,7 @@ impl Lockup {
     /// The lock-up clutch of a gearbox with `gears` gears.
     pub fn validate(&self, gears: usize) -> CoreResult<()> {
         let f = |key: &str| field("lockup", key);
-        Range::POSITIVE.check(&f("capacity_nm"), self.capacity_nm)?;
+        CLUTCH_CAPACITY.check(&f("capacity_nm"), self.capacity_nm)?;
         Range::AT_LEAST_ONE.check(&f("static_to_kinetic"), self.static_to_kinetic)?;
         Range::POSITIVE.check(&f("engage_time_s"), self.engage_time_s)?;
         if !(1..=gears).contains(&self.min_gear) {
@@ -382,20 +457,20 @@ impl Vehicle {
         self.gearbox.validate()?;
         self.lockup.validate(self.gearbox.ratios.len())?;
         let d = &self.driveline;
-        Range::POSITIVE.check(&field("driveline", "final_drive_ratio"), d.final_drive_ratio)?;
+        FINAL_DRIVE_RATIO.check(&field("driveline", "final_drive_ratio"), d.final_drive_ratio)?;
         for (i, axle) in ["front", "rear"].iter().enumerate() {
             let f = |key: &str| field("driveline", &format!("{axle}_{key}"));
-            Range::POSITIVE.check(&f("shaft_stiffness_nm_per_rad"), d.shaft_stiffness_nm_per_rad[i])?;
-            Range::NON_NEGATIVE.check(&f("shaft_damping_nm_s_per_rad"), d.shaft_damping_nm_s_per_rad[i])?;
-            Range::POSITIVE.check(&f("axle_inertia_kg_m2"), d.axle_inertia_kg_m2[i])?;
+            SHAFT_STIFFNESS.check(&f("shaft_stiffness_nm_per_rad"), d.shaft_stiffness_nm_per_rad[i])?;
+            SHAFT_DAMPING.check(&f("shaft_damping_nm_s_per_rad"), d.shaft_damping_nm_s_per_rad[i])?;
+            AXLE_INERTIA.check(&f("axle_inertia_kg_m2"), d.axle_inertia_kg_m2[i])?;
         }
         let (t, b) = (&self.tyres, &self.body);
-        Range::POSITIVE.check(&field("tyres", "rolling_radius_m"), t.rolling_radius_m)?;
+        ROLLING_RADIUS.check(&field("tyres", "rolling_radius_m"), t.rolling_radius_m)?;
         Range::POSITIVE.check(&field("tyres", "friction_coefficient"), t.friction_coefficient)?;
-        Range::POSITIVE.check(&field("tyres", "slip_stiffness"), t.slip_stiffness)?;
+        SLIP_STIFFNESS.check(&field("tyres", "slip_stiffness"), t.slip_stiffness)?;
         FRONT_LOAD_FRACTION.check(&field("tyres", "front_load_fraction"), t.front_load_fraction)?;
-        Range::POSITIVE.check(&field("body", "mass_kg"), b.mass_kg)?;
-        Range::NON_NEGATIVE.check(&field("body", "drag_area_m2"), b.drag_area_m2)?;
+        BODY_MASS.check(&field("body", "mass_kg"), b.mass_kg)?;
+        DRAG_AREA.check(&field("body", "drag_area_m2"), b.drag_area_m2)?;
         Range::NON_NEGATIVE.check(&field("body", "rolling_resistance"), b.rolling_resistance)?;
         AIR_DENSITY.check(&field("body", "air_density_kg_m3"), b.air_density_kg_m3)?;
         GRADE_PERCENT.check(&field("body", "grade_percent"), b.grade_percent)?;
@@ -417,4 +492,136 @@ pub struct Scenario {
     /// its complete-vehicle simulation (§3.5.2.2). The pedal then only drives the shift and lock-up
     /// schedules.
     pub engine_torque_nm: Option<Signal>,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::file::read_vehicle;
+
+    const SEDAN: &str = include_str!("../../tests/data/sedan.toml");
+
+    /// The sedan with the line of `key` in `[section]` replaced by `key = value`.
+    fn with(section: &str, key: &str, value: &str) -> String {
+        let mut in_section = false;
+        let lines = SEDAN.lines().map(|l| {
+            if l.starts_with('[') {
+                in_section = l == format!("[{section}]");
+            }
+            match in_section && l.split('=').next().map(str::trim) == Some(key) {
+                true => format!("{key} = {value}"),
+                false => l.to_string(),
+            }
+        });
+        lines.collect::<Vec<_>>().join("\n")
+    }
+
+    /// The physical ranges: at each new bound the sedan reads; just over it the error names the
+    /// field as the file does and says what is expected.
+    #[test]
+    fn the_physical_ranges_at_and_over_each_bound() {
+        let torques = |last: &str| format!("[120.0, 200.0, 300.0, 400.0, 400.0, 350.0, {last}]");
+        let ratios = |first: &str| format!("[{first}, 3.03, 1.95, 1.46, 1.22, 1.0, 0.81, 0.67]");
+        let cases = [
+            ("body", "mass_kg", "200000.0", "200001.0", "[body].mass_kg", "greater than 0 and at most 200000"),
+            (
+                "engine",
+                "full_load_torque_nm",
+                &torques("100000.0"),
+                &torques("100001.0"),
+                "[engine].full_load_torque_nm[6]",
+                "at least 0 and at most 100000",
+            ),
+            ("engine", "fast_time_constant_s", "0.001", "0.0009", "[engine].fast_time_constant_s", "at least 0.001"),
+            ("engine", "boost_time_constant_s", "0.001", "0.0009", "[engine].boost_time_constant_s", "at least 0.001"),
+            (
+                "gearbox",
+                "ratios",
+                &ratios("30.0"),
+                &ratios("30.5"),
+                "[gearbox].ratios[0]",
+                "greater than 0 and at most 30",
+            ),
+            ("gearbox", "output_inertia_kg_m2", "0.001", "0.0009", "[gearbox].output_inertia_kg_m2", "at least 0.001"),
+            (
+                "gearbox",
+                "shift_clutch_capacity_nm",
+                "100000.0",
+                "100001.0",
+                "[gearbox].shift_clutch_capacity_nm",
+                "greater than 0 and at most 100000",
+            ),
+            (
+                "lockup",
+                "capacity_nm",
+                "100000.0",
+                "100001.0",
+                "[lockup].capacity_nm",
+                "greater than 0 and at most 100000",
+            ),
+            (
+                "driveline",
+                "final_drive_ratio",
+                "50.0",
+                "50.5",
+                "[driveline].final_drive_ratio",
+                "greater than 0 and at most 50",
+            ),
+            (
+                "driveline",
+                "front_shaft_stiffness_nm_per_rad",
+                "1e7",
+                "1.1e7",
+                "[driveline].front_shaft_stiffness_nm_per_rad",
+                "greater than 0 and at most 10000000",
+            ),
+            (
+                "driveline",
+                "rear_shaft_stiffness_nm_per_rad",
+                "1e7",
+                "1.1e7",
+                "[driveline].rear_shaft_stiffness_nm_per_rad",
+                "greater than 0 and at most 10000000",
+            ),
+            (
+                "driveline",
+                "front_shaft_damping_nm_s_per_rad",
+                "100000.0",
+                "100001.0",
+                "[driveline].front_shaft_damping_nm_s_per_rad",
+                "at least 0 and at most 100000",
+            ),
+            (
+                "driveline",
+                "rear_shaft_damping_nm_s_per_rad",
+                "100000.0",
+                "100001.0",
+                "[driveline].rear_shaft_damping_nm_s_per_rad",
+                "at least 0 and at most 100000",
+            ),
+            (
+                "driveline",
+                "front_axle_inertia_kg_m2",
+                "0.01",
+                "0.0099",
+                "[driveline].front_axle_inertia_kg_m2",
+                "at least 0.01",
+            ),
+            (
+                "driveline",
+                "rear_axle_inertia_kg_m2",
+                "0.01",
+                "0.0099",
+                "[driveline].rear_axle_inertia_kg_m2",
+                "at least 0.01",
+            ),
+            ("tyres", "rolling_radius_m", "2.0", "2.01", "[tyres].rolling_radius_m", "greater than 0 and at most 2"),
+            ("tyres", "slip_stiffness", "100.0", "100.5", "[tyres].slip_stiffness", "greater than 0 and at most 100"),
+            ("body", "drag_area_m2", "100.0", "100.5", "[body].drag_area_m2", "at least 0 and at most 100"),
+        ];
+        for (section, key, ok, bad, name, expected) in cases {
+            read_vehicle(&with(section, key, ok)).unwrap_or_else(|e| panic!("{key} = {ok}: {e}"));
+            let e = read_vehicle(&with(section, key, bad)).unwrap_err();
+            assert_eq!((e.field.as_str(), e.expected.as_str()), (name, format!("a finite number {expected}").as_str()));
+        }
+    }
 }
