@@ -155,7 +155,7 @@ def _idle_cannot_hold(d):
 # case -> (edit, words the message must contain)
 BAD = {
     "negative inertia": (_set("engine", "inertia_kg_m2", -0.2), ["[engine].inertia_kg_m2", "-0.2", "greater than 0"]),
-    "zero mass": (_set("body", "mass_kg", 0.0), ["[body].mass_kg", "0", "greater than 0"]),
+    "zero mass": (_set("body", "mass_kg", 0.0), ["[body].mass_kg", "0", "at least 50"]),
     "nan value": (_set("tyres", "slip_stiffness", math.nan), ["[tyres].slip_stiffness", "nan", "finite"]),
     "inf in an array": (
         _item("engine", "full_load_torque_nm", 2, math.inf),
@@ -263,7 +263,7 @@ SETTLED = {
         "idle_governor_gain_nm_s_per_rad",
         0.5,
         0.0,
-        "a finite number greater than 0",
+        "a finite number greater than 0 and at most 1000",
     ),
     "front load fraction": (
         "tyres",
@@ -272,7 +272,7 @@ SETTLED = {
         1.0,
         "a finite number greater than 0 and less than 1",
     ),
-    "air density": ("body", "air_density_kg_m3", 0.0, -0.1, "a finite number at least 0"),
+    "air density": ("body", "air_density_kg_m3", 0.0, -0.1, "a finite number at least 0 and at most 10"),
     "brake capacity": ("brake", "capacity_nm", 1.0, 0.0, "a finite number greater than 0"),
     "gearbox input inertia": ("gearbox", "input_inertia_kg_m2", 0.0, -0.01, "a finite number at least 0"),
 }

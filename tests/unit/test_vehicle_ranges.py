@@ -44,6 +44,10 @@ FORMER_EXIT_1 = {
     ("tyres", "slip_stiffness", 1e6): "[tyres].slip_stiffness",
     ("body", "mass_kg", 1e30): "[body].mass_kg",
     ("body", "drag_area_m2", 1e30): "[body].drag_area_m2",
+    ("body", "mass_kg", 1e-30): "[body].mass_kg",
+    ("body", "air_density_kg_m3", 1e30): "[body].air_density_kg_m3",
+    ("engine", "idle_governor_gain_nm_s_per_rad", 1e6): "[engine].idle_governor_gain_nm_s_per_rad",
+    ("engine", "idle_governor_gain_nm_s_per_rad", 1e30): "[engine].idle_governor_gain_nm_s_per_rad",
 }
 
 

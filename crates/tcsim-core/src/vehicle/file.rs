@@ -687,10 +687,16 @@ mod tests {
         let cases = [
             ("body", "grade_percent", "50.0", "60.0", "a finite number at least -50 and at most 50"),
             ("body", "grade_percent", "-50.0", "-50.5", "a finite number at least -50 and at most 50"),
-            ("engine", "idle_governor_gain_nm_s_per_rad", "1e-3", "0.0", "a finite number greater than 0"),
+            (
+                "engine",
+                "idle_governor_gain_nm_s_per_rad",
+                "1e-3",
+                "0.0",
+                "a finite number greater than 0 and at most 1000",
+            ),
             ("tyres", "front_load_fraction", "0.999", "1.0", "a finite number greater than 0 and less than 1"),
             ("tyres", "front_load_fraction", "0.001", "0.0", "a finite number greater than 0 and less than 1"),
-            ("body", "air_density_kg_m3", "0.0", "-0.1", "a finite number at least 0"),
+            ("body", "air_density_kg_m3", "0.0", "-0.1", "a finite number at least 0 and at most 10"),
             ("brake", "capacity_nm", "1e-3", "0.0", "a finite number greater than 0"),
         ];
         for (section, key, ok, bad, expected) in cases {

@@ -88,7 +88,10 @@ pub const GRADE_PERCENT: Range = Range { low: Some((-50.0, true)), high: Some((5
 /// `[engine].idle_governor_gain_nm_s_per_rad`, N·m·s/rad: greater than 0. Without the governor
 /// (gain 0) the engine makes no torque at zero pedal, so no engine speed balances drag and the
 /// stalled converter: the braked standstill every launch starts from does not exist.
-pub const IDLE_GOVERNOR_GAIN: Range = Range::POSITIVE;
+/// The upper end (1000 N·m·s/rad, 100 times the bundled gain) is issue 10's: against an engine
+/// and pump inertia of about 0.3 kg·m² a gain of 1e7 settles in microseconds, faster than a firing
+/// interval, and the solver fails on it.
+pub const IDLE_GOVERNOR_GAIN: Range = Range { low: Some((0.0, false)), high: Some((1000.0, true)) };
 
 /// `[tyres].front_load_fraction`: greater than 0 and less than 1. Both axles are driven (the AWD
 /// split is by shaft stiffness); an axle without load has no tyre force, so its shaft would spin
@@ -97,7 +100,8 @@ pub const FRONT_LOAD_FRACTION: Range = Range { low: Some((0.0, false)), high: So
 
 /// `[body].air_density_kg_m3`, kg/m³: 0 or more. Density 0 only removes the aerodynamic drag
 /// (as `drag_area_m2 = 0` does); the plant stays well posed, so 0 is included.
-pub const AIR_DENSITY: Range = Range::NON_NEGATIVE;
+/// The upper end (10 kg/m³, eight times sea-level air) is issue 10's: 1e30 made the solver fail.
+pub const AIR_DENSITY: Range = Range { low: Some((0.0, true)), high: Some((10.0, true)) };
 
 /// `[brake].capacity_nm`, N·m: greater than 0. Every launch starts at a braked standstill with
 /// the wheels held by the brake against the stalled converter's torque; a brake of capacity 0
@@ -114,14 +118,13 @@ pub const GEARBOX_INPUT_INERTIA: Range = Range::NON_NEGATIVE;
 // minimum) instead of giving an answer. Each bound keeps a wide margin to the largest real
 // vehicle and to the value where the bundled vehicle's launch first fails (docs/vehicle.md).
 
-/// `[body].mass_kg`, kg: greater than 0, at most 200 000. The heaviest road vehicles (Nordic
+/// `[body].mass_kg`, kg: at least 50, at most 200 000. The heaviest road vehicles (Nordic
 /// 60–76 t combinations, Australian road trains up to about 200 t) are at most 200 t, a 40 t
 /// truck is well inside. Beyond, the tyre forces (μ m g) against the axle inertias make the
 /// driveline so stiff that the solver fails (1.9e33 kg in the bundled vehicle): 1e30 kg is not a
-/// vehicle. The lower end stays open at 0 (a catalogued message names it); a mass of 1.9e-27 kg
-/// also makes the solver fail (the aerodynamic drag over the mass), and no road vehicle with a
-/// driver is below 50 kg.
-pub const BODY_MASS: Range = Range { low: Some((0.0, false)), high: Some((200_000.0, true)) };
+/// vehicle. At the lower end, a mass of 1.9e-27 kg also makes the solver fail (the aerodynamic drag
+/// over the mass), and no road vehicle with a driver is below 50 kg.
+pub const BODY_MASS: Range = Range { low: Some((50.0, true)), high: Some((200_000.0, true)) };
 
 /// `[engine].full_load_torque_nm[k]`, N·m: from 0 to 100 000, both included. Heavy-truck diesels
 /// make up to about 3 500 N·m and the largest mining-truck engines about 20 000 N·m; 4e32 N·m
@@ -522,7 +525,17 @@ mod tests {
         let torques = |last: &str| format!("[120.0, 200.0, 300.0, 400.0, 400.0, 350.0, {last}]");
         let ratios = |first: &str| format!("[{first}, 3.03, 1.95, 1.46, 1.22, 1.0, 0.81, 0.67]");
         let cases = [
-            ("body", "mass_kg", "200000.0", "200001.0", "[body].mass_kg", "greater than 0 and at most 200000"),
+            ("body", "mass_kg", "200000.0", "200001.0", "[body].mass_kg", "at least 50 and at most 200000"),
+            ("body", "mass_kg", "50.0", "49.9", "[body].mass_kg", "at least 50 and at most 200000"),
+            ("body", "air_density_kg_m3", "10.0", "10.1", "[body].air_density_kg_m3", "at least 0 and at most 10"),
+            (
+                "engine",
+                "idle_governor_gain_nm_s_per_rad",
+                "1000.0",
+                "1001.0",
+                "[engine].idle_governor_gain_nm_s_per_rad",
+                "greater than 0 and at most 1000",
+            ),
             (
                 "engine",
                 "full_load_torque_nm",
