@@ -110,6 +110,10 @@ def check_message(case: dict[str, Any], stderr: str) -> None:
     """One ``error:`` line naming the file (``command line`` for options and usage errors), the
     fragments and what was expected."""
     lines = [ln for ln in stderr.splitlines() if ln.strip()]
+    if "warning" in case:  # a warning the case names (about what caused the error) may come first
+        warned = [ln for ln in lines if ln.startswith("warning: ")]
+        assert any(all(f in ln for f in case["warning"]) for ln in warned), (case["warning"], warned)
+        lines = [ln for ln in lines if ln not in warned]
     assert len(lines) == 1, f"expected one stderr line, got {len(lines)}: {lines}"
     msg = lines[0]
     assert msg.startswith("error: "), msg

@@ -428,7 +428,9 @@ pub fn initial_state(
         }
         (None, None) => {
             let tp = drive.pump_torque().map_or(0.0, |s| s.value(t0));
-            steady_pump_speed(model, tp, wt, wt_source)?
+            let wp = steady_pump_speed(model, tp, wt, wt_source)?;
+            check_steady_pump_speed(wp, tp)?;
+            wp
         }
     };
     // the speeds the steady state starts from: the drive's unless the user gave one
@@ -545,6 +547,24 @@ fn check_finite_state(
         range.map_or(String::new(), |r| format!(" (plausible: {} to {} {})", sig(r.low), sig(r.high), r.unit));
     let expected = format!("a value at which the model's torques, power and stored energy are finite{plausible}");
     Err(CoreError::of(source_of(c), format!("initial {}", COORDINATES[c]), u[c], expected).into())
+}
+
+/// A steady initial pump speed beyond ten times the plausible speeds ([`crate::plausibility`]) is
+/// refused: the first pump torque is a plausible measured value (the readers check it), so a
+/// converter that absorbs it only there has parameters beyond any converter (a blade angle of
+/// 89.999999999°), and the solver would fail on the start. The error blames the converter.
+fn check_steady_pump_speed(wp: f64, pump_torque_nm: f64) -> TransientResult<()> {
+    let limit = 10.0 * crate::plausibility::range("speed_rad_s").map_or(1100.0, |r| r.high);
+    if wp.abs() <= limit {
+        return Ok(());
+    }
+    let expected = format!(
+        "a steady pump speed below {} rad/s for the first pump torque ({} N·m): the converter absorbs almost no \
+         torque; check its parameters against their plausible ranges",
+        sig(limit),
+        sig(pump_torque_nm)
+    );
+    Err(CoreError::of(InputSource::Converter, "initial pump_speed_rad_s", wp, expected).into())
 }
 
 /// The pump speed at which the steady-state pump torque equals `pump_torque_nm` at turbine
