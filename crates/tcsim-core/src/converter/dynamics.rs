@@ -75,8 +75,9 @@ pub trait ConverterDynamics: Sync {
     fn has_flow_sign(&self) -> bool {
         false
     }
-    /// Forces on the flow coordinate that do not depend on sgn Q, and the magnitude of the
-    /// sgn-Q term, both at Q = 0 (the "dry friction" of the flow; see [`crate::engine`]).
+    /// The force on the flow coordinate at Q = 0 approached from either side, `(F_Q(0⁺), F_Q(0⁻))`
+    /// (σ = +1 and σ = −1): the flow is held at zero while `F_Q(0⁺) ≤ 0 ≤ F_Q(0⁻)` (the "dry
+    /// friction" of the flow; see [`crate::engine::converter_events`]).
     fn zero_flow_head(&self, _u: &Vec4) -> (f64, f64) {
         (0.0, 0.0)
     }
@@ -222,6 +223,31 @@ struct HtConst {
     c: [f64; 3],
     friction: f64,
     r: [f64; 3],
+    /// The same quantities for reverse flow (Q < 0, [`ReverseConst`]).
+    rev: ReverseConst,
+}
+
+/// Constants of the reverse-flow form (docs/models.md, "Reverse flow"): with Q < 0 the fluid
+/// enters each element across its exit edge and leaves across its inlet edge, so the element x
+/// receives from `src[x]` (pump ← turbine ← stator ← pump), leaves at the inlet radius (pump at
+/// R_s, turbine at R_p, stator at R_t) with the inlet angle, and its entry shock compares the
+/// inlet angle of `src[x]` with its own exit angle at its exit radius.
+#[derive(Debug, Clone)]
+struct ReverseConst {
+    /// Square of the radius each element leaves across: `[R_s², R_p², R_t²]`.
+    r2: [f64; 3],
+    /// `R tan α` at the edge each element leaves across: `[R_s tan α_pp, R_p tan α_tt, R_t tan α_ss]`.
+    radius_tan: [f64; 3],
+    /// The element each one receives from: turbine, stator, pump.
+    src: [usize; 3],
+    /// The element each one delivers to (the inverse of `src`): stator, pump, turbine.
+    dst: [usize; 3],
+    /// Radius of each element's entry (its exit edge): `[R_p, R_t, R_s]`.
+    r_entry: [f64; 3],
+    /// Coefficients of q in the reverse shock velocities.
+    b: [f64; 3],
+    /// Friction coefficient `f (3 + Σ tan²α_in)` (the edges the fluid leaves across).
+    friction: f64,
 }
 
 impl HtDynamics {
@@ -333,6 +359,16 @@ impl HtDynamics {
             c: [g.get(PumpShockLoss), g.get(TurbineShockLoss), g.get(StatorShockLoss)],
             friction: g.get(FrictionLoss) * (3.0 + t[0] * t[0] + t[1] * t[1] + t[2] * t[2]),
             r,
+            rev: ReverseConst {
+                r2: [r[2] * r[2], r[0] * r[0], r[1] * r[1]],
+                radius_tan: [r[2] * ti[0], r[0] * ti[1], r[1] * ti[2]],
+                src: [1, 2, 0],
+                dst: [2, 0, 1],
+                r_entry: r,
+                // pump entered from the turbine inlet, turbine from the stator inlet, stator from the pump inlet
+                b: [ti[1] - t[0], ti[2] - t[1], ti[0] - t[2]],
+                friction: g.get(FrictionLoss) * (3.0 + ti[0] * ti[0] + ti[1] * ti[1] + ti[2] * ti[2]),
+            },
         }
     }
 }
@@ -403,6 +439,64 @@ fn shock_velocities(k: &HtConst, w: &[f64; 3], q: f64) -> [f64; 3] {
     [k.r[2] * (w[2] - w[0]) + q * k.b[0], k.r[0] * (w[0] - w[1]) + q * k.b[1], k.r[1] * (w[1] - w[2]) + q * k.b[2]]
 }
 
+impl ReverseConst {
+    /// Reverse shock velocities at the entry of pump, turbine and stator (each at its exit radius):
+    /// `V_p = R_p(ω_t − ω_p) + q(tan α_tt − tan α_p)`, `V_t = R_t(ω_s − ω_t) + q(tan α_ss − tan α_t)`,
+    /// `V_s = R_s(ω_p − ω_s) + q(tan α_pp − tan α_s)`.
+    fn shock_velocities(&self, w: &[f64; 3], q: f64) -> [f64; 3] {
+        std::array::from_fn(|x| self.r_entry[x] * (w[self.src[x]] - w[x]) + q * self.b[x])
+    }
+
+    /// Angular momentum per unit mass leaving each element across its inlet edge.
+    fn h(&self, w: &[f64; 3], q: f64) -> [f64; 3] {
+        std::array::from_fn(|x| w[x] * self.r2[x] + self.radius_tan[x] * q)
+    }
+
+    /// Reverse-flow forces: `F_x = ρQ(h_x − h_src(x))` (external torque ρ|Q|(h out − h in)), and
+    /// `F_Q = ρ(head − σ loss)` with σ = −1 and `head = Σ ω_x (h_src(x) − h_x)`, the work per unit
+    /// volume the blades do on the fluid, so that `ω·F + Q F_Q = −ρ|Q| loss`.
+    fn forces(&self, k: &HtConst, u: &Vec4) -> Vec4 {
+        let w = [u[PUMP], u[TURBINE], u[STATOR]];
+        let (flow, q) = (u[FLOW], u[FLOW] / k.area);
+        let h = self.h(&w, q);
+        let head: f64 = (0..3).map(|x| w[x] * (h[self.src[x]] - h[x])).sum();
+        let v = self.shock_velocities(&w, q);
+        let loss = 0.5 * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2] + self.friction * q * q);
+        [
+            k.rho * (h[0] - h[self.src[0]]) * flow,
+            k.rho * (h[1] - h[self.src[1]]) * flow,
+            k.rho * (h[2] - h[self.src[2]]) * flow,
+            k.rho * (head + loss),
+        ]
+    }
+
+    /// `∂F/∂u` of [`ReverseConst::forces`].
+    fn force_jacobian(&self, k: &HtConst, u: &Vec4) -> Mat4 {
+        let (rho, area) = (k.rho, k.area);
+        let w = [u[PUMP], u[TURBINE], u[STATOR]];
+        let (flow, q) = (u[FLOW], u[FLOW] / area);
+        let h = self.h(&w, q);
+        let v = self.shock_velocities(&w, q);
+        let mut j = [[0.0; 4]; 4];
+        for x in 0..3 {
+            let (s, d) = (self.src[x], self.dst[x]);
+            j[x][x] += rho * self.r2[x] * flow;
+            j[x][s] -= rho * self.r2[s] * flow;
+            j[x][FLOW] = rho * (h[x] - h[s]) + rho * flow * (self.radius_tan[x] - self.radius_tan[s]) / area;
+            // head: ∂/∂ω_x of Σ ω_y (h_src(y) − h_y), where x is the source of d
+            let dhead = h[s] - h[x] + self.r2[x] * (w[d] - w[x]);
+            // loss: V_x holds −ω_x, V_d holds +ω_x
+            let dloss = k.c[d] * v[d] * self.r_entry[d] - k.c[x] * v[x] * self.r_entry[x];
+            j[FLOW][x] = rho * (dhead + dloss);
+        }
+        let dhead_dq: f64 = (0..3).map(|x| w[x] * (self.radius_tan[self.src[x]] - self.radius_tan[x])).sum();
+        let dloss_dq =
+            k.c[0] * v[0] * self.b[0] + k.c[1] * v[1] * self.b[1] + k.c[2] * v[2] * self.b[2] + self.friction * q;
+        j[FLOW][FLOW] = rho * (dhead_dq + dloss_dq) / area;
+        j
+    }
+}
+
 impl ConverterDynamics for HtDynamics {
     fn coordinates(&self) -> [bool; 4] {
         [true; 4]
@@ -425,8 +519,13 @@ impl ConverterDynamics for HtDynamics {
         m[FLOW][FLOW] = self.fluid_inertance();
         m
     }
+    /// σ = +1 and σ = 0 (held) use the thesis's equations (the latter without the loss, which a held
+    /// flow does not see); σ = −1 the reverse-flow form ([`ReverseConst`]).
     fn forces(&self, u: &Vec4, sigma: f64) -> Vec4 {
         let k = &self.k;
+        if sigma < 0.0 {
+            return k.rev.forces(k, u);
+        }
         let w = [u[PUMP], u[TURBINE], u[STATOR]];
         let flow = u[FLOW];
         let q = flow / k.area;
@@ -451,6 +550,9 @@ impl ConverterDynamics for HtDynamics {
     }
     fn force_jacobian(&self, u: &Vec4, sigma: f64) -> Mat4 {
         let k = &self.k;
+        if sigma < 0.0 {
+            return k.rev.force_jacobian(k, u);
+        }
         let (rho, area) = (k.rho, k.area);
         let w = [u[PUMP], u[TURBINE], u[STATOR]];
         let flow = u[FLOW];
@@ -495,10 +597,7 @@ impl ConverterDynamics for HtDynamics {
     fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
         let mut at_zero = *u;
         at_zero[FLOW] = 0.0;
-        let k = &self.k;
-        let v = shock_velocities(k, &[u[0], u[1], u[2]], 0.0);
-        let shock = 0.5 * k.rho * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2]);
-        (self.forces(&at_zero, 0.0)[FLOW], shock)
+        (self.forces(&at_zero, 1.0)[FLOW], self.forces(&at_zero, -1.0)[FLOW])
     }
 }
 
@@ -605,9 +704,16 @@ mod tests {
     #[test]
     fn analytic_jacobians_match_finite_differences() {
         let h = ht([-0.00569, 0.00134, 0.0009]);
-        for u in
-            [[200.0, 0.0, 0.0, 0.12], [210.0, 150.0, 20.0, 0.05], [150.0, 170.0, 60.0, -0.03], [100.0, 40.0, 0.0, 0.0]]
-        {
+        for u in [
+            [200.0, 0.0, 0.0, 0.12],
+            [210.0, 150.0, 20.0, 0.05],
+            [150.0, 170.0, 60.0, -0.03],
+            [100.0, 40.0, 0.0, 0.0],
+            [200.0, 400.0, 0.0, -0.1],
+            [-120.0, 30.0, 5.0, -0.02],
+            [-80.0, -200.0, 15.0, -0.2],
+            [60.0, -90.0, 0.0, 0.07],
+        ] {
             for sigma in [1.0, -1.0, 0.0] {
                 check_jacobian(&h, u, sigma);
             }
@@ -621,25 +727,91 @@ mod tests {
 
     #[test]
     fn ht_flow_terms_cancel_in_the_power_balance() {
-        // ω·F = −Q·P_loss with P_loss from eq 2.19 written out directly
+        // ω·F = −Q·P_loss with P_loss from eq 2.19 written out directly (Q > 0)
         let h = ht([0.0; 3]);
         let g = &h.geometry;
         use HtParam::*;
-        for (u, sigma) in [([210.0, 150.0, 20.0, 0.05], 1.0), ([150.0, 170.0, 60.0, -0.03], -1.0)] {
+        let u = [210.0, 150.0, 20.0, 0.05];
+        let q = u[3] / g.get(FlowArea);
+        let t = |p| g.get(p).tan();
+        let vp = g.get(StatorExitRadius) * (u[2] - u[0]) + q * (t(StatorExitAngle) - t(PumpInletAngle));
+        let vt = g.get(PumpExitRadius) * (u[0] - u[1]) + q * (t(PumpExitAngle) - t(TurbineInletAngle));
+        let vs = g.get(TurbineExitRadius) * (u[1] - u[2]) + q * (t(TurbineExitAngle) - t(StatorInletAngle));
+        let rho = g.get(FluidDensity);
+        let vre2: f64 =
+            [PumpExitAngle, TurbineExitAngle, StatorExitAngle].iter().map(|&a| q * q * (1.0 + t(a).powi(2))).sum();
+        let ploss = rho / 2.0 * (vp * vp + vt * vt + vs * vs) + rho * g.get(FrictionLoss) / 2.0 * vre2;
+        let lp = h.loss_power_w(&u, &h.forces(&u, 1.0));
+        assert!((lp - u[3] * ploss).abs() <= 1e-10 * lp.abs(), "{lp} vs {}", u[3] * ploss);
+        assert!(lp > 0.0);
+    }
+
+    /// The reverse-flow form written out by hand (docs/models.md, "Reverse flow"): torques from the
+    /// angular momentum leaving across the inlet edges, the reverse shock velocities, friction with
+    /// the inlet angles; ω·F = −|Q|·P_loss in every quadrant of the speeds.
+    #[test]
+    fn ht_reverse_flow_terms_cancel_in_the_power_balance() {
+        let h = ht([0.0; 3]);
+        let g = &h.geometry;
+        use HtParam::*;
+        let t = |p| g.get(p).tan();
+        let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
+        let rho = g.get(FluidDensity);
+        for u in [
+            [150.0, 170.0, 60.0, -0.03],
+            [200.0, 400.0, 0.0, -0.1],
+            [-120.0, 30.0, 0.0, -0.02],
+            [-80.0, -200.0, 15.0, -0.2],
+            [0.0, 300.0, 0.0, -0.05],
+        ] {
             let q = u[3] / g.get(FlowArea);
-            let t = |p| g.get(p).tan();
-            let vp = g.get(StatorExitRadius) * (u[2] - u[0]) + q * (t(StatorExitAngle) - t(PumpInletAngle));
-            let vt = g.get(PumpExitRadius) * (u[0] - u[1]) + q * (t(PumpExitAngle) - t(TurbineInletAngle));
-            let vs = g.get(TurbineExitRadius) * (u[1] - u[2]) + q * (t(TurbineExitAngle) - t(StatorInletAngle));
-            let rho = g.get(FluidDensity);
-            let vre2: f64 =
-                [PumpExitAngle, TurbineExitAngle, StatorExitAngle].iter().map(|&a| q * q * (1.0 + t(a).powi(2))).sum();
-            let ploss =
-                sigma * rho / 2.0 * (vp * vp + vt * vt + vs * vs) + sigma * rho * g.get(FrictionLoss) / 2.0 * vre2;
-            let lp = h.loss_power_w(&u, &h.forces(&u, sigma));
-            assert!((lp - u[3] * ploss).abs() <= 1e-10 * lp.abs(), "{lp} vs {}", u[3] * ploss);
+            // leaving across the inlet edges: pump at R_s, turbine at R_p, stator at R_t
+            let hp = u[0] * rs * rs + rs * t(PumpInletAngle) * q;
+            let ht_ = u[1] * rp * rp + rp * t(TurbineInletAngle) * q;
+            let hs = u[2] * rt * rt + rt * t(StatorInletAngle) * q;
+            // external torque = ρ|Q|(h out − h in): pump ← turbine ← stator ← pump
+            let mass_flow = rho * u[3].abs();
+            let ext = [mass_flow * (hp - ht_), mass_flow * (ht_ - hs), mass_flow * (hs - hp)];
+            let f = h.forces(&u, -1.0);
+            for x in 0..3 {
+                assert!((f[x] + ext[x]).abs() <= 1e-12 * ext[x].abs().max(1.0), "{x}: {} vs {}", f[x], -ext[x]);
+            }
+            let vp = rp * (u[1] - u[0]) + q * (t(TurbineInletAngle) - t(PumpExitAngle));
+            let vt = rt * (u[2] - u[1]) + q * (t(StatorInletAngle) - t(TurbineExitAngle));
+            let vs = rs * (u[0] - u[2]) + q * (t(PumpInletAngle) - t(StatorExitAngle));
+            let vre2: f64 = [PumpInletAngle, TurbineInletAngle, StatorInletAngle]
+                .iter()
+                .map(|&a| q * q * (1.0 + t(a).powi(2)))
+                .sum();
+            let ploss = rho / 2.0 * (vp * vp + vt * vt + vs * vs) + rho * g.get(FrictionLoss) / 2.0 * vre2;
+            let lp = h.loss_power_w(&u, &f);
+            assert!((lp - u[3].abs() * ploss).abs() <= 1e-10 * lp.abs(), "{u:?}: {lp} vs {}", u[3].abs() * ploss);
             assert!(lp > 0.0);
         }
+    }
+
+    /// At Q = 0 with unit shock coefficients both forms give the centrifugal head
+    /// `½ρ Σ ω_x² (R_exit,x² − R_inlet,x²)`: F_Q(0⁺) = F_Q(0⁻), so the flow passes through zero
+    /// without sticking (docs/models.md, "At Q = 0").
+    #[test]
+    fn ht_zero_flow_force_is_the_same_from_both_sides_with_unit_shock_coefficients() {
+        let h = ht([0.0; 3]);
+        let (rp, rt, rs) = (0.12f64, 0.065f64, 0.06f64);
+        for w in [[209.4, 209.4, 0.0], [100.0, 250.0, 0.0], [-50.0, 80.0, 30.0], [0.0, 0.0, 0.0]] {
+            let (fp, fm) = h.zero_flow_head(&[w[0], w[1], w[2], 0.0]);
+            let centrifugal = 0.5
+                * 840.0
+                * (w[0] * w[0] * (rp * rp - rs * rs)
+                    + w[1] * w[1] * (rt * rt - rp * rp)
+                    + w[2] * w[2] * (rs * rs - rt * rt));
+            let scale = 840.0 * rp * rp * w.iter().map(|x| x * x).sum::<f64>() + 1e-300;
+            assert!((fp - centrifugal).abs() <= 1e-12 * scale, "{w:?}: {fp} vs {centrifugal}");
+            assert!((fm - centrifugal).abs() <= 1e-12 * scale, "{w:?}: {fm} vs {centrifugal}");
+        }
+        // the brief's hand check: stator locked, SR = 1: ½ρω²(R_t² − R_s²) > 0, the flow starts forwards
+        let w = 209.4;
+        let (fp, _) = h.zero_flow_head(&[w, w, 0.0, 0.0]);
+        assert!((fp - 0.5 * 840.0 * w * w * (rt * rt - rs * rs)).abs() < 1e-9);
     }
 
     #[test]

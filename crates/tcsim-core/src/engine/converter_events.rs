@@ -68,9 +68,9 @@ pub enum ConverterRoot {
     StatorSpeed,
     /// Flow with sign ±1: Q reaches zero.
     Flow,
-    /// Flow held at zero: the net head beats the shock term forwards.
+    /// Flow held at zero: the net force on a starting forward flow, `F_Q(0⁺)`, turns positive.
     FlowStartsPositive,
-    /// Flow held at zero: the net head beats the shock term backwards.
+    /// Flow held at zero: the net force on a starting reverse flow, `F_Q(0⁻)`, turns negative.
     FlowStartsNegative,
 }
 
@@ -109,7 +109,7 @@ pub fn roots(model: &dyn ConverterDynamics, mode: Mode) -> Vec<ConverterRoot> {
 
 /// The value of `root`, positive while the mode holds (with the hysteresis `h`). `u` holds the
 /// converter's coordinates first; `stator_torque` is the constraint torque on the stator and
-/// `held_flow` the held-flow balance `(d, P₀)` ([`held_flow_balance`]) of the plant.
+/// `held_flow` the held-flow balance `(d⁺, d⁻)` ([`held_flow_balance`]) of the plant.
 pub fn root_value(
     root: ConverterRoot,
     mode: Mode,
@@ -123,33 +123,40 @@ pub fn root_value(
         ConverterRoot::StatorSpeed => u[STATOR] + h.stator_speed_rad_s,
         ConverterRoot::Flow => mode.flow_sign * u[FLOW] + h.flow_m3_s,
         ConverterRoot::FlowStartsPositive => {
-            let (d, p0) = held_flow();
-            p0 - d + h.head_pa
+            let (forward, _) = held_flow();
+            h.head_pa - forward
         }
         ConverterRoot::FlowStartsNegative => {
-            let (d, p0) = held_flow();
-            p0 + d + h.head_pa
+            let (_, reverse) = held_flow();
+            reverse + h.head_pa
         }
     }
 }
 
-/// The net head on a held flow, `d = F_Q(σ = 0) − (M u̇)_Q`, and the shock term `P₀`, from the
-/// converter coordinates `u`, the flow row of the plant's mass matrix and the plant's rates.
+/// The net force on a held flow starting forwards and backwards, `d± = F_Q(0±) − (M u̇)_Q`
+/// ([`ConverterDynamics::zero_flow_head`]), from the converter coordinates `u`, the flow row of
+/// the plant's mass matrix and the plant's rates (with the flow held, so the same for both signs).
 pub fn held_flow_balance(model: &dyn ConverterDynamics, u: &Vec4, flow_mass_row: &[f64], u_dot: &[f64]) -> (f64, f64) {
-    let (head, shock) = model.zero_flow_head(u);
+    let (forward, reverse) = model.zero_flow_head(u);
     let inertial: f64 = flow_mass_row.iter().zip(u_dot).map(|(m, a)| m * a).sum();
-    (head - inertial, shock)
+    (forward - inertial, reverse - inertial)
 }
 
-/// Sign of the flow that starts from Q = 0, from the held-flow balance `(d, P₀)`: +1 or −1 when
-/// the net head beats the shock term, else 0 (held).
-pub fn flow_sign_from_balance((d, p0): (f64, f64)) -> f64 {
-    if d > p0 {
-        1.0
-    } else if d < -p0 {
-        -1.0
-    } else {
-        0.0
+/// Sign of the flow that starts from Q = 0, from the held-flow balance `(d⁺, d⁻)`: +1 when only
+/// `d⁺ > 0`, −1 when only `d⁻ < 0`, the larger of `d⁺` and `−d⁻` when both (forward on a tie),
+/// else 0 (held: `d⁺ ≤ 0 ≤ d⁻`).
+pub fn flow_sign_from_balance((forward, reverse): (f64, f64)) -> f64 {
+    match (forward > 0.0, reverse < 0.0) {
+        (true, true) => {
+            if forward >= -reverse {
+                1.0
+            } else {
+                -1.0
+            }
+        }
+        (true, false) => 1.0,
+        (false, true) => -1.0,
+        (false, false) => 0.0,
     }
 }
 

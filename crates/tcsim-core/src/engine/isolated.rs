@@ -26,15 +26,17 @@
 //!   clutch releases (`T_s ≥ 0` is all a one-way clutch can give).
 //! * stator **free-wheeling** (`T_s = 0`): the stator speed. It reaches zero and the clutch locks.
 //! * flow with **sign σ = ±1** in the losses (eq 2.19): Q. At Q = 0 the sign is decided as below.
-//! * flow **held at zero** (σ = 0): `P₀ − d` and `P₀ + d`, see next.
+//! * flow **held at zero** (σ = 0): `−d⁺` and `d⁻`, see next.
 //!
-//! **Flow reversal (sgn Q).** The shock losses carry `sgn Q`, not Q, so at Q = 0 they jump by
-//! `2P₀`, `P₀ = ½ρ Σ C_sh V_sh²`. The engine treats sgn Q as dry friction (the Filippov
-//! solution): with `d` the net head on the flow at Q = 0 (eq 2.15 without the losses, minus the
-//! inertial coupling, with the flow held), the flow stays at zero while `|d| ≤ P₀` and starts in
-//! the direction of `d` once `|d| > P₀`. Between events the sign is constant, so the right-hand
-//! side is smooth and the energy identity holds exactly (the held flow does no work). This is the
-//! same state the closed-form steady state calls `no-flow` near SR = 1.
+//! **Flow reversal (sgn Q).** The model has one form for Q > 0 (the thesis's equations) and one
+//! for Q < 0 (the reverse-flow form of docs/models.md: the fluid leaves each element across its
+//! inlet edge), and the losses carry `sgn Q`, so the net force on the flow may jump at Q = 0. The
+//! engine treats the switch as a Filippov system: with `d± = F_Q(0±)` minus the inertial coupling
+//! (the flow held), the flow stays at zero while `d⁺ ≤ 0 ≤ d⁻` and starts forwards once `d⁺ > 0`,
+//! backwards once `d⁻ < 0` (both: the larger of `d⁺` and `−d⁻`, forwards on a tie). Between
+//! events the sign is constant, so the right-hand side is smooth and the energy identity holds
+//! exactly (the held flow does no work). This is the state the closed-form steady state calls
+//! `no-flow`.
 
 use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::{self, ConverterRoot};
@@ -312,7 +314,7 @@ impl<'a> Segment<'a> {
         converter_events::external_torques(&self.mass, ud, f)
     }
 
-    /// The net head on a held flow, `d = F_Q(σ = 0) − (M u̇)_Q`, and the shock term `P₀`.
+    /// The net force on a held flow starting forwards and backwards, `d± = F_Q(0±) − (M u̇)_Q`.
     fn held_flow_balance(&self, u: &Vec4, ud: &Vec4) -> (f64, f64) {
         converter_events::held_flow_balance(self.model, u, &self.mass[FLOW], ud)
     }
@@ -383,8 +385,7 @@ pub fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f
     mode
 }
 
-/// Sign of the flow that starts from Q = 0: +1 or −1 when the net head beats the shock term,
-/// else 0 (held).
+/// Sign of the flow that starts from Q = 0 ([`converter_events::flow_sign_from_balance`]).
 fn flow_sign_at_zero(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64, stator_locked: bool) -> f64 {
     let seg = Segment::new(model, drive, Mode { stator_locked, flow_sign: 0.0 });
     let mut u0 = *u;

@@ -405,7 +405,7 @@ impl<'a> Plant<'a> {
         }
     }
 
-    /// The converter's held-flow balance `(d, P₀)` with the plant's masses and rates.
+    /// The converter's held-flow balance `(d⁺, d⁻)` with the plant's masses and rates.
     pub(super) fn held_flow_balance(&self, u: &Coords, ud: &Coords) -> (f64, f64) {
         converter_events::held_flow_balance(self.model, &[u[0], u[1], u[2], u[3]], &self.mass[FLOW], ud)
     }
