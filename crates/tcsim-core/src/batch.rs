@@ -254,7 +254,7 @@ mod tests {
     fn batch_matches_pointwise_and_reports_failures() {
         let g = HtGeometry::appendix_d();
         let wp = [200.0, 200.0, 200.0];
-        let wt = [0.0, 100.0, 260.0];
+        let wt = [0.0, 100.0, f64::NAN];
         let lenient = ht_steady_states(&[g], &wp, &wt, false).unwrap();
         let one = steady_state(&g, 200.0, 100.0).unwrap();
         assert_eq!(lenient.pump_torque_nm[1], one.pump_torque_nm);
@@ -262,7 +262,10 @@ mod tests {
         assert!(lenient.flow_m3_s[2].is_nan());
         let strict = ht_steady_states(&[g], &wp, &wt, true).unwrap_err();
         assert_eq!(strict.index, 2);
-        assert_eq!(strict.error.field, "speed_ratio");
+        assert_eq!(strict.error.field, "turbine_speed_rad_s");
+        // overrun has a steady state now (reverse flow)
+        let coast = ht_steady_states(&[g], &[200.0], &[260.0], true).unwrap();
+        assert!(coast.flow_m3_s[0] < 0.0 && coast.pump_torque_nm[0] < 0.0);
     }
 
     #[test]

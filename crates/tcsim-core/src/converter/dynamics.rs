@@ -824,6 +824,66 @@ mod tests {
         assert!((-f[PUMP] - p.pump_torque_nm).abs() < 1e-10 * p.pump_torque_nm);
     }
 
+    /// Passivity at every steady state of a grid over all signs of ω_p and ω_t (SR up to 5 and
+    /// below −5): the absorbed power `T_p ω_p + T_t ω_t + T_s ω_s` (external torques, physics notes
+    /// §2) equals `|Q|·P_loss ≥ 0`; the closed form balances the mass-matrix forces of its flow
+    /// direction (F_Q = 0, torques equal) and respects the one-way clutch.
+    #[test]
+    fn ht_steady_states_in_every_quadrant_are_passive_and_balance_the_forces() {
+        use crate::converter::hrovat_tobler::StatorMode;
+        let h = ht([0.0; 3]);
+        let speeds = [-400.0, -209.4, -60.0, -1.0, 0.0, 1e-3, 30.0, 150.0, 209.4, 300.0, 1000.0];
+        let mut reverse = 0;
+        for &wp in &speeds {
+            for &wt in &speeds {
+                let s = steady_state(&h.geometry, wp, wt).unwrap();
+                let (ws, q) = (s.stator_speed_rad_s, s.flow_m3_s);
+                let absorbed = s.pump_torque_nm * wp - s.turbine_torque_nm * wt + s.stator_torque_nm * ws;
+                let scale = 840.0 * 0.0144 * 0.12 * (wp.abs() + wt.abs()).powi(3) + 1e-300;
+                assert!(absorbed >= -1e-12 * scale, "{wp} {wt}: absorbed {absorbed}");
+                match s.mode {
+                    StatorMode::Locked => assert!(ws == 0.0 && s.stator_torque_nm >= 0.0, "{wp} {wt}: {s:?}"),
+                    StatorMode::FreeWheeling => assert!(ws >= 0.0 && s.stator_torque_nm == 0.0, "{wp} {wt}: {s:?}"),
+                    StatorMode::NoFlow => assert!(q == 0.0 && absorbed == 0.0, "{wp} {wt}: {s:?}"),
+                }
+                if q == 0.0 {
+                    continue;
+                }
+                reverse += usize::from(q < 0.0);
+                let sigma = q.signum();
+                let u = [wp, wt, ws, q];
+                let f = h.forces(&u, sigma);
+                let torque_scale = 840.0 * 0.0144 * (wp.abs() + wt.abs()).powi(2) * 0.12;
+                assert!(f[FLOW].abs() <= 1e-9 * 840.0 * 0.0144 * (wp.abs() + wt.abs()).powi(2), "{wp} {wt}: {f:?}");
+                assert!((-f[PUMP] - s.pump_torque_nm).abs() <= 1e-10 * torque_scale, "{wp} {wt}");
+                assert!((f[TURBINE] - s.turbine_torque_nm).abs() <= 1e-10 * torque_scale, "{wp} {wt}");
+                assert!((absorbed - h.loss_power_w(&u, &f)).abs() <= 1e-9 * scale, "{wp} {wt}");
+                assert!(h.loss_power_w(&u, &f) > 0.0);
+            }
+        }
+        assert!(reverse > 10, "{reverse} reverse-flow points");
+    }
+
+    /// Sustained overrun of the bundled Appendix D converter (SR 1.2, 2, 3 at 2000 rpm): the flow
+    /// reverses and the pump torque opposes the pump's rotation (engine braking), with the stator
+    /// free-wheeling (the clutch lets go: the reversed flow drives it forwards) and with it locked.
+    #[test]
+    fn ht_coast_reverses_the_flow_and_brakes_the_pump() {
+        use crate::converter::hrovat_tobler::{solve_reverse, StatorMode};
+        let g = HtGeometry::appendix_d();
+        let wp = 209.4;
+        for sr in [1.2, 2.0, 3.0] {
+            let s = steady_state(&g, wp, sr * wp).unwrap();
+            assert_eq!(s.mode, StatorMode::FreeWheeling, "SR {sr}");
+            assert!(s.flow_m3_s < 0.0 && s.pump_torque_nm < 0.0 && s.stator_speed_rad_s > 0.0, "SR {sr}: {s:?}");
+            assert!((s.torque_ratio() - 1.0).abs() < 1e-12);
+            let locked = solve_reverse(&g, wp, sr * wp, StatorMode::Locked).unwrap();
+            assert!(locked.flow_m3_s < 0.0 && locked.pump_torque_nm < 0.0, "SR {sr}: {locked:?}");
+            // the clutch cannot hold it: the reversed flow drives the stator forwards (T_s < 0)
+            assert!(locked.stator_torque_nm < 0.0);
+        }
+    }
+
     #[test]
     fn mass_matrix_bound_is_the_models_check() {
         let shape = [0.004, -0.003, 0.001];

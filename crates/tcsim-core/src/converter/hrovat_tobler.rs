@@ -149,6 +149,13 @@ impl HtGeometry<f64> {
                 "a positive friction loss or shock losses with non-zero incidence: without losses the flow is unbounded",
             ));
         }
+        if g.reverse_dissipation_coefficient() <= 0.0 {
+            return Err(CoreError::new(
+                "friction_loss",
+                values[HtParam::FrictionLoss.index()],
+                "a positive friction loss or shock losses with non-zero incidence in reverse flow too: without losses the reverse flow is unbounded",
+            ));
+        }
         Ok(g)
     }
 
@@ -213,6 +220,18 @@ impl HtGeometry<f64> {
 
     pub fn to_dual(&self) -> HtGeometry<Dual> {
         HtGeometry { values: self.values.map(Dual::cst) }
+    }
+
+    /// The coefficient of q² in the reverse-flow locked-stator residual divided by ρ/2 (the
+    /// reverse shock velocities and friction with the inlet angles); positive when the losses bound
+    /// a reverse flow.
+    fn reverse_dissipation_coefficient(&self) -> f64 {
+        let [tp, tt, ts, tpp, ttt, tss] = tangents(self);
+        let c =
+            [self.get(HtParam::PumpShockLoss), self.get(HtParam::TurbineShockLoss), self.get(HtParam::StatorShockLoss)];
+        let b = [ttt - tp, tss - tt, tpp - ts];
+        let friction = 3.0 + tpp * tpp + ttt * ttt + tss * tss;
+        c.iter().zip(b).map(|(c, b)| c * b * b).sum::<f64>() + self.get(HtParam::FrictionLoss) * friction
     }
 
     /// The coefficient of −q² in the locked-stator residual divided by ρ/2; positive when the
@@ -460,21 +479,110 @@ pub fn locked_steady_state<T: Scalar>(
     solve_mode(g, pump_speed_rad_s, turbine_speed_rad_s, StatorMode::Locked)
 }
 
-/// The operating point's errors are about the speeds asked for ([`InputSource::Drive`]).
+/// The operating point's errors are about the speeds asked for ([`InputSource::Drive`]): any
+/// finite pair of speeds has a steady state.
 fn check_operating_point(wp: f64, wt: f64) -> CoreResult<()> {
-    if !(wp.is_finite() && wp > 0.0) {
-        return Err(CoreError::of(InputSource::Drive, "pump_speed_rad_s", wp, "a finite, positive pump speed"));
+    if !wp.is_finite() {
+        return Err(CoreError::of(InputSource::Drive, "pump_speed_rad_s", wp, "a finite pump speed"));
     }
-    let sr = wt / wp;
-    if !(0.0..=1.0).contains(&sr) {
-        return Err(CoreError::of(
-            InputSource::Drive,
-            "speed_ratio",
-            sr,
-            "a speed ratio from 0 to 1: the Hrovat & Tobler steady state does not yet cover reverse turbine rotation or overrun",
-        ));
+    if !wt.is_finite() {
+        return Err(CoreError::of(InputSource::Drive, "turbine_speed_rad_s", wt, "a finite turbine speed"));
     }
     Ok(())
+}
+
+/// The reverse-flow residual `F_Q/ρ·ρ` (docs/models.md, "Reverse flow") as a polynomial in
+/// `p = −q ≥ 0`, for a stator speed affine in p.
+fn reverse_balance<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
+    use HtParam::*;
+    let rho = g.get(FluidDensity);
+    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
+    let [tp, tt, ts, tpp, ttt, tss] = tangents(g);
+    let w = [Quad::cst(wp), Quad::cst(wt), stator_speed];
+    let q = Quad::q().times(T::cst(-1.0));
+    let (r_leave, tan_leave, src) = ([rs, rp, rt], [tpp, ttt, tss], [1usize, 2, 0]);
+    let h: [Quad<T>; 3] =
+        std::array::from_fn(|x| w[x].times(r_leave[x] * r_leave[x]).add(q.times(r_leave[x] * tan_leave[x])));
+    let head = (0..3).fold(Quad::cst(T::cst(0.0)), |acc, x| acc.add(w[x].mul_affine(h[src[x]].sub(h[x]))));
+    let (r_entry, b) = ([rp, rt, rs], [ttt - tp, tss - tt, tpp - ts]);
+    let c = [g.get(PumpShockLoss), g.get(TurbineShockLoss), g.get(StatorShockLoss)];
+    let shock = (0..3).fold(Quad::cst(T::cst(0.0)), |acc, x| {
+        let v = w[src[x]].sub(w[x]).times(r_entry[x]).add(q.times(b[x]));
+        acc.add(v.mul_affine(v).times(c[x]))
+    });
+    let one = T::cst(1.0);
+    let friction = q.mul_affine(q).times(g.get(FrictionLoss) * (one + tpp * tpp + one + ttt * ttt + one + tss * tss));
+    let residual = head.add(shock.add(friction).times(T::cst(0.5))).times(rho);
+    Balance { residual, stator_speed }
+}
+
+/// A reverse-flow steady state in `mode` (locked or free-wheeling): the root in `p = −q > 0` of
+/// largest magnitude (the locked residual has one), with the torques of the reverse form.
+pub(crate) fn solve_reverse<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, mode: StatorMode) -> Option<HtSteadyState<T>> {
+    use HtParam::*;
+    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
+    let [_, _, _, tpp, ttt, tss] = tangents(g);
+    let stator_speed = match mode {
+        StatorMode::Locked => Quad::cst(T::cst(0.0)),
+        // T_s = 0: the stator passes on the angular momentum it receives from the pump,
+        // ω_s R_t² + R_t tan α_ss q = ω_p R_s² + R_s tan α_pp q, with q = −p
+        _ => Quad::affine(wp * rs * rs / (rt * rt), (rt * tss - rs * tpp) / (rt * rt)),
+    };
+    let b = reverse_balance(g, wp, wt, stator_speed);
+    let p = largest_real_root(b.residual)?;
+    if p.re() <= 0.0 {
+        return None;
+    }
+    let (ws, q) = (b.stator_speed.eval(p), -p);
+    let flow = q * g.get(FlowArea);
+    let rho = g.get(FluidDensity);
+    let hp = wp * rs * rs + rs * tpp * q;
+    let ht = wt * rp * rp + rp * ttt * q;
+    let hs = ws * rt * rt + rt * tss * q;
+    Some(HtSteadyState {
+        flow_m3_s: flow,
+        stator_speed_rad_s: ws,
+        // external torque −F_x = −ρQ(h_x − h_src(x)); the turbine's delivered torque is F_t
+        pump_torque_nm: -(rho * (hp - ht) * flow),
+        turbine_torque_nm: rho * (ht - hs) * flow,
+        stator_torque_nm: if mode == StatorMode::Locked { -(rho * (hs - hp) * flow) } else { T::cst(0.0) },
+        mode,
+    })
+}
+
+/// The direction in which the flow starts from rest with the stator at rest (σ of
+/// [`crate::engine::converter_events::flow_sign_from_balance`] on `F_Q(0±)`): +1, −1 or 0 (held).
+pub fn start_direction<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T) -> i8 {
+    let (forward, reverse) = zero_flow_forces(g, wp, wt);
+    match (forward > 0.0, reverse < 0.0) {
+        (true, true) => {
+            if forward >= -reverse {
+                1
+            } else {
+                -1
+            }
+        }
+        (true, false) => 1,
+        (false, true) => -1,
+        (false, false) => 0,
+    }
+}
+
+/// `(F_Q(0⁺), F_Q(0⁻))` with the stator at rest, Pa.
+pub fn zero_flow_forces<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T) -> (f64, f64) {
+    let zero = Quad::cst(T::cst(0.0));
+    (balance(g, wp, wt, zero).residual.c[0].re(), reverse_balance(g, wp, wt, zero).residual.c[0].re())
+}
+
+fn no_flow<T: Scalar>(stator_speed: T) -> HtSteadyState<T> {
+    HtSteadyState {
+        flow_m3_s: T::cst(0.0),
+        stator_speed_rad_s: stator_speed,
+        pump_torque_nm: T::cst(0.0),
+        turbine_torque_nm: T::cst(0.0),
+        stator_torque_nm: T::cst(0.0),
+        mode: StatorMode::NoFlow,
+    }
 }
 
 impl<T: Scalar> HtSteadyState<T> {
@@ -497,8 +605,11 @@ fn overflow(wp: f64) -> CoreError {
     )
 }
 
-/// Steady state with the one-way clutch: locked while it holds (T_s ≥ 0), free-wheeling past the
-/// coupling point, no flow where the free-wheeling quadratic has no positive root.
+/// Steady state with the one-way clutch at any finite speeds (docs/models.md, "Steady state in
+/// every quadrant"). The flow direction is the one in which the flow starts from rest with the
+/// stator at rest ([`start_direction`]); in that direction: locked while the clutch holds
+/// (T_s ≥ 0), else free-wheeling if that has a steady state with ω_s ≥ 0, else no flow (Q = 0,
+/// zero torques, ω_s = ω_t). A flow held at rest gives no flow with ω_s = 0.
 pub fn steady_state<T: Scalar>(
     g: &HtGeometry<T>,
     pump_speed_rad_s: T,
@@ -506,30 +617,27 @@ pub fn steady_state<T: Scalar>(
 ) -> CoreResult<HtSteadyState<T>> {
     let (wp, wt) = (pump_speed_rad_s, turbine_speed_rad_s);
     check_operating_point(wp.re(), wt.re())?;
-    let locked = locked_steady_state(g, wp, wt).ok_or_else(|| {
-        CoreError::new(
-            "speed_ratio",
-            wt.re() / wp.re(),
-            "an operating point where the locked-stator head exceeds the shock losses (no steady state with positive flow for these parameters)",
-        )
-    })?;
+    let scale = wp.re().abs().max(wt.re().abs());
+    let (forward, reverse) = zero_flow_forces(g, wp, wt);
+    if !(forward.is_finite() && reverse.is_finite()) {
+        return Err(overflow(scale));
+    }
+    let direction = start_direction(g, wp, wt);
+    if direction == 0 {
+        return Ok(no_flow(T::cst(0.0)));
+    }
+    let solve = |mode| if direction > 0 { solve_mode(g, wp, wt, mode) } else { solve_reverse(g, wp, wt, mode) };
+    let locked = solve(StatorMode::Locked).ok_or_else(|| overflow(scale))?;
     if !locked.is_finite() {
-        return Err(overflow(wp.re()));
+        return Err(overflow(scale));
     }
     if locked.stator_torque_nm.re() >= 0.0 {
         return Ok(locked);
     }
-    match solve_mode(g, wp, wt, StatorMode::FreeWheeling) {
-        Some(free) if !free.is_finite() => Err(overflow(wp.re())),
+    match solve(StatorMode::FreeWheeling) {
+        Some(free) if !free.is_finite() => Err(overflow(scale)),
         Some(free) if free.stator_speed_rad_s.re() >= 0.0 => Ok(free),
-        _ => Ok(HtSteadyState {
-            flow_m3_s: T::cst(0.0),
-            stator_speed_rad_s: wt,
-            pump_torque_nm: T::cst(0.0),
-            turbine_torque_nm: T::cst(0.0),
-            stator_torque_nm: T::cst(0.0),
-            mode: StatorMode::NoFlow,
-        }),
+        _ => Ok(no_flow(wt)),
     }
 }
 
@@ -688,12 +796,17 @@ mod tests {
     }
 
     #[test]
-    fn out_of_range_operating_points_are_errors() {
+    fn only_non_finite_speeds_are_errors() {
         let g = HtGeometry::appendix_d();
-        assert_eq!(steady_state(&g, WP, 1.1 * WP).unwrap_err().field, "speed_ratio");
-        assert_eq!(steady_state(&g, WP, -0.1 * WP).unwrap_err().field, "speed_ratio");
-        assert_eq!(steady_state(&g, -WP, 0.0).unwrap_err().field, "pump_speed_rad_s");
-        assert!(steady_state(&g, f64::NAN, 0.0).is_err());
+        assert_eq!(steady_state(&g, f64::NAN, 0.0).unwrap_err().field, "pump_speed_rad_s");
+        assert_eq!(steady_state(&g, WP, f64::INFINITY).unwrap_err().field, "turbine_speed_rad_s");
+        for (wp, wt) in [(WP, 1.1 * WP), (WP, -0.1 * WP), (-WP, 0.0), (0.0, WP), (0.0, 0.0), (-WP, -3.0 * WP)] {
+            let s = steady_state(&g, wp, wt).unwrap();
+            assert!(s.is_finite(), "{wp} {wt}");
+        }
+        // both speeds zero: nothing moves
+        let s = steady_state(&g, 0.0, 0.0).unwrap();
+        assert_eq!((s.mode, s.flow_m3_s, s.pump_torque_nm, s.stator_speed_rad_s), (StatorMode::NoFlow, 0.0, 0.0, 0.0));
     }
 
     #[test]
@@ -731,7 +844,7 @@ mod tests {
         let outputs_f = |s: &HtSteadyState<f64>| {
             [s.flow_m3_s, s.pump_torque_nm, s.turbine_torque_nm, s.stator_torque_nm, s.stator_speed_rad_s]
         };
-        for sr in [0.0, 0.3, 0.75, 0.95] {
+        for sr in [0.0, 0.3, 0.75, 0.95, -0.5, 1.5, 3.0] {
             let wt = sr * WP;
             for p in HtParam::ALL {
                 let ad = steady_state(&g.seeded(p), Dual::cst(WP), Dual::cst(wt)).unwrap();
@@ -763,9 +876,6 @@ mod tests {
                         steady_state(&g, WP, wt + d).unwrap()
                     }
                 };
-                if sr == 0.0 && which == 1 {
-                    continue; // SR < 0 is out of range: one-sided at stall, checked below
-                }
                 let (a, b) = (eval(-h), eval(h));
                 for (o, (fa, fb)) in outputs(&ad).iter().zip(outputs_f(&a).iter().zip(outputs_f(&b).iter())) {
                     let fd = (fb - fa) / (2.0 * h);
