@@ -5,7 +5,9 @@
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
-use crate::converter::hrovat_tobler::{steady_state, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE};
+use crate::converter::hrovat_tobler::{
+    drive_steady_state, steady_state, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE,
+};
 use crate::error::CoreError;
 use crate::scalar::{Dual, Scalar};
 
@@ -110,7 +112,8 @@ pub fn ht_steady_states_cancellable(
 /// with their exact derivatives with respect to the parameters `free`.
 ///
 /// Returns `(tr, cf, d_tr, d_cf)`; the derivative matrices are row-major, `n_points × free.len()`.
-/// Points without a steady state are NaN, which a least-squares fit must treat as a failure.
+/// Points without a forward-flow drive steady state ([`drive_steady_state`]) are NaN, which a
+/// least-squares fit must treat as a failure.
 pub fn ht_ratio_gradients(
     geometry: &HtGeometry<f64>,
     pump_speed_rad_s: f64,
@@ -130,7 +133,7 @@ pub fn ht_ratio_gradients(
         let seeds: Vec<HtGeometry<Dual>> =
             if k == 0 { vec![geometry.to_dual()] } else { free.iter().map(|&p| geometry.seeded(p)).collect() };
         for (j, g) in seeds.iter().enumerate() {
-            let Ok(s) = steady_state(g, wp, wt) else { break };
+            let Ok(s) = drive_steady_state(g, wp, wt) else { break };
             let (t, c) = (s.torque_ratio(), s.pump_torque_nm);
             tr[i] = t.v;
             cf[i] = c.v / w2;

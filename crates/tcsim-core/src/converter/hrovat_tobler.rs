@@ -628,17 +628,56 @@ pub fn steady_state<T: Scalar>(
     }
     let solve = |mode| if direction > 0 { solve_mode(g, wp, wt, mode) } else { solve_reverse(g, wp, wt, mode) };
     let locked = solve(StatorMode::Locked).ok_or_else(|| overflow(scale))?;
+    with_clutch(locked, || solve(StatorMode::FreeWheeling), wt, scale)
+}
+
+/// The one-way clutch on a locked solution: kept while it holds (T_s ≥ 0), else the free-wheeling
+/// one if it has ω_s ≥ 0, else no flow with ω_s = ω_t.
+fn with_clutch<T: Scalar>(
+    locked: HtSteadyState<T>,
+    free: impl FnOnce() -> Option<HtSteadyState<T>>,
+    wt: T,
+    scale: f64,
+) -> CoreResult<HtSteadyState<T>> {
     if !locked.is_finite() {
         return Err(overflow(scale));
     }
     if locked.stator_torque_nm.re() >= 0.0 {
         return Ok(locked);
     }
-    match solve(StatorMode::FreeWheeling) {
+    match free() {
         Some(free) if !free.is_finite() => Err(overflow(scale)),
         Some(free) if free.stator_speed_rad_s.re() >= 0.0 => Ok(free),
         _ => Ok(no_flow(wt)),
     }
+}
+
+/// The drive steady state with the thesis's equations only (Q ≥ 0), 0 ≤ SR ≤ 1 and ω_p > 0, as
+/// before issue 11: the locked stator's largest root, an error where it has no positive root.
+/// [`steady_state`] gives the same numbers wherever the flow starts forwards; the fits
+/// ([`crate::batch::ht_ratio_gradients`]) fit the drive characteristic with this one, so that a
+/// trial geometry without a forward flow counts as a failure, as it did.
+pub fn drive_steady_state<T: Scalar>(
+    g: &HtGeometry<T>,
+    pump_speed_rad_s: T,
+    turbine_speed_rad_s: T,
+) -> CoreResult<HtSteadyState<T>> {
+    let (wp, wt) = (pump_speed_rad_s, turbine_speed_rad_s);
+    let sr = wt.re() / wp.re();
+    if !(wp.re().is_finite() && wp.re() > 0.0) {
+        return Err(CoreError::of(InputSource::Drive, "pump_speed_rad_s", wp.re(), "a finite, positive pump speed"));
+    }
+    if !(0.0..=1.0).contains(&sr) {
+        return Err(CoreError::of(InputSource::Drive, "speed_ratio", sr, "a speed ratio from 0 to 1 (drive)"));
+    }
+    let locked = locked_steady_state(g, wp, wt).ok_or_else(|| {
+        CoreError::new(
+            "speed_ratio",
+            sr,
+            "an operating point where the locked-stator head exceeds the shock losses (no steady state with positive flow for these parameters)",
+        )
+    })?;
+    with_clutch(locked, || solve_mode(g, wp, wt, StatorMode::FreeWheeling), wt, wp.re())
 }
 
 /// The coupling point: the speed ratio in (0, 1) where the locked-stator holding torque changes
