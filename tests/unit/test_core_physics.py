@@ -98,9 +98,10 @@ def reference_torque_ratio(out) -> np.ndarray:
 def test_steady_torque_ratio_is_the_reference_rule():
     conv = load_converter("li-sunden-2016")
     g = conv.core_geometry().copy()
-    g[0, 1] *= 1.88  # a dense fluid: locked, free-wheeling, no-flow and no steady state
+    g[0, 1] *= 1.88  # a dense fluid: locked, free-wheeling, no-flow (and reverse flow past SR ≈ 1.03)
     wp = 200.0
     sr = np.linspace(0.0, 1.3, 131)
+    sr[-1] = np.nan  # only a non-finite speed has no steady state
     out = hrovat_tobler_steady_state(g, np.full(sr.shape, wp), sr * wp, strict=False)
     assert set(out["stator_mode"].tolist()) == {-1, 0, 1, 2}
     np.testing.assert_array_equal(_columns(out, wp)["torque_ratio"], reference_torque_ratio(out))
