@@ -68,24 +68,18 @@ fn energy_identity_holds_through_clutch_and_flow_events() {
 
 #[test]
 fn agrees_with_the_scipy_reference_take_off() {
-    // bench/scipy_reference.py (LSODA/Radau, rtol 1e-10): final state at 10 s and event times
+    // bench/scipy_reference.py (LSODA/Radau, rtol 1e-10): event times and final state at 10 s. The
+    // reference writes the thesis's forward form for Q < 0 too, so on the tip-out only the events up
+    // to the first flow reversal (the stator release and Q reaching zero) are compared; after it
+    // the reverse-flow form of issue 11 applies (docs/models.md), which the reference lacks.
     let t = grid(0.0, 10.0, 101);
-    let (traj, cols) = run(&ht(SHAPE), &takeoff(true), &t, InitialState::default());
-    let reference_events = [2.3734962, 5.1049215, 5.5777629, 5.6587392, 6.8475352, 8.8716640];
+    let (traj, _) = run(&ht(SHAPE), &takeoff(true), &t, InitialState::default());
+    let reference_events = [2.3734962, 5.1049215];
     let times: Vec<f64> = traj.events.iter().map(|e| e.time_s).collect();
-    assert_eq!(times.len(), reference_events.len(), "{:?}", traj.events);
     for (a, b) in times.iter().zip(reference_events) {
         assert!((a - b).abs() < 5e-5, "event at {a} vs {b}");
     }
-    let last = |name| *col(&cols, name).last().unwrap();
-    for (name, reference) in [
-        ("pump_speed_rad_s", -126.98775),
-        ("turbine_speed_rad_s", 21.33480),
-        ("flow_m3_s", 0.01775067),
-        ("stator_torque_nm", 3.4574),
-    ] {
-        assert!((last(name) - reference).abs() <= 2e-4 * reference.abs(), "{name}: {} vs {reference}", last(name));
-    }
+    assert_eq!(traj.events[1].kind, EventKind::FlowZero);
     let (_, cols) = run(&ht(SHAPE), &takeoff(false), &t, InitialState::default());
     let last = |name| *col(&cols, name).last().unwrap();
     for (name, reference) in [
@@ -111,10 +105,9 @@ fn held_speeds_settle_on_the_closed_form_steady_state() {
     let g = HtGeometry::appendix_d();
     let wp = 209.44;
     let t = grid(0.0, 10.0, 101);
-    // locked (SR 0, 0.5), free-wheeling (SR 0.95) and no-flow (SR 0.995) steady states, each
-    // started away from it: half the flow, stator at rest. (Without flow the stator speed is
-    // undetermined: it keeps whatever speed it had when the flow stopped.)
-    for sr in [0.0, 0.5, 0.95, 0.995] {
+    // locked (SR 0, 0.5) and free-wheeling (SR 0.95) steady states, each started away from it:
+    // half the flow, stator at rest (no-flow: `the_no_flow_region_circles_round_zero_flow`)
+    for sr in [0.0, 0.5, 0.95] {
         let ss = steady_state(&g, wp, sr * wp).unwrap();
         let init = InitialState {
             flow_m3_s: Some(0.5 * ss.flow_m3_s.max(0.02)),
@@ -132,11 +125,7 @@ fn held_speeds_settle_on_the_closed_form_steady_state() {
             traj.events.len()
         );
         match ss.mode {
-            StatorMode::NoFlow => {
-                assert_eq!(last("flow_m3_s"), 0.0);
-                assert_eq!(last("flow_direction"), 0.0);
-                assert_eq!(last("pump_torque_nm"), 0.0);
-            }
+            StatorMode::NoFlow => unreachable!(),
             _ => {
                 assert!(rel(last("flow_m3_s"), ss.flow_m3_s) < 1e-4, "Q {} vs {}", last("flow_m3_s"), ss.flow_m3_s);
                 assert!(rel(last("pump_torque_nm"), ss.pump_torque_nm) < 1e-4);
@@ -153,6 +142,74 @@ fn held_speeds_settle_on_the_closed_form_steady_state() {
         let sum = last("pump_torque_nm") - last("turbine_torque_nm") + last("stator_torque_nm");
         assert!(sum.abs() < 1e-4 * last("pump_torque_nm").abs().max(1.0), "sum {sum}");
     }
+}
+
+/// Between the fold of the free-wheeling branch (SR 0.9923 for Appendix D) and SR 1 the closed
+/// form has no flowing steady state (`no-flow`). With both forms at Q = 0 the flow is not held
+/// there (unit shock coefficients: F_Q(0⁺) = F_Q(0⁻)); the free stator spins up to the speed ω*
+/// where the zero-flow head vanishes, `ω*² = (ω_p²(R_p² − R_s²) + ω_t²(R_t² − R_p²)) / (R_t² − R_s²)`,
+/// and the flow circles round zero there with a small amplitude (docs/models.md, "At Q = 0").
+#[test]
+fn the_no_flow_region_circles_round_zero_flow() {
+    let g = HtGeometry::appendix_d();
+    let (wp, sr) = (209.44, 0.995);
+    assert_eq!(steady_state(&g, wp, sr * wp).unwrap().mode, StatorMode::NoFlow);
+    let wt = sr * wp;
+    let (rp, rt, rs) = (0.12f64, 0.065f64, 0.06f64);
+    let w_star = ((wp * wp * (rp * rp - rs * rs) + wt * wt * (rt * rt - rp * rp)) / (rt * rt - rs * rs)).sqrt();
+    let t = grid(0.0, 40.0, 40001);
+    let init = InitialState { flow_m3_s: Some(0.01), stator_speed_rad_s: Some(0.0), ..Default::default() };
+    let (traj, cols) = run(&ht(SHAPE), &held(wp, wt, 40.0), &t, init);
+    let late = |name| col(&cols, name)[30000..].to_vec();
+    let max_abs = |v: Vec<f64>| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let (q_late, tp_late) = (max_abs(late("flow_m3_s")), max_abs(late("pump_torque_nm")));
+    let ws_err = max_abs(late("stator_speed_rad_s").iter().map(|w| w - w_star).collect());
+    println!(
+        "ω* {w_star}: late |Q| ≤ {q_late}, |T_p| ≤ {tp_late}, |ω_s − ω*| ≤ {ws_err}, {} events",
+        traj.events.len()
+    );
+    // the flowing free-wheeling state at SR 0.95 carries 0.05 m³/s and 40 N·m
+    assert!(q_late < 1e-3 && tp_late < 2.0, "{q_late} {tp_late}");
+    assert!(ws_err < 0.01 * w_star, "{ws_err}");
+    // it passes Q = 0 both ways (flow-zero events), never stuck
+    assert!(traj.events.iter().any(|e| e.kind == EventKind::FlowZero && e.mode.flow_sign == -1.0));
+    assert!(traj.events.iter().any(|e| e.kind == EventKind::FlowZero && e.mode.flow_sign == 1.0));
+    let (rel, passed) = energy_residual(&cols);
+    assert!(rel.abs() < 1e-6, "energy residual {rel:e} of {passed} J");
+}
+
+/// Coast at held speeds (SR 1.2, 2, 3; pump 2000 rpm): the run starts on the reverse-flow steady
+/// state and stays there; the pump torque brakes the pump, the loss is positive and the energy
+/// identity holds.
+#[test]
+fn coast_at_held_speeds_brakes_the_pump_with_reverse_flow() {
+    let g = HtGeometry::appendix_d();
+    let wp = 209.44;
+    let t = grid(0.0, 3.0, 301);
+    for sr in [1.2, 2.0, 3.0] {
+        let ss = steady_state(&g, wp, sr * wp).unwrap();
+        let (traj, cols) = run(&ht(SHAPE), &held(wp, sr * wp, 3.0), &t, InitialState::default());
+        let last = |name| *col(&cols, name).last().unwrap();
+        assert!(traj.events.is_empty(), "SR {sr}: {:?}", traj.events);
+        assert!(last("flow_m3_s") < 0.0 && last("pump_torque_nm") < 0.0, "SR {sr}");
+        assert!((last("pump_torque_nm") - ss.pump_torque_nm).abs() < 1e-6 * ss.pump_torque_nm.abs());
+        assert!(col(&cols, "fluid_loss_power_w").iter().all(|&p| p > 0.0));
+    }
+    // a ramp through SR 1.0 → 1.06 in 0.7 s (the issue's coast): the flow reverses once, smoothly,
+    // with no on/off bursts and with engine braking at the end
+    let drive = Drive::Speeds {
+        pump_speed_rad_s: signal("pump", &[(0.0, wp), (0.7, wp)]),
+        turbine_speed_rad_s: signal("turbine", &[(0.0, wp), (0.7, 1.06 * wp)]),
+    };
+    let t = grid(0.0, 0.7, 701);
+    let (traj, cols) = run(&ht(SHAPE), &drive, &t, InitialState::default());
+    let q = col(&cols, "flow_m3_s");
+    let sign_changes = q.windows(2).filter(|w| w[0] * w[1] < 0.0).count();
+    println!("ramp 1.0 → 1.06: events {:?}, final T_p {}", traj.events, col(&cols, "pump_torque_nm")[700]);
+    assert!(sign_changes <= 1, "{sign_changes} sign changes");
+    assert!(col(&cols, "pump_torque_nm")[700] < -10.0);
+    let (rel, passed) = energy_residual(&cols);
+    assert!(rel.abs() < 1e-6, "energy residual {rel:e} of {passed} J");
 }
 
 #[test]
@@ -182,7 +239,9 @@ fn tip_out_reverses_the_flow_and_finishes() {
     let (traj, cols) = run(&ht(SHAPE), &takeoff(true), &t, InitialState::default());
     assert_eq!(*col(&cols, "time_s").last().unwrap(), 10.0);
     assert!(
-        traj.events.iter().any(|e| e.kind == EventKind::FlowStart && e.mode.flow_sign == -1.0),
+        traj.events
+            .iter()
+            .any(|e| matches!(e.kind, EventKind::FlowStart | EventKind::FlowZero) && e.mode.flow_sign == -1.0),
         "{:?}",
         traj.events
     );
