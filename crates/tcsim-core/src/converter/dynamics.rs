@@ -520,7 +520,7 @@ impl ConverterDynamics for HtDynamics {
         m
     }
     /// σ = +1 and σ = 0 (held) use the thesis's equations (the latter without the loss, which a held
-    /// flow does not see); σ = −1 the reverse-flow form ([`ReverseConst`]).
+    /// flow does not see); σ = −1 the reverse-flow form (`ReverseConst`).
     fn forces(&self, u: &Vec4, sigma: f64) -> Vec4 {
         let k = &self.k;
         if sigma < 0.0 {

@@ -22,6 +22,12 @@
 //!   Filippov solution of the sgn Q discontinuity), TR = 1 by continuity, and the stator speed,
 //!   which the equations leave undetermined at Q = 0, equal to the turbine speed. At SR = 1
 //!   this is physics notes §4's ω_s = ω_p, Q = 0.
+//! * **Reverse flow** (Q < 0, docs/models.md "Reverse flow"): the fluid leaves each element across
+//!   its inlet edge; the same structure with the reverse geometry gives a quadratic in q for the
+//!   locked and the free-wheeling stator (`solve_reverse`).
+//! * **Every quadrant** ([`steady_state`]): the flow direction is the one in which the flow starts
+//!   from rest with the stator at rest ([`start_direction`]); the clutch logic then follows.
+//!   [`drive_steady_state`] keeps the drive-only forward solution for the fits.
 //!
 //! The solvers are generic over [`Scalar`] so that the same code yields exact derivatives.
 
