@@ -34,10 +34,12 @@ def test_a_negative_first_turbine_speed_names_the_measurement(tmp_path, capsys):
     assert not (tmp_path / "o").exists()
 
 
-def test_a_first_sample_without_a_steady_state_names_the_measurement(tmp_path, capsys):
+def test_a_first_sample_in_overrun_replays_with_hrovat_tobler(tmp_path):
+    # before issue 11: exit 2, "initial speed_ratio = 2: expected a speed ratio from 0 to 1"; now the
+    # H&T steady state covers overrun (reverse flow), so the replay starts from it
     meas = _csv(tmp_path / "log.csv", pump_speed_rad_s=100.0, turbine_speed_rad_s=200.0)
-    assert main(["replay", "li-sunden-2016", meas, "--drive", "speeds", "--out", str(tmp_path / "o")]) == 2
-    assert _error_line(capsys).startswith(f"error: {meas}: initial speed_ratio = 2: expected a speed ratio")
+    args = ["replay", "li-sunden-2016", meas, "--drive", "speeds", "-m", "hrovat-tobler", "--out", str(tmp_path / "o")]
+    assert main(args) == 0
 
 
 def test_a_bad_initial_value_names_the_command_line(tmp_path, capsys):

@@ -237,9 +237,10 @@ def test_invalid_values_and_missing_steady_states_are_nan_not_a_crash(conv):
     assert len(res) == (3 + 1) * 4 + 3 * 4  # the stator exit angle of 60° is added to -90, 0, 90
     at_90 = res["parameter_value"].abs() == 90.0
     assert (res.loc[at_90, "stator_mode"] == study.INVALID_PARAMETER).all()
-    # a stator shock loss of 10.5 or 20 leaves the locked head below the shock loss near SR 1
-    lost = (res["parameter"] == "stator_shock_loss") & (res["parameter_value"] > 1) & (res["speed_ratio"] >= 0.9)
-    assert (res.loc[lost, "stator_mode"] == "no-steady-state").all()
-    bad = at_90 | lost
-    assert res.loc[bad, COLUMNS[3:-1]].isna().all().all()
-    assert res.loc[~bad, COLUMNS[3:-1]].notna().all().all()
+    # a stator shock loss of 10.5 or 20 leaves the locked head below the shock loss near SR 1: the
+    # flow is held at rest either way (F_Q(0+) <= 0 <= F_Q(0-), issue 11), a steady state without flow
+    held = (res["parameter"] == "stator_shock_loss") & (res["parameter_value"] > 1) & (res["speed_ratio"] >= 0.9)
+    assert (res.loc[held, "stator_mode"] == "no-flow").all()
+    assert (res.loc[held, "pump_torque_nm"] == 0.0).all()
+    assert res.loc[at_90, COLUMNS[3:-1]].isna().all().all()
+    assert res.loc[~at_90 & ~held, COLUMNS[3:-1]].notna().all().all()

@@ -14,7 +14,8 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tcsim import hrovat_tobler_steady_state, load_converter
+from tcsim import hrovat_tobler_steady_state, load_converter, simulate
+from tcsim.models.drives import Speeds
 
 CONVERTERS = ("li-sunden-2016", "li-sunden-2016-fitted")
 GEOMETRY = {name: load_converter(name).core_geometry() for name in CONVERTERS}
@@ -58,3 +59,19 @@ def test_steady_states_are_passive_on_a_grid_and_coast_brakes_the_pump(name):
     sr = np.array([1.2, 2.0, 3.0, 5.0])
     out = check_passive(name, np.full(sr.shape, 209.44), 209.44 * sr)
     assert np.all(out["flow_m3_s"] < 0.0) and np.all(out["pump_torque_nm"] < 0.0), out
+
+
+def test_the_closed_form_coast_state_is_the_transients_where_the_flow_could_start_either_way():
+    """Fitted geometry (shock coefficients below 1), SR 1.037: at rest F_Q(0⁺) > 0 > F_Q(0⁻); the
+    forward direction has no flowing steady state, the reverse free-wheeling one is returned, and a
+    transient run held there from it stays on it (no event)."""
+    conv = load_converter("li-sunden-2016-fitted")
+    wp, wt = 178.0, 1.037 * 178.0
+    out = hrovat_tobler_steady_state(conv.core_geometry(), np.array([wp]), np.array([wt]))
+    assert out["stator_mode"][0] == 1 and out["flow_m3_s"][0] < 0.0 and out["pump_torque_nm"][0] < 0.0
+    drive = Speeds(time_s=[0.0, 3.0], pump_speed_rad_s=[wp, wp], turbine_speed_rad_s=[wt, wt])
+    run = simulate(conv, drive, "hrovat-tobler", times_s=np.linspace(0.0, 3.0, 31))
+    assert not run.events
+    last = run.frame().iloc[-1]
+    assert last["flow_m3_s"] == pytest.approx(out["flow_m3_s"][0], rel=1e-6)
+    assert last["pump_torque_nm"] == pytest.approx(out["pump_torque_nm"][0], rel=1e-6)

@@ -615,7 +615,9 @@ fn overflow(wp: f64) -> CoreError {
 /// every quadrant"). The flow direction is the one in which the flow starts from rest with the
 /// stator at rest ([`start_direction`]); in that direction: locked while the clutch holds
 /// (T_s ≥ 0), else free-wheeling if that has a steady state with ω_s ≥ 0, else no flow (Q = 0,
-/// zero torques, ω_s = ω_t). A flow held at rest gives no flow with ω_s = 0.
+/// zero torques, ω_s = ω_t). Where the flow could start either way and that gives no flow, the
+/// other direction's flowing steady state if it has one. A flow held at rest gives no flow with
+/// ω_s = 0.
 pub fn steady_state<T: Scalar>(
     g: &HtGeometry<T>,
     pump_speed_rad_s: T,
@@ -632,9 +634,21 @@ pub fn steady_state<T: Scalar>(
     if direction == 0 {
         return Ok(no_flow(T::cst(0.0)));
     }
-    let solve = |mode| if direction > 0 { solve_mode(g, wp, wt, mode) } else { solve_reverse(g, wp, wt, mode) };
-    let locked = solve(StatorMode::Locked).ok_or_else(|| overflow(scale))?;
-    with_clutch(locked, || solve(StatorMode::FreeWheeling), wt, scale)
+    let in_direction = |sign: i8| -> CoreResult<HtSteadyState<T>> {
+        let solve = |mode| if sign > 0 { solve_mode(g, wp, wt, mode) } else { solve_reverse(g, wp, wt, mode) };
+        let locked = solve(StatorMode::Locked).ok_or_else(|| overflow(scale))?;
+        with_clutch(locked, || solve(StatorMode::FreeWheeling), wt, scale)
+    };
+    let first = in_direction(direction)?;
+    // where the flow could start either way (F_Q(0⁺) > 0 > F_Q(0⁻), shock coefficients below 1) and
+    // the preferred direction has no flowing steady state, the other one's is taken if it has one
+    if first.mode == StatorMode::NoFlow && forward > 0.0 && reverse < 0.0 {
+        let other = in_direction(-direction)?;
+        if other.mode != StatorMode::NoFlow {
+            return Ok(other);
+        }
+    }
+    Ok(first)
 }
 
 /// The one-way clutch on a locked solution: kept while it holds (T_s ≥ 0), else the free-wheeling
@@ -852,6 +866,41 @@ mod tests {
         // both speeds zero: nothing moves
         let s = steady_state(&g, 0.0, 0.0).unwrap();
         assert_eq!((s.mode, s.flow_m3_s, s.pump_torque_nm, s.stator_speed_rad_s), (StatorMode::NoFlow, 0.0, 0.0, 0.0));
+    }
+
+    fn with_shock(c: f64) -> HtGeometry<f64> {
+        let mut v = HtGeometry::appendix_d().values;
+        for p in [HtParam::PumpShockLoss, HtParam::TurbineShockLoss, HtParam::StatorShockLoss] {
+            v[p.index()] = c;
+        }
+        HtGeometry::new(v).unwrap()
+    }
+
+    /// The rule at Q = 0 (docs/models.md, "At Q = 0"): with shock coefficients above 1 a band of held
+    /// flow (F_Q(0⁺) ≤ 0 ≤ F_Q(0⁻)) gives no flow with the stator at rest; below 1 a band where both
+    /// directions could start, decided by the larger force, and a flowing steady state is returned.
+    #[test]
+    fn the_flow_direction_at_rest_decides_between_steady_states() {
+        // Appendix D, stator at rest: the centrifugal head vanishes at SR = √((R_p² − R_s²)/(R_p² − R_t²))
+        let sr0 = ((0.0144f64 - 0.0036) / (0.0144 - 0.004225)).sqrt();
+        let g = HtGeometry::appendix_d();
+        let (fp, fm) = zero_flow_forces(&g, WP, sr0 * WP);
+        assert!(fp.abs() < 1e-9 * scale_of_head(WP) && (fp - fm).abs() < 1e-9 * scale_of_head(WP));
+        let held = with_shock(2.0);
+        let (fp, fm) = zero_flow_forces(&held, WP, sr0 * WP);
+        assert!(fp < 0.0 && fm > 0.0, "{fp} {fm}");
+        assert_eq!(start_direction(&held, WP, sr0 * WP), 0);
+        let s = steady_state(&held, WP, sr0 * WP).unwrap();
+        assert_eq!((s.mode, s.flow_m3_s, s.stator_speed_rad_s), (StatorMode::NoFlow, 0.0, 0.0));
+        let both = with_shock(0.5);
+        for sr in [sr0 - 0.01, sr0, sr0 + 0.01] {
+            let (fp, fm) = zero_flow_forces(&both, WP, sr * WP);
+            assert!(fp > 0.0 && fm < 0.0, "SR {sr}: {fp} {fm}");
+            let expected = if fp >= -fm { 1 } else { -1 };
+            assert_eq!(start_direction(&both, WP, sr * WP), expected, "SR {sr}");
+            let s = steady_state(&both, WP, sr * WP).unwrap();
+            assert_ne!(s.mode, StatorMode::NoFlow, "SR {sr}: {s:?}");
+        }
     }
 
     #[test]
