@@ -267,16 +267,16 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
     characteristic = None
     if doc.characteristic is not None:
         key, values = doc.characteristic.capacity()
-        section = doc.characteristic
+        table = doc.characteristic
         characteristic = Characteristic.from_columns(
-            section.speed_ratio,
-            section.torque_ratio,
+            table.speed_ratio,
+            table.torque_ratio,
             values,
             key,
             path,
             "[characteristic].",
-            overrun=section.overrun,
-            interpolation=section.interpolation,
+            overrun=table.overrun,
+            interpolation=table.interpolation,
         )
     if doc.geometry is not None:
         try:

@@ -41,14 +41,14 @@ class DynamicModel:
         """The shape effects (pump, turbine[, stator]); empty for the table model."""
         return tuple(self.spec.get("shape_effect_m2", ()))
 
-    def warn_if_extended(self, columns: Mapping[str, np.ndarray], what: str = "the run") -> None:
+    def warn_if_extended(self, columns: Mapping[str, Any], what: str = "the run") -> None:
         """For the table models, one warning when the run's pump and turbine speeds (``columns``)
         reached the overrun rule's extension of the table (:func:`~.characteristic.warn_if_extended`)."""
         if self.name not in ("table", "quasi-dynamic"):
             return
         s = self.spec
         table = (np.asarray(s["speed_ratio"]), np.asarray(s["torque_ratio"]), np.asarray(s["capacity_factor_nm_s2"]))
-        rules = {k: s[k] for k in ("overrun", "interpolation") if k in s}
+        rules: dict[str, str] = {k: str(s[k]) for k in ("overrun", "interpolation") if k in s}
         warn_if_extended(self.source, table, rules, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"], what)
 
     def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:

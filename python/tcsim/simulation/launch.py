@@ -115,7 +115,7 @@ def run_launch(
     for name, model, run in zip(names, models, raw):
         result = _unpack(run, name, _files(vehicle, scenario, [model]))
         if isinstance(result, LaunchRun):
-            model.warn_if_extended(result.frame, f"the launch run {name!r}")
+            model.warn_if_extended({str(k): v for k, v in result.frame.items()}, f"the launch run {name!r}")
             out[name] = result
             continue
         if on_error == "raise":

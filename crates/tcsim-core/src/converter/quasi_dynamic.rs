@@ -65,7 +65,8 @@ impl QuasiDynamics {
     fn steady_flow(&self, wp: f64, wt: f64) -> (f64, [f64; 2]) {
         let t = self.characteristic.torques(wp, wt);
         let k = self.flow_scale();
-        (k * t.flow, [k * t.d_flow[0], k * t.d_flow[1]])
+        // (k·factor)·speed, the arithmetic of the drive-only model before issue 11, bit for bit
+        (k * t.flow_factor * t.flow_speed, [k * t.d_flow[0], k * t.d_flow[1]])
     }
 }
 

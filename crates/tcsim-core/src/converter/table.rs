@@ -129,9 +129,12 @@ pub struct TableTorques {
     pub d_delivered: [f64; 2],
     /// The torque ratio used, after the passivity projection.
     pub torque_ratio: f64,
-    /// `Q_ss·ρR_p²`, N·m/(rad/s): the quasi-dynamic model's steady flow scaled (see
-    /// [`Characteristic::torques`]), and its gradient.
-    pub flow: f64,
+    /// `Q_ss·ρR_p² = flow_factor·flow_speed`, N·m/(rad/s): the quasi-dynamic model's steady flow
+    /// scaled (see [`Characteristic::torques`]): `flow_factor` is CF or −C·m, N·m/(rad/s)², and
+    /// `flow_speed` is |ω_p| or |ω_t|, rad/s.
+    pub flow_factor: f64,
+    pub flow_speed: f64,
+    /// Gradient of `flow_factor·flow_speed` with respect to (ω_p, ω_t).
     pub d_flow: [f64; 2],
     pub region: Region,
     /// Outside the table's rows (held end values or a turbine-referred region).
@@ -383,7 +386,8 @@ impl Characteristic {
                 d_pump: [0.0; 2],
                 d_delivered: [0.0; 2],
                 torque_ratio: self.torque_ratio[0],
-                flow: 0.0,
+                flow_factor: 0.0,
+                flow_speed: 0.0,
                 d_flow: [0.0; 2],
                 region: Region::Rest,
                 extrapolated: true,
@@ -401,7 +405,7 @@ impl Characteristic {
 
     fn pump_referred(&self, wp: f64, wt: f64) -> TableTorques {
         let sr = wt / wp;
-        let dsr = [-sr / wp, 1.0 / wp];
+        let dsr = [-wt / (wp * wp), 1.0 / wp];
         let l = self.lookup(sr);
         let (cf, dcf) = (l.capacity_factor_nm_s2, l.d_capacity_factor);
         let w2 = wp * wp.abs();
@@ -419,7 +423,8 @@ impl Characteristic {
             d_pump,
             d_delivered: [dtr[0] * tp + tr * d_pump[0], dtr[1] * tp + tr * d_pump[1]],
             torque_ratio: tr,
-            flow: cf * wp.abs(),
+            flow_factor: cf,
+            flow_speed: wp.abs(),
             d_flow: [dcf * dsr[0] * wp.abs() + cf * wp.signum(), dcf * dsr[1] * wp.abs()],
             region: Region::Pump,
             extrapolated: l.extrapolated,
@@ -444,7 +449,8 @@ impl Characteristic {
             d_pump,
             d_delivered: [dtr[0] * tp + tr * d_pump[0], dtr[1] * tp + tr * d_pump[1]],
             torque_ratio: tr,
-            flow: -g * wt.abs(),
+            flow_factor: -g,
+            flow_speed: wt.abs(),
             d_flow: [-dg * dx[0] * wt.abs(), -dg * dx[1] * wt.abs() - g * wt.signum()],
             region: if overrun { Region::Overrun } else { Region::TurbineReversed },
             extrapolated: true,
@@ -806,7 +812,7 @@ mod tests {
                     for (a, b, what) in [
                         (at.pump_nm, near.pump_nm, "pump"),
                         (at.delivered_nm, near.delivered_nm, "delivered"),
-                        (at.flow * 300.0, near.flow * 300.0, "flow"),
+                        (at.flow_factor * at.flow_speed * 300.0, near.flow_factor * near.flow_speed * 300.0, "flow"),
                     ] {
                         assert!((a - b).abs() <= 1e-6 * scale, "{name} {what} at ({wp}, {wt}) vs ({p}, {q}): {a} {b}");
                     }
