@@ -864,8 +864,8 @@ mod tests {
         let l = t.lookup(0.925);
         let k = 0.5 * (1.0 / cf[10].sqrt() + 1.0 / cf[11].sqrt());
         assert!((l.capacity_factor_nm_s2 - 1.0 / (k * k)).abs() <= 1e-15, "{l:?}");
-        for i in 0..cf.len() {
-            assert_eq!(t.lookup(t.speed_ratio()[i]).capacity_factor_nm_s2, cf[i]);
+        for (&sr, &c) in t.speed_ratio().iter().zip(cf) {
+            assert_eq!(t.lookup(sr).capacity_factor_nm_s2, c);
         }
         let h = 1e-6;
         let d = (t.lookup(0.93 + h).capacity_factor_nm_s2 - t.lookup(0.93 - h).capacity_factor_nm_s2) / (2.0 * h);
