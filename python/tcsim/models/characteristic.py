@@ -15,12 +15,6 @@ from .plausibility import warn_implausible
 
 CAPACITY_KEYS = tuple(_core.capacity_conventions())
 
-#: ``[characteristic] overrun``: how the table continues beyond its rows in overrun (docs/models.md);
-#: the default is ``"table"`` for a table with coast rows (last SR > 1), ``"mirror"`` otherwise.
-OVERRUN_RULES = ("mirror", "table")
-#: ``[characteristic] interpolation``: the quantity interpolated linearly in SR between rows.
-INTERPOLATIONS = ("capacity_factor", "k_factor")
-
 #: Stall torque at 2000 rpm outside this range (N·m) suggests a capacity read in the wrong
 #: convention (physics notes §1).
 PLAUSIBLE_STALL_TORQUE_NM = (20.0, 2000.0)
@@ -34,8 +28,10 @@ PLAUSIBLE_STALL_TORQUE_NM = (20.0, 2000.0)
 class Characteristic:
     """TR and CF (N·m/(rad/s)²) against SR, validated; ``convention`` is the capacity key read.
 
-    ``overrun`` and ``interpolation`` are the file's ``[characteristic]`` keys (None: not given,
-    the core's default: see :data:`OVERRUN_RULES`, :data:`INTERPOLATIONS`).
+    ``overrun`` and ``interpolation`` are the file's ``[characteristic]`` keys, None where not
+    given; the core owns their values and defaults (``"mirror"`` or ``"table"``, the latter the
+    default for a table with rows above SR 1; ``"capacity_factor"`` or ``"k_factor"``;
+    docs/models.md).
     """
 
     speed_ratio: np.ndarray
@@ -175,7 +171,10 @@ def warn_if_extended(
         return
     wp, wt = np.ascontiguousarray(wp[ok]), np.ascontiguousarray(wt[ok])
     sr, tr, cf = (np.ascontiguousarray(v, dtype=float) for v in table)
-    ext = np.asarray(_core.table_steady_states(sr, tr, cf, wp, wt, **rules)["extension"], dtype=bool)
+    try:
+        ext = np.asarray(_core.table_steady_states(sr, tr, cf, wp, wt, **rules)["extension"], dtype=bool)
+    except _core.CoreInputError:  # speeds whose torques overflow: the run itself says so
+        return
     if not ext.any():
         return
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -361,7 +361,10 @@ impl Characteristic {
                 let vertex = if slope != 0.0 { (a * slope - tr[i - 1]) / (2.0 * slope) } else { lo };
                 let candidates = [lo, hi, vertex.clamp(lo, hi)];
                 if let Some(&x) = candidates.iter().find(|&&x| violates(sign, efficiency(x))) {
-                    return Err(passivity_error(i, tr[i], efficiency(x), x, sign, Some((a, b))));
+                    // the row that pushes the efficiency the wrong way: the larger TR where the
+                    // pump absorbs power, the smaller where it is driven
+                    let j = if (tr[i - 1] > tr[i]) == (sign > 0.0) { i - 1 } else { i };
+                    return Err(passivity_error(j, tr[j], efficiency(x), x, sign, Some((a, b))));
                 }
             }
         }
@@ -750,7 +753,7 @@ mod tests {
         assert!(e.expected.contains("SR·TR = 1.1"), "{e}");
         // rows fine, but between them SR·TR = SR·(3 − 2 SR) reaches 1.125 at SR 0.75
         let e = Characteristic::new(vec![0.5, 1.0], vec![2.0, 1.0], vec![3e-3, 1e-3]).unwrap_err();
-        assert_eq!(e.field, "torque_ratio[1]", "{e}");
+        assert_eq!(e.field, "torque_ratio[0]", "{e}");
         assert!(e.expected.contains("between the rows at SR 0.5 and 1") && e.expected.contains("1.125"), "{e}");
         // a coast row (CF < 0) must have SR·TR ≥ 1: TR 0.8 at SR 1.1 would drive the turbine
         let e = Characteristic::new(vec![0.0, 1.0, 1.1], vec![2.0, 1.0, 0.8], vec![3e-3, 0.0, -1e-3]).unwrap_err();
