@@ -191,4 +191,7 @@ def simulate_batch(
         sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
         raise from_core(e, sources) from None
     n = len(raw)
+    failed = next((i for i, r in enumerate(raw) if r.error is not None), None)
+    if failed is not None:  # raised before any run's warning: a failure is one line
+        _unpack(raw[failed], models[failed if len(models) > 1 else 0], failed if n > 1 else None, files)
     return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None, files) for i, r in enumerate(raw)]
