@@ -11,6 +11,7 @@ import pytest
 import tcsim
 from conftest import C1_CF, C1_SR, C1_TR, CONVERTER_DATA
 from tcsim import _core
+from tcsim.errors import TcsimWarning
 from tcsim.models.converter import load_converter
 from tcsim.models.steady import characterise, coupling_point
 from tcsim.models.torus import torus_estimate
@@ -38,11 +39,18 @@ def test_quasi_dynamic_steady_state_is_the_table(ls):
     pd.testing.assert_frame_equal(a, b)
 
 
-def test_table_model_holds_end_values_outside_the_table(ls):
-    df = characterise(ls, "table", speed_ratio=np.array([-0.2, 1.2]))
+def test_table_model_holds_its_first_row_below_and_mirrors_beyond_the_table(ls):
+    # issue 11: SR 1.2 used to hold CF(1) > 0, driving a turbine already faster than the pump
+    with pytest.warns(
+        TcsimWarning, match='overrun = "mirror": the table ends at SR 1; the characteristic reached SR 1.2'
+    ):
+        df = characterise(ls, "table", speed_ratio=np.array([-0.2, 1.2]))
     assert df["extrapolated"].all()
     assert df["torque_ratio"].tolist() == [2.14, 1.0]
-    np.testing.assert_allclose(df["capacity_factor_nm_s2"], [3.272e-3, 0.187e-3], rtol=1e-15)
+    # mirror: T_p = −CF(x)·ω_t² with x = 1/1.2 interpolated between the rows at 0.8 and 0.85
+    x = 1.0 / 1.2
+    cf_x = 2.481e-3 + (x - 0.8) / 0.05 * (2.370e-3 - 2.481e-3)
+    np.testing.assert_allclose(df["capacity_factor_nm_s2"], [3.272e-3, -cf_x * 1.2**2], rtol=1e-12)
 
 
 def test_overrun_rows_of_jambe_trami_table_reverse_the_torque():

@@ -98,6 +98,9 @@ impl ModelSpec for Spec<'_> {
         }
         Some(v)
     }
+    fn text(&self, key: &str) -> Option<String> {
+        self.model.get(key).and_then(Value::as_str).map(str::to_string)
+    }
 }
 
 /// An instance between `fmi2Instantiate` and `fmi2FreeInstance`.

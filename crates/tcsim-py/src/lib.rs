@@ -285,27 +285,46 @@ fn characteristic(
     sr: &PyReadonlyArray1<'_, f64>,
     tr: &PyReadonlyArray1<'_, f64>,
     cf: &PyReadonlyArray1<'_, f64>,
+    overrun: Option<&str>,
+    interpolation: Option<&str>,
 ) -> PyResult<Characteristic> {
     Characteristic::new(
         slice(sr, "speed_ratio")?.to_vec(),
         slice(tr, "torque_ratio")?.to_vec(),
         slice(cf, "capacity_factor_nm_s2")?.to_vec(),
     )
+    .and_then(|c| c.with_rules(overrun, interpolation))
     .map_err(input_error)
 }
 
-/// Validate a characteristic table (finite, strictly increasing SR, equal lengths).
+/// Validate a characteristic table (finite, strictly increasing SR, equal lengths, passive on its
+/// rows) with its overrun rule and interpolation domain (None: the defaults).
 #[pyfunction]
+#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, overrun=None, interpolation=None))]
 fn table_check(
     speed_ratio: PyReadonlyArray1<'_, f64>,
     torque_ratio: PyReadonlyArray1<'_, f64>,
     capacity_factor_nm_s2: PyReadonlyArray1<'_, f64>,
+    overrun: Option<String>,
+    interpolation: Option<String>,
 ) -> PyResult<()> {
-    guard(|| characteristic(&speed_ratio, &torque_ratio, &capacity_factor_nm_s2).map(|_| ()))
+    guard(|| {
+        characteristic(
+            &speed_ratio,
+            &torque_ratio,
+            &capacity_factor_nm_s2,
+            overrun.as_deref(),
+            interpolation.as_deref(),
+        )
+        .map(|_| ())
+    })
 }
 
-/// Steady states of the table model at `pump[i], turbine[i]` (rad/s). Returns a dict of arrays.
+/// Steady states of the table model at `pump[i], turbine[i]` (rad/s, any signs). Returns a dict
+/// of arrays; `extension` says where the overrun rule extended the table beyond its rows.
 #[pyfunction]
+#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, pump_speed_rad_s, turbine_speed_rad_s, overrun=None, interpolation=None))]
+#[allow(clippy::too_many_arguments)]
 fn table_steady_states<'py>(
     py: Python<'py>,
     speed_ratio: PyReadonlyArray1<'py, f64>,
@@ -313,9 +332,17 @@ fn table_steady_states<'py>(
     capacity_factor_nm_s2: PyReadonlyArray1<'py, f64>,
     pump_speed_rad_s: PyReadonlyArray1<'py, f64>,
     turbine_speed_rad_s: PyReadonlyArray1<'py, f64>,
+    overrun: Option<String>,
+    interpolation: Option<String>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
-        let t = characteristic(&speed_ratio, &torque_ratio, &capacity_factor_nm_s2)?;
+        let t = characteristic(
+            &speed_ratio,
+            &torque_ratio,
+            &capacity_factor_nm_s2,
+            overrun.as_deref(),
+            interpolation.as_deref(),
+        )?;
         let (wp, wt) =
             (slice(&pump_speed_rad_s, "pump_speed_rad_s")?, slice(&turbine_speed_rad_s, "turbine_speed_rad_s")?);
         if wp.len() != wt.len() {
@@ -341,6 +368,7 @@ fn table_steady_states<'py>(
         d.set_item("turbine_torque_nm", col(|p| p.turbine_torque_nm))?;
         d.set_item("stator_torque_nm", col(|p| p.stator_torque_nm))?;
         d.set_item("extrapolated", points.iter().map(|p| p.extrapolated).collect::<Vec<_>>())?;
+        d.set_item("extension", points.iter().map(|p| p.extension).collect::<Vec<_>>())?;
         Ok(d)
     })
 }
@@ -568,6 +596,9 @@ impl tcsim_core::converter::spec::ModelSpec for DictSpec<'_, '_> {
     fn numbers(&self, key: &str) -> Option<Vec<f64>> {
         let v = self.0.get_item(key).ok()??;
         v.extract::<f64>().map(|x| vec![x]).or_else(|_| v.extract::<Vec<f64>>()).ok()
+    }
+    fn text(&self, key: &str) -> Option<String> {
+        self.0.get_item(key).ok()??.extract::<String>().ok()
     }
 }
 

@@ -266,15 +266,21 @@ def run_models(
 ) -> dict[str, transient.TransientResult]:
     """Each model under the drive, sampled at the drive's time stamps. An error the core finds in
     the drive's samples (its ``core_source`` ``drive``) names ``drive_file``, the measurement; one
-    in a value of ``initial`` names ``--initial`` on the command line."""
+    in a value of ``initial`` names ``--initial`` on the command line. The runs' warnings (the
+    overrun extension of a table) are shown only when every model ran: a failure is one line."""
     results = {}
-    for m in models:
-        try:
-            results[m.name] = transient.simulate(m, drive, initial=initial or None, files={"drive": drive_file})
-        except InputError as e:
-            if e.core_source == "initial":
-                raise InputError("command line", f"--{e.field}", e.value, e.expected, core_source="initial") from None
-            raise
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for m in models:
+            try:
+                results[m.name] = transient.simulate(m, drive, initial=initial or None, files={"drive": drive_file})
+            except InputError as e:
+                if e.core_source == "initial":
+                    field = f"--{e.field}"
+                    raise InputError("command line", field, e.value, e.expected, core_source="initial") from None
+                raise
+    for w in caught:
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return results
 
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 import warnings
 from dataclasses import dataclass
 
@@ -25,13 +26,21 @@ PLAUSIBLE_STALL_TORQUE_NM = (20.0, 2000.0)
 
 @dataclass(frozen=True)
 class Characteristic:
-    """TR and CF (N·m/(rad/s)²) against SR, validated; ``convention`` is the capacity key read."""
+    """TR and CF (N·m/(rad/s)²) against SR, validated; ``convention`` is the capacity key read.
+
+    ``overrun`` and ``interpolation`` are the file's ``[characteristic]`` keys, None where not
+    given; the core owns their values and defaults (``"mirror"`` or ``"table"``, the latter the
+    default for a table with rows above SR 1; ``"capacity_factor"`` or ``"k_factor"``;
+    docs/models.md).
+    """
 
     speed_ratio: np.ndarray
     torque_ratio: np.ndarray
     capacity_factor_nm_s2: np.ndarray
     convention: str = "capacity_factor_nm_s2"
     source: str = ""
+    overrun: str | None = None
+    interpolation: str | None = None
 
     @classmethod
     def from_columns(
@@ -43,11 +52,15 @@ class Characteristic:
         source: str,
         where: str = "",
         rows: list[int] | None = None,
+        overrun: str | None = None,
+        interpolation: str | None = None,
     ) -> Characteristic:
         """Validate and convert a table read in capacity ``convention``.
 
         ``where`` prefixes field names (``"[characteristic]."`` for TOML); ``rows`` maps each
-        point to its line number in a text file, so that messages name the line.
+        point to its line number in a text file, so that messages name the line. ``overrun`` and
+        ``interpolation`` are checked by the core, with the table's passivity (every row and
+        every segment between rows: SR·TR at most 1 where CF > 0, at least 1 where CF < 0).
         """
         if convention not in CAPACITY_KEYS:
             raise InputError(source, f"{where}capacity", convention, f"one of {', '.join(CAPACITY_KEYS)}")
@@ -99,10 +112,23 @@ class Characteristic:
             )
         warn_implausible("torque_ratio", tr, source, lambda i: name("torque_ratio", i))
         try:
-            _core.table_check(sr, tr, cf)
-        except _core.CoreInputError as e:  # pragma: no cover - the checks above come first
+            _core.table_check(sr, tr, cf, overrun, interpolation)
+        except _core.CoreInputError as e:
+            row = re.fullmatch(r"torque_ratio\[(\d+)\]", e.args[1])
+            if row is not None and rows is not None:
+                raise InputError(source, name("torque_ratio", int(row[1])), float(tr[int(row[1])]), e.args[3]) from None
             raise from_core(e, source, where) from None
-        return cls(sr, tr, cf, convention, source)
+        return cls(sr, tr, cf, convention, source, overrun, interpolation)
+
+    def core_rules(self) -> dict[str, str]:
+        """The ``overrun`` and ``interpolation`` keys the file gave, for the core's table functions
+        and model specification (absent keys: the core's defaults)."""
+        rules = {"overrun": self.overrun, "interpolation": self.interpolation}
+        return {k: v for k, v in rules.items() if v is not None}
+
+    def warn_if_extended(self, pump_speed_rad_s, turbine_speed_rad_s, what: str = "the run") -> None:
+        """:func:`warn_if_extended` for this table."""
+        warn_if_extended(self.source, self.arrays(), self.core_rules(), pump_speed_rad_s, turbine_speed_rad_s, what)
 
     def stall_torque_nm(self, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM) -> float:
         """Pump torque at SR = 0 (or the table's first SR ≥ 0) and the given pump speed."""
@@ -124,3 +150,38 @@ class Characteristic:
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self.speed_ratio, self.torque_ratio, self.capacity_factor_nm_s2
+
+
+def warn_if_extended(
+    source: str,
+    table: tuple[np.ndarray, np.ndarray, np.ndarray],
+    rules: dict[str, str],
+    pump_speed_rad_s,
+    turbine_speed_rad_s,
+    what: str = "the run",
+) -> None:
+    """One :class:`~tcsim.errors.TcsimWarning` when the core's overrun rule extended the table
+    ``(speed_ratio, torque_ratio, capacity_factor_nm_s2)`` beyond its rows at any of the points
+    (rad/s; the core says where, by the ``extension`` flag of ``tcsim._core.table_steady_states``):
+    the results there rest on the extension rule, not on data (docs/models.md)."""
+    wp = np.asarray(pump_speed_rad_s, dtype=float).reshape(-1)
+    wt = np.asarray(turbine_speed_rad_s, dtype=float).reshape(-1)
+    ok = np.isfinite(wp) & np.isfinite(wt)
+    if not ok.any():
+        return
+    wp, wt = np.ascontiguousarray(wp[ok]), np.ascontiguousarray(wt[ok])
+    sr, tr, cf = (np.ascontiguousarray(v, dtype=float) for v in table)
+    try:
+        ext = np.asarray(_core.table_steady_states(sr, tr, cf, wp, wt, **rules)["extension"], dtype=bool)
+    except _core.CoreInputError:  # speeds whose torques overflow: the run itself says so
+        return
+    if not ext.any():
+        return
+    with np.errstate(divide="ignore", invalid="ignore"):
+        reached = float(np.max(np.abs(wt[ext] / wp[ext])))
+    warnings.warn(
+        f'{source}: overrun = "mirror": the table ends at SR {sr[-1]:g}; {what} reached SR {reached:.3g}, '
+        "where tcsim mirrors the characteristic (the turbine drives the pump; see docs/models.md)",
+        TcsimWarning,
+        stacklevel=3,
+    )

@@ -43,6 +43,10 @@ class CharacteristicSection(_Section):
     k_factor_rpm_per_sqrt_lbf_ft: list[float] | None = None
     capacity_nm_per_rpm2: list[float] | None = None
     mp1000_nm: list[float] | None = None
+    #: How the table continues in overrun beyond its rows (checked by the core; docs/models.md).
+    overrun: str | None = None
+    #: The quantity interpolated in SR between rows (checked by the core; docs/models.md).
+    interpolation: str | None = None
 
     @model_validator(mode="after")
     def _one_capacity(self):
@@ -187,6 +191,7 @@ class Converter:
                 "speed_ratio": c.speed_ratio.tolist(),
                 "torque_ratio": c.torque_ratio.tolist(),
                 "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
+                **c.core_rules(),
             }
         for section in ("inertia", "geometry", "quasi_dynamic"):
             model = getattr(self, section)
@@ -262,8 +267,16 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
     characteristic = None
     if doc.characteristic is not None:
         key, values = doc.characteristic.capacity()
+        table = doc.characteristic
         characteristic = Characteristic.from_columns(
-            doc.characteristic.speed_ratio, doc.characteristic.torque_ratio, values, key, path, "[characteristic]."
+            table.speed_ratio,
+            table.torque_ratio,
+            values,
+            key,
+            path,
+            "[characteristic].",
+            overrun=table.overrun,
+            interpolation=table.interpolation,
         )
     if doc.geometry is not None:
         try:

@@ -4,13 +4,16 @@ See ``docs/transient.md``."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
+
+import numpy as np
 
 from .. import _core
 from ..errors import InputError, from_core
 from ..units import DEFAULT_PUMP_SPEED_RAD_S
+from .characteristic import warn_if_extended
 from .converter import MODELS, Converter, load_converter
 
 #: Pump speed at which the default quasi-dynamic flow time constant is evaluated (stall), rad/s:
@@ -38,6 +41,16 @@ class DynamicModel:
         """The shape effects (pump, turbine[, stator]); empty for the table model."""
         return tuple(self.spec.get("shape_effect_m2", ()))
 
+    def warn_if_extended(self, columns: Mapping[str, Any], what: str = "the run") -> None:
+        """For the table models, one warning when the run's pump and turbine speeds (``columns``)
+        reached the overrun rule's extension of the table (:func:`~.characteristic.warn_if_extended`)."""
+        if self.name not in ("table", "quasi-dynamic"):
+            return
+        s = self.spec
+        table = (np.asarray(s["speed_ratio"]), np.asarray(s["torque_ratio"]), np.asarray(s["capacity_factor_nm_s2"]))
+        rules: dict[str, str] = {k: str(s[k]) for k in ("overrun", "interpolation") if k in s}
+        warn_if_extended(self.source, table, rules, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"], what)
+
     def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:
         """The same model with other shape effects (eqs 2.16–2.18 sign convention)."""
         if self.name == "table":
@@ -62,6 +75,7 @@ def _table_spec(conv: Converter) -> dict[str, Any]:
         "speed_ratio": c.speed_ratio.tolist(),
         "torque_ratio": c.torque_ratio.tolist(),
         "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
+        **c.core_rules(),
     }
 
 

@@ -96,8 +96,9 @@ def characterise_table(
 ) -> pd.DataFrame:
     """Steady state of the table model at a fixed pump speed over ``speed_ratio``.
 
-    Inside the table TR and CF are interpolated linearly; outside it the end values are held and
-    the ``extrapolated`` column says so (``docs/models.md``).
+    Inside the table TR and CF are interpolated linearly; outside it the core's rules for every
+    quadrant apply and the ``extrapolated`` column says so; a warning says when the overrun rule
+    extended the table (``docs/models.md``).
     """
     conv.require("table")
     wp = _check_speed(pump_speed_rpm, allow_implausible)
@@ -106,9 +107,11 @@ def characterise_table(
     assert conv.characteristic is not None  # conv.require("table") checked it
     table_sr, table_tr, table_cf = conv.characteristic.arrays()
     try:
-        out = _core.table_steady_states(table_sr, table_tr, table_cf, pump, np.ascontiguousarray(sr * wp))
+        rules = conv.characteristic.core_rules()
+        out = _core.table_steady_states(table_sr, table_tr, table_cf, pump, np.ascontiguousarray(sr * wp), **rules)
     except _core.CoreInputError as e:
         raise _speed_error(e, pump_speed_rpm, conv.path) from None
+    conv.characteristic.warn_if_extended(pump, sr * wp, "the characteristic")
     df = pd.DataFrame(
         {
             "speed_ratio": sr,

@@ -111,14 +111,16 @@ def run_launch(
         raw = _core.launch_runs([m.spec for m in models], vehicle.core, scenario.core_spec(), options, threads)
     except _core.CoreInputError as e:
         raise from_core(e, _files(vehicle, scenario, models)) from None
+    results = [_unpack(run, name, _files(vehicle, scenario, [model])) for name, model, run in zip(names, models, raw)]
+    failed = next((r for r in results if not isinstance(r, LaunchRun)), None)
+    if on_error == "raise" and failed is not None:
+        raise failed  # before any run's warning: a failure is one line
     out: dict[str, LaunchRun] = {}
-    for name, model, run in zip(names, models, raw):
-        result = _unpack(run, name, _files(vehicle, scenario, [model]))
+    for name, model, run, result in zip(names, models, raw, results):
         if isinstance(result, LaunchRun):
+            model.warn_if_extended({str(k): v for k, v in result.frame.items()}, f"the launch run {name!r}")
             out[name] = result
             continue
-        if on_error == "raise":
-            raise result
         text = f"solver: {run.error.message}" if isinstance(result, SolverError) and run.error else str(result)
         warnings.warn(f"{name} left out ({text})", TcsimWarning, stacklevel=2)
     return out

@@ -115,6 +115,7 @@ def _unpack(
                 f"a drive whose run stays finite (it overflows at t = {t:.6g} s: check the drive's values and units)",
                 core_source="drive",
             )
+        model.warn_if_extended(run.columns, "the run" + where)
         return TransientResult(model.name, dict(run.columns), events)
     if err.kind == "input":
         assert err.source is not None and err.field is not None and err.expected is not None
@@ -190,4 +191,7 @@ def simulate_batch(
         sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
         raise from_core(e, sources) from None
     n = len(raw)
+    failed = next((i for i, r in enumerate(raw) if r.error is not None), None)
+    if failed is not None:  # raised before any run's warning: a failure is one line
+        _unpack(raw[failed], models[failed if len(models) > 1 else 0], failed if n > 1 else None, files)
     return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None, files) for i, r in enumerate(raw)]

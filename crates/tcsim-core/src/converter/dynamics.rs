@@ -108,47 +108,24 @@ impl Inertias {
 
 pub use crate::error::sig;
 
-fn signed_square(w: f64) -> f64 {
-    w * w.abs()
-}
-
 // ---------------------------------------------------------------------------------------------
 // Table model
 
 /// The steady-state table model with inertias (Li & Sundén 2016, eqs 2.8–2.11):
-/// `I_p ω̇_p = T_p − CF(SR) ω_p|ω_p|`, `I_t ω̇_t = TR(SR) CF(SR) ω_p|ω_p| + T_t`.
-/// Outside the table the end values are held (see [`Characteristic::lookup`]).
+/// `I_p ω̇_p = T_p − CF(SR) ω_p|ω_p|`, `I_t ω̇_t = TR(SR) CF(SR) ω_p|ω_p| + T_t` in drive, and
+/// the table's law in every other quadrant as [`Characteristic::torques`] defines it (passive,
+/// continuous; the overrun rule beyond the table's rows).
 #[derive(Debug, Clone)]
 pub struct TableDynamics {
     pub characteristic: Characteristic,
     pub inertia: Inertias,
 }
 
-/// SR = ω_t/ω_p, and its partial derivatives; zero when the pump stands still.
-pub(super) fn speed_ratio(wp: f64, wt: f64) -> (f64, f64, f64) {
-    if wp == 0.0 {
-        (0.0, 0.0, 0.0)
-    } else {
-        (wt / wp, -wt / (wp * wp), 1.0 / wp)
-    }
-}
-
-/// Table torques `(T_p,tr, T_t,tr)` and their gradients with respect to (ω_p, ω_t).
+/// Table torques `(T_p,tr, T_t,tr)` and their gradients with respect to (ω_p, ω_t), in every
+/// quadrant ([`Characteristic::torques`]).
 pub(super) fn table_torques(c: &Characteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [f64; 2]) {
-    let (sr, dsr_dwp, dsr_dwt) = speed_ratio(wp, wt);
-    let l = c.lookup(sr);
-    let w2 = signed_square(wp);
-    let tp = l.capacity_factor_nm_s2 * w2;
-    let tt = l.torque_ratio * tp;
-    let dtp = [
-        l.d_capacity_factor * dsr_dwp * w2 + l.capacity_factor_nm_s2 * 2.0 * wp.abs(),
-        l.d_capacity_factor * dsr_dwt * w2,
-    ];
-    let dtt = [
-        l.d_torque_ratio * dsr_dwp * tp + l.torque_ratio * dtp[0],
-        l.d_torque_ratio * dsr_dwt * tp + l.torque_ratio * dtp[1],
-    ];
-    (tp, tt, dtp, dtt)
+    let t = c.torques(wp, wt);
+    (t.pump_nm, t.delivered_nm, t.d_pump, t.d_delivered)
 }
 
 /// Pump speed of a table steady state, and the table's pump torque there.
@@ -722,6 +699,56 @@ mod tests {
         for u in [[200.0, 33.0, 0.0, 0.1], [210.0, 170.0, 0.0, 0.05], [150.0, 160.0, 0.0, 0.02]] {
             check_jacobian(&TableDynamics { characteristic: c1(), inertia: inertia() }, u, 1.0);
             check_jacobian(&qd(), u, 1.0);
+        }
+    }
+
+    #[test]
+    fn table_jacobians_match_finite_differences_in_every_quadrant() {
+        // a coast-row table (JAMBE-like: the `table` overrun rule) and Table C.1 (the mirror),
+        // in CF and in K interpolation
+        let coast = Characteristic::new(
+            vec![-0.1, 0.0, 0.5, 0.9, 1.0, 1.5, 2.1],
+            vec![1.81, 1.81, 1.36, 1.0, 1.0, 1.0, 1.0],
+            vec![3.5e-3, 3.5e-3, 3.9e-3, 2.7e-3, 0.0, -1.5e-3, -2.4e-3],
+        )
+        .unwrap();
+        let tables = [c1(), c1().with_rules(None, Some("k_factor")).unwrap(), coast];
+        let points = [
+            [200.0, 90.0],   // drive
+            [200.0, -60.0],  // roll-back, SR in [−1, 0]
+            [100.0, -310.0], // roll-back beyond SR −1
+            [-90.0, 270.0],  // reversed pump, turbine forward
+            [-200.0, -70.0], // both reversed
+            [150.0, 410.0],  // overrun, mirror on the table's rows / the table rule
+            [288.0, 300.0],  // overrun on the mirror's last segment (x = 0.96)
+            [200.0, 290.0],  // coast rows (SR 1.45)
+            [100.0, 340.0],  // beyond the coast rows
+            [-130.0, -370.0],
+        ];
+        for t in tables {
+            let table = TableDynamics { characteristic: t.clone(), inertia: inertia() };
+            let q = QuasiDynamics { characteristic: t, ..qd() };
+            for [wp, wt] in points {
+                check_jacobian(&table, [wp, wt, 0.0, 0.0], 1.0);
+                check_jacobian(&q, [wp, wt, 0.0, 0.01], 1.0);
+            }
+        }
+    }
+
+    #[test]
+    fn quasi_dynamic_steady_state_is_the_table_in_every_quadrant() {
+        let q = qd();
+        for (wp, wt) in [(200.0, 100.0), (200.0, 400.0), (0.0, 300.0), (-150.0, 40.0), (100.0, -350.0), (-80.0, -90.0)]
+        {
+            let (tp, tt, _, _) = table_torques(&q.characteristic, wp, wt);
+            let u = q.steady_point(wp, wt).unwrap().u;
+            let f = q.forces(&u, 1.0);
+            assert!(f[FLOW].abs() <= 1e-12 * u[FLOW].abs().max(1e-9), "Q̇ = {} at ({wp}, {wt})", f[FLOW]);
+            assert_eq!((-f[PUMP], f[TURBINE]), (tp, tt));
+            // the steady flow reverses in overrun (the turbine drives the fluid)
+            if wt.abs() > wp.abs() {
+                assert!(u[FLOW] < 0.0, "Q_ss = {} at ({wp}, {wt})", u[FLOW]);
+            }
         }
     }
 

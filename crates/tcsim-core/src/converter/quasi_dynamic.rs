@@ -1,7 +1,7 @@
 //! tcsim's quasi-dynamic converter model (tables plus fluid inertia) in mass-matrix form.
 
 use super::dynamics::{
-    speed_ratio, table_steady, table_torques, ConverterDynamics, Inertias, Mat4, SteadyPoint, Vec4, FLOW, PUMP, TURBINE,
+    table_steady, table_torques, ConverterDynamics, Inertias, Mat4, SteadyPoint, Vec4, FLOW, PUMP, TURBINE,
 };
 use super::table::Characteristic;
 use crate::error::{CoreError, CoreResult};
@@ -14,6 +14,11 @@ use crate::error::{CoreError, CoreResult};
 ///     I_t ω̇_t + ρ S_t Q̇ = TR(SR) CF(SR) ω_p|ω_p| + T_t
 ///     Q̇ = (Q_ss − Q)/τ_Q,    Q_ss = CF(SR) |ω_p| / (ρ R_p²)
 /// ```
+///
+/// in drive; in every other quadrant the torques are the table's ([`Characteristic::torques`]) and
+/// the steady flow follows the same regions: `Q_ss = −C(x)·m(x)·|ω_t| / (ρ R_p²)` where the
+/// turbine-referred capacity C(x) applies (x = ω_p/ω_t), negative in overrun, continuous at the
+/// region boundaries.
 ///
 /// `Q_ss` is the Euler-equation flow that carries the table's pump torque with the fluid leaving
 /// the pump at `R_p` and entering it with no swirl. At steady state Q̇ = 0, so the torques are the
@@ -58,15 +63,10 @@ impl QuasiDynamics {
 
     /// Steady flow Q_ss and its gradient with respect to (ω_p, ω_t).
     fn steady_flow(&self, wp: f64, wt: f64) -> (f64, [f64; 2]) {
-        let (sr, dsr_dwp, dsr_dwt) = speed_ratio(wp, wt);
-        let l = self.characteristic.lookup(sr);
+        let t = self.characteristic.torques(wp, wt);
         let k = self.flow_scale();
-        let q = k * l.capacity_factor_nm_s2 * wp.abs();
-        let dq = [
-            k * (l.d_capacity_factor * dsr_dwp * wp.abs() + l.capacity_factor_nm_s2 * wp.signum()),
-            k * l.d_capacity_factor * dsr_dwt * wp.abs(),
-        ];
-        (q, dq)
+        // (k·factor)·speed, the arithmetic of the drive-only model before issue 11, bit for bit
+        (k * t.flow_factor * t.flow_speed, [k * t.d_flow[0], k * t.d_flow[1]])
     }
 }
 

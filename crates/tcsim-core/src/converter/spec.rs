@@ -12,6 +12,10 @@ use crate::units::REFERENCE_PUMP_SPEED_RAD_S;
 pub trait ModelSpec {
     fn kind(&self) -> CoreResult<String>;
     fn numbers(&self, key: &str) -> Option<Vec<f64>>;
+    /// A text entry (`overrun`, `interpolation` of a table); None when missing.
+    fn text(&self, _key: &str) -> Option<String> {
+        None
+    }
 }
 
 fn numbers(spec: &dyn ModelSpec, key: &str, n: Option<usize>) -> CoreResult<Vec<f64>> {
@@ -85,7 +89,8 @@ fn build_unchecked(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics
             numbers(spec, "speed_ratio", None)?,
             numbers(spec, "torque_ratio", None)?,
             numbers(spec, "capacity_factor_nm_s2", None)?,
-        )
+        )?
+        .with_rules(spec.text("overrun").as_deref(), spec.text("interpolation").as_deref())
     };
     Ok(match kind.as_str() {
         "table" => Box::new(TableDynamics { characteristic: table()?, inertia }),
