@@ -185,3 +185,12 @@ def fmu_event_indicators(model: str) -> int:
 
 def fmu_units() -> list[tuple[str, list[tuple[str, int]], list[tuple[str, str]]]]:
     """``<UnitDefinitions>``: name, SI base-unit exponents, display units with their factors as text."""
+
+def table_steady_states_lenient(
+    speed_ratio: _ArrayLike,
+    torque_ratio: _ArrayLike,
+    capacity_factor_nm_s2: _ArrayLike,
+    pump_speed_rad_s: _ArrayLike,
+    turbine_speed_rad_s: _ArrayLike,
+) -> dict[str, Any]: ...
+def time_resolution_s(t: float) -> float: ...

@@ -1042,6 +1042,54 @@ fn steady_torque_ratio<'py>(
     })
 }
 
+// ---------------------------------------------------------------------------------------------
+// Issue 11: steady states at arbitrary speeds, time resolution
+
+/// [`table_steady_states`] that never stops: a point without a steady state (the pump at rest, where
+/// SR is undefined, or torques that overflow) is NaN in every column, with `solved` false.
+#[pyfunction]
+fn table_steady_states_lenient<'py>(
+    py: Python<'py>,
+    speed_ratio: PyReadonlyArray1<'py, f64>,
+    torque_ratio: PyReadonlyArray1<'py, f64>,
+    capacity_factor_nm_s2: PyReadonlyArray1<'py, f64>,
+    pump_speed_rad_s: PyReadonlyArray1<'py, f64>,
+    turbine_speed_rad_s: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let t = characteristic(&speed_ratio, &torque_ratio, &capacity_factor_nm_s2)?;
+        let (wp, wt) =
+            (slice(&pump_speed_rad_s, "pump_speed_rad_s")?, slice(&turbine_speed_rad_s, "turbine_speed_rad_s")?);
+        if wp.len() != wt.len() {
+            return Err(PyValueError::new_err("pump and turbine speeds need equal lengths"));
+        }
+        let points: Vec<_> = py.detach(|| wp.iter().zip(wt).map(|(&p, &t_)| t.operating_point(p, t_).ok()).collect());
+        let col = |f: fn(&tcsim_core::converter::table::TableOperatingPoint) -> f64| {
+            points.iter().map(|p| p.as_ref().map_or(f64::NAN, f)).collect::<Vec<_>>().into_pyarray(py)
+        };
+        let d = PyDict::new(py);
+        d.set_item("speed_ratio", col(|p| p.speed_ratio))?;
+        d.set_item("torque_ratio", col(|p| p.torque_ratio))?;
+        d.set_item("capacity_factor_nm_s2", col(|p| p.capacity_factor_nm_s2))?;
+        d.set_item("pump_torque_nm", col(|p| p.pump_torque_nm))?;
+        d.set_item("turbine_torque_nm", col(|p| p.turbine_torque_nm))?;
+        d.set_item("stator_torque_nm", col(|p| p.stator_torque_nm))?;
+        d.set_item(
+            "extrapolated",
+            points.iter().map(|p| p.as_ref().is_some_and(|p| p.extrapolated)).collect::<Vec<_>>(),
+        )?;
+        d.set_item("solved", points.iter().map(Option::is_some).collect::<Vec<_>>())?;
+        Ok(d)
+    })
+}
+
+/// The time resolution of the engine at time `t` (s): 1 µs, or 1024 ulp of `t` when coarser
+/// (`tcsim_core::engine::signal::time_resolution_s`).
+#[pyfunction]
+fn time_resolution_s(t: f64) -> f64 {
+    tcsim_core::engine::signal::time_resolution_s(t)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
@@ -1077,6 +1125,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vehicle_sections, m)?)?;
     m.add_class::<PyVehicle>()?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(table_steady_states_lenient, m)?)?;
+    m.add_function(wrap_pyfunction!(time_resolution_s, m)?)?;
     fmu::register(m)?;
     Ok(())
 }
