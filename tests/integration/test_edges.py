@@ -277,6 +277,19 @@ def test_characterise_sweeps_beyond_0_to_1(tmp_path, capsys, model, sweep):
     assert np.isnan(k[df["capacity_factor_nm_s2"] < 0]).all()
 
 
+def test_characterise_overrun_rows_write_without_a_warning(tmp_path, capsys):
+    """A table's own coast rows (negative CF) give a NaN K-factor by definition, and CF = 0 an
+    infinite one: neither is an overflow (before issue 11 the writer warned ``non-finite values …
+    in k_factor_rpm_per_sqrt_nm (40)``, the NaN of a column whose name ends in ``_nm``)."""
+    table = Path(__file__).resolve().parents[1] / "data" / "converters" / "jambe_trami_9at.csv"
+    out = tmp_path / "out"
+    assert run_cli("characterise", table, "--speed-ratio=0:3:0.05", "--out", out) == 0
+    assert "warning" not in capsys.readouterr().err
+    df = pd.read_csv(out / "characteristic.csv")
+    negative = df["capacity_factor_nm_s2"] < 0
+    assert negative.sum() > 10 and df["k_factor_rpm_per_sqrt_nm"][negative].isna().all()
+
+
 @pytest.mark.parametrize(
     "sweep",
     ["0:1", "a:b:c", "0:1:0", "0:1:-0.1", "1:0:0.1", "0:nan:0.1", "0:101:1", "-0.5:1e3:0.1", "0:10:1e-5"],

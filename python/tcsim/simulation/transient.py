@@ -73,7 +73,8 @@ def _options(rtol: float | None, **extra) -> dict[str, Any]:
     return o
 
 
-#: Columns that may hold ±inf by definition: the K-factor is infinite where the capacity is zero.
+#: Columns that may hold ±inf or NaN by definition: the K-factor is infinite where the capacity is
+#: zero and undefined (NaN) where it is negative (overrun rows of a table, ``conventions.md``).
 INFINITE_ALLOWED: frozenset[str] = frozenset({"k_factor_rpm_per_sqrt_nm"})
 #: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies): a run that has
 #: such a quantity never leaves it NaN at some samples; ratios, times not reached and metrics may be
