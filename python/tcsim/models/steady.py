@@ -175,9 +175,10 @@ def characterise_hrovat_tobler(
     speed_ratio: np.ndarray | None = None,
     allow_implausible: bool = False,
 ) -> pd.DataFrame:
-    """Closed-form steady state over SR 0–1 with the one-way clutch, coupling point included. A
-    steady state that overflows (pump speeds above about 1e150 rad/s) is an error about
-    ``--pump-speed-rpm``, never a ``no-flow`` point."""
+    """Closed-form steady state over ``speed_ratio`` (default SR 0–1 in steps of 0.01 with the
+    coupling point) with the one-way clutch; a speed ratio the core does not solve is an error about
+    ``--speed-ratio``. A steady state that overflows (pump speeds above about 1e150 rad/s) is an
+    error about ``--pump-speed-rpm``, never a ``no-flow`` point."""
     conv.require("hrovat-tobler")
     wp = _check_speed(pump_speed_rpm, allow_implausible)
     if speed_ratio is None:
