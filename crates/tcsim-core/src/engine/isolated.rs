@@ -581,7 +581,7 @@ pub fn steady_point_scaled(model: &dyn ConverterDynamics, wp: f64, wt: f64) -> C
     if s == 0.0 {
         return Ok(SteadyPoint { u: [0.0; 4], pump_torque_nm: 0.0 });
     }
-    if !(s < STEADY_SCALE_RAD_S) {
+    if s.is_nan() || s >= STEADY_SCALE_RAD_S {
         return model.steady_point(wp, wt);
     }
     let k = STEADY_SCALE_RAD_S / s;
