@@ -6,7 +6,8 @@ and Hrovat & Tobler (1985). Units are SI and carried in every name (``convention
 
 Tiers:
 
-* one-liners: :func:`characterise` (a converter name or file and a model → DataFrame) and
+* one-liners: :func:`characterise` (a converter name or file and a model → DataFrame),
+  :func:`steady_state` (steady states at any pump and turbine speeds → DataFrame) and
   :func:`simulate` (a converter, a drive and a model → :class:`~tcsim.transient.TransientResult`);
 * objects: :func:`load_converter` → :class:`Converter`, then :mod:`tcsim.steady` per model;
   :func:`dynamic_model` → :class:`~tcsim.transient.DynamicModel` and the drives of
@@ -38,6 +39,7 @@ __all__ = [
     "load_converter",
     "simulate",
     "simulate_batch",
+    "steady_state",
 ]
 
 
@@ -47,3 +49,11 @@ def characterise(
     """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`)."""
     conv = converter if isinstance(converter, Converter) else load_converter(converter)
     return _steady.characterise(conv, model, pump_speed_rpm, speed_ratio)
+
+
+def steady_state(converter, model: str, pump_speed_rad_s, turbine_speed_rad_s):
+    """Steady states of ``model`` at any pump and turbine speeds, rad/s (arrays, broadcast, any sign):
+    one row per point with the columns of ``characteristic.csv``; see
+    :func:`tcsim.steady.steady_state`. ``converter`` is a bundled name, a path or a :class:`Converter`."""
+    conv = converter if isinstance(converter, Converter) else load_converter(converter)
+    return _steady.steady_state(conv, model, pump_speed_rad_s, turbine_speed_rad_s)

@@ -113,6 +113,7 @@ def table_steady_states(
     turbine_speed_rad_s: _ArrayLike,
     overrun: str | None = None,
     interpolation: str | None = None,
+    lenient: bool = False,
 ) -> dict[str, Any]: ...
 def smoothed_rate(time_s: _ArrayLike, values: _ArrayLike, window_s: float) -> _Array: ...
 def transient_columns() -> list[str]: ...
@@ -193,3 +194,5 @@ def fmu_event_indicators(model: str) -> int:
 
 def fmu_units() -> list[tuple[str, list[tuple[str, int]], list[tuple[str, str]]]]:
     """``<UnitDefinitions>``: name, SI base-unit exponents, display units with their factors as text."""
+
+def time_resolution_s(t: float) -> float: ...

@@ -9,6 +9,7 @@ from .models.steady import (
     characterise_table,
     coupling_point,
     hrovat_tobler_steady_state,
+    steady_state,
 )
 
 __all__ = [
@@ -18,4 +19,5 @@ __all__ = [
     "characterise_table",
     "coupling_point",
     "hrovat_tobler_steady_state",
+    "steady_state",
 ]

@@ -32,6 +32,8 @@ DOCUMENTED = [
     "tcsim.simulate",
     "tcsim.simulate_batch",
     "tcsim.steady.hrovat_tobler_steady_state",
+    "tcsim.steady_state",
+    "tcsim.steady.steady_state",
     "tcsim.transient.isolated_takeoff",
     "tcsim.transient.simulate",
     "tcsim.transient.dynamic_model",
@@ -105,6 +107,8 @@ def test_readme_python_example():
     m = tcsim.dynamic_model("li-sunden-2016", "quasi-dynamic")
     runs = tcsim.simulate_batch([m.with_shape_effects(s, s) for s in (0, 0.1)], [tr.isolated_takeoff()])
     assert len(runs) == 2
+    ss = tcsim.steady_state("li-sunden-2016", "table", [209.4, -100.0], [[0.0], [300.0]])
+    assert list(ss.columns) == list(tcsim.characterise("li-sunden-2016", model="table").columns) and len(ss) == 4
 
 
 def run(*args: object) -> None:

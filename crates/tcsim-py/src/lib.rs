@@ -321,9 +321,11 @@ fn table_check(
 }
 
 /// Steady states of the table model at `pump[i], turbine[i]` (rad/s, any signs). Returns a dict
-/// of arrays; `extension` says where the overrun rule extended the table beyond its rows.
+/// of arrays; `extension` says where the overrun rule extended the table beyond its rows. A point
+/// without a steady state (torques that overflow) is an error naming the point, or with `lenient`
+/// a row of NaN with `solved` false.
 #[pyfunction]
-#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, pump_speed_rad_s, turbine_speed_rad_s, overrun=None, interpolation=None))]
+#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, pump_speed_rad_s, turbine_speed_rad_s, overrun=None, interpolation=None, lenient=false))]
 #[allow(clippy::too_many_arguments)]
 fn table_steady_states<'py>(
     py: Python<'py>,
@@ -334,6 +336,7 @@ fn table_steady_states<'py>(
     turbine_speed_rad_s: PyReadonlyArray1<'py, f64>,
     overrun: Option<String>,
     interpolation: Option<String>,
+    lenient: bool,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let t = characteristic(
@@ -348,17 +351,17 @@ fn table_steady_states<'py>(
         if wp.len() != wt.len() {
             return Err(PyValueError::new_err("pump and turbine speeds need equal lengths"));
         }
-        let points = py
-            .detach(|| {
-                wp.iter()
-                    .zip(wt)
-                    .enumerate()
-                    .map(|(i, (&p, &t_))| t.operating_point(p, t_).map_err(|e| (i, e)))
-                    .collect::<Result<Vec<_>, _>>()
-            })
-            .map_err(|(i, e)| input_error(CoreError { field: format!("{} (point {i})", e.field), ..e }))?;
+        let points: Vec<_> = py.detach(|| wp.iter().zip(wt).map(|(&p, &t_)| t.operating_point(p, t_)).collect());
+        if !lenient {
+            if let Some((i, e)) = points.iter().enumerate().find_map(|(i, p)| p.as_ref().err().map(|e| (i, e))) {
+                return Err(input_error(CoreError { field: format!("{} (point {i})", e.field), ..e.clone() }));
+            }
+        }
         let col = |f: fn(&tcsim_core::converter::table::TableOperatingPoint) -> f64| {
-            points.iter().map(f).collect::<Vec<_>>().into_pyarray(py)
+            points.iter().map(|p| p.as_ref().map_or(f64::NAN, f)).collect::<Vec<_>>().into_pyarray(py)
+        };
+        let flag = |f: fn(&tcsim_core::converter::table::TableOperatingPoint) -> bool| {
+            points.iter().map(|p| p.as_ref().is_ok_and(f)).collect::<Vec<_>>()
         };
         let d = PyDict::new(py);
         d.set_item("speed_ratio", col(|p| p.speed_ratio))?;
@@ -367,8 +370,9 @@ fn table_steady_states<'py>(
         d.set_item("pump_torque_nm", col(|p| p.pump_torque_nm))?;
         d.set_item("turbine_torque_nm", col(|p| p.turbine_torque_nm))?;
         d.set_item("stator_torque_nm", col(|p| p.stator_torque_nm))?;
-        d.set_item("extrapolated", points.iter().map(|p| p.extrapolated).collect::<Vec<_>>())?;
-        d.set_item("extension", points.iter().map(|p| p.extension).collect::<Vec<_>>())?;
+        d.set_item("extrapolated", flag(|p| p.extrapolated))?;
+        d.set_item("extension", flag(|p| p.extension))?;
+        d.set_item("solved", points.iter().map(Result::is_ok).collect::<Vec<_>>())?;
         Ok(d)
     })
 }
@@ -1073,6 +1077,16 @@ fn steady_torque_ratio<'py>(
     })
 }
 
+// ---------------------------------------------------------------------------------------------
+// Issue 11: steady states at arbitrary speeds, time resolution
+
+/// The time resolution of the engine at time `t` (s): 1 µs, or 1024 ulp of `t` when coarser
+/// (`tcsim_core::engine::signal::time_resolution_s`).
+#[pyfunction]
+fn time_resolution_s(t: f64) -> f64 {
+    tcsim_core::engine::signal::time_resolution_s(t)
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
@@ -1108,6 +1122,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(vehicle_sections, m)?)?;
     m.add_class::<PyVehicle>()?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(time_resolution_s, m)?)?;
     fmu::register(m)?;
     Ok(())
 }

@@ -29,8 +29,8 @@ app = typer.Typer(
     help="tcsim: hydrodynamic torque converter models (table, Hrovat & Tobler, quasi-dynamic).",
 )
 #: Messages, warnings and progress go to stderr; results to stdout.
-console = Console(stderr=True)
-stdout = Console()
+console = Console(stderr=True, emoji=False)  # a value such as "a:b:c" is text, never an emoji code
+stdout = Console(emoji=False)
 
 ModelOpt = Annotated[str, typer.Option("--model", "-m", help="table | hrovat-tobler | quasi-dynamic")]
 ModelsOpt = Annotated[

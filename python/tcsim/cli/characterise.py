@@ -17,23 +17,36 @@ def characterise(
     pump_speed_rpm: Annotated[float, typer.Option(help="fixed pump speed of the sweep")] = DEFAULT_PUMP_SPEED_RPM,
     out: OutOpt = Path("characteristic"),
     allow_implausible: AllowImplausibleOpt = False,
+    speed_ratio: Annotated[
+        str | None,
+        typer.Option(
+            "--speed-ratio",
+            help="sweep MIN:MAX:STEP (default: 0:1:0.01 with the table's points or the coupling point); "
+            "negative and above 1 allowed, |SR| <= 100, at most 100001 points",
+        ),
+    ] = None,
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
     from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_frames
     from ..models.converter import load_converter
     from ..models.steady import characterise as run
-    from ..models.steady import coupling_point
+    from ..models.steady import coupling_point, speed_ratio_sweep, sweep_speed_ratios
     from ..plots.characteristic import plot_characteristic
 
+    if speed_ratio is not None:
+        speed_ratio_sweep(speed_ratio)  # the command line first, before any file is read
     check_output_dir(out, [converter])
     conv = load_converter(converter)
     inputs = [converter, conv.path]
     check_output_dir(out, inputs)
     model = model or ("hrovat-tobler" if "hrovat-tobler" in conv.models else "table")
     conv.require(model)
-    df = run(conv, model, pump_speed_rpm, allow_implausible=allow_implausible)
+    sr = None if speed_ratio is None else sweep_speed_ratios(conv, model, speed_ratio)
+    df = run(conv, model, pump_speed_rpm, sr, allow_implausible=allow_implausible)
     cp = coupling_point(conv) if model == "hrovat-tobler" else None
+    if cp is not None and sr is not None and not sr[0] <= cp <= sr[-1]:
+        cp = None
     with output_dir(out, inputs) as stage:
         write_frames({"characteristic.csv": df}, stage)
         table = conv.characteristic if model == "hrovat-tobler" else None

@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError, from_core
+from ..errors import InputError, core_value, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .converter import Converter
 from .plausibility import check_plausible_rpm
@@ -45,9 +45,12 @@ def ratio_frame(speed_ratio: np.ndarray, torque_ratio: np.ndarray, capacity_fact
 
 
 def _derived(df: pd.DataFrame) -> pd.DataFrame:
-    """Add CF, K-factor and efficiency from torques and speeds."""
+    """Add CF, K-factor and efficiency from torques and speeds: CF = T_p/(ω_p|ω_p|), the table law's
+    signed square, so a reversed pump in drive has the same CF as the forward one; NaN with the pump
+    at rest."""
     wp = df["pump_speed_rad_s"].to_numpy()
-    cf = df["pump_torque_nm"].to_numpy() / wp**2
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        cf = np.where(wp != 0.0, df["pump_torque_nm"].to_numpy() / (wp * np.abs(wp)), np.nan)
     df["capacity_factor_nm_s2"] = cf
     df["k_factor_rpm_per_sqrt_nm"] = k_factor_rpm_per_sqrt_nm(cf)
     df["efficiency"] = df["torque_ratio"] * df["speed_ratio"]
@@ -74,8 +77,11 @@ def _check_speed(pump_speed_rpm: float, allow_implausible: bool = False) -> floa
 
 
 def _speed_error(e: Exception, pump_speed_rpm: float, converter_file: str, field_prefix: str = "") -> InputError:
-    """A core error of a sweep: about the commanded speed (source ``drive``: the steady state
-    overflowed) it names ``--pump-speed-rpm``, else the converter file."""
+    """A core error of a sweep: about the commanded speed (source ``drive``) it names
+    ``--speed-ratio`` when the core refused a speed ratio, else ``--pump-speed-rpm`` (the steady
+    state overflowed); any other error names the converter file."""
+    if e.args[4] == "drive" and str(e.args[1]).startswith("speed_ratio"):
+        return InputError("command line", "--speed-ratio", core_value(e.args[2]), e.args[3], core_source="drive")
     if e.args[4] == "drive":
         return InputError("command line", "--pump-speed-rpm", pump_speed_rpm, e.args[3], core_source="drive")
     return from_core(e, converter_file, field_prefix)
@@ -112,19 +118,23 @@ def characterise_table(
     except _core.CoreInputError as e:
         raise _speed_error(e, pump_speed_rpm, conv.path) from None
     conv.characteristic.warn_if_extended(pump, sr * wp, "the characteristic")
-    df = pd.DataFrame(
+    return _order(_derived(_table_frame(out, sr, pump, sr * wp)))
+
+
+def _table_frame(out: dict, sr: np.ndarray, wp: np.ndarray, wt: np.ndarray) -> pd.DataFrame:
+    """The table model's columns from the core's steady states ``out`` at speeds ``wp``, ``wt``, rad/s."""
+    return pd.DataFrame(
         {
             "speed_ratio": sr,
             "torque_ratio": out["torque_ratio"],
-            "pump_speed_rad_s": pump,
-            "turbine_speed_rad_s": sr * wp,
+            "pump_speed_rad_s": wp,
+            "turbine_speed_rad_s": wt,
             "pump_torque_nm": out["pump_torque_nm"],
             "turbine_torque_nm": out["turbine_torque_nm"],
             "stator_torque_nm": out["stator_torque_nm"],
             "extrapolated": out["extrapolated"],
         }
     )
-    return _order(_derived(df))
 
 
 def characterise_quasi_dynamic(
@@ -171,9 +181,10 @@ def characterise_hrovat_tobler(
     speed_ratio: np.ndarray | None = None,
     allow_implausible: bool = False,
 ) -> pd.DataFrame:
-    """Closed-form steady state over SR 0–1 with the one-way clutch, coupling point included. A
-    steady state that overflows (pump speeds above about 1e150 rad/s) is an error about
-    ``--pump-speed-rpm``, never a ``no-flow`` point."""
+    """Closed-form steady state over ``speed_ratio`` (default SR 0–1 in steps of 0.01 with the
+    coupling point) with the one-way clutch; a speed ratio the core does not solve is an error about
+    ``--speed-ratio``. A steady state that overflows (pump speeds above about 1e150 rad/s) is an
+    error about ``--pump-speed-rpm``, never a ``no-flow`` point."""
     conv.require("hrovat-tobler")
     wp = _check_speed(pump_speed_rpm, allow_implausible)
     if speed_ratio is None:
@@ -183,26 +194,24 @@ def characterise_hrovat_tobler(
             sr = np.unique(np.append(sr, cp))
     else:
         sr = np.asarray(speed_ratio, dtype=float)
-    bad = np.flatnonzero((sr < 0) | (sr > 1) | ~np.isfinite(sr))
-    if bad.size:
-        raise InputError(
-            "command line",
-            "speed ratio",
-            float(sr[bad[0]]),
-            "0 to 1 for the hrovat-tobler model (reverse rotation and overrun are not modelled yet)",
-        )
     pump = np.full(sr.shape, wp)
     try:
-        out = hrovat_tobler_steady_state(conv.core_geometry(), pump, sr * wp)
+        df = _ht_frame(conv, pump, sr * wp, sr)
     except _core.CoreInputError as e:
         raise _speed_error(e, pump_speed_rpm, conv.path, "[geometry] at ") from None
-    tr = steady_torque_ratio(out)
-    df = pd.DataFrame(
+    return _order(_derived(df))
+
+
+def _ht_frame(conv: Converter, wp: np.ndarray, wt: np.ndarray, sr: np.ndarray, strict: bool = True) -> pd.DataFrame:
+    """Hrovat & Tobler's columns at speeds ``wp``, ``wt``, rad/s (``strict``: the core's error at the
+    first point without a steady state, else a NaN row with mode ``no-steady-state``)."""
+    out = hrovat_tobler_steady_state(conv.core_geometry(), wp, wt, strict)
+    return pd.DataFrame(
         {
             "speed_ratio": sr,
-            "torque_ratio": tr,
-            "pump_speed_rad_s": pump,
-            "turbine_speed_rad_s": sr * wp,
+            "torque_ratio": steady_torque_ratio(out),
+            "pump_speed_rad_s": wp,
+            "turbine_speed_rad_s": wt,
             "pump_torque_nm": out["pump_torque_nm"],
             "turbine_torque_nm": out["turbine_torque_nm"],
             "stator_torque_nm": out["stator_torque_nm"],
@@ -211,7 +220,6 @@ def characterise_hrovat_tobler(
             "stator_mode": [STATOR_MODES[int(m)] for m in out["stator_mode"]],
         }
     )
-    return _order(_derived(df))
 
 
 CHARACTERISE = {
@@ -236,6 +244,147 @@ _FIRST = [
 
 def _order(df: pd.DataFrame) -> pd.DataFrame:
     return df[_FIRST + [c for c in df.columns if c not in _FIRST]]
+
+
+#: The largest magnitude of a speed ratio a ``--speed-ratio`` sweep may reach.
+MAX_ABS_SPEED_RATIO = 100.0
+#: The most grid points of a ``--speed-ratio`` sweep.
+MAX_SWEEP_POINTS = 100_001
+
+
+def parse_speed_ratio_sweep(text: str) -> tuple[float, float, float]:
+    """``MIN:MAX:STEP`` of ``--speed-ratio`` as three numbers, else an :class:`InputError` about it."""
+    parts = text.split(":")
+    try:
+        if len(parts) != 3:
+            raise ValueError
+        lo, hi, step = (float(p) for p in parts)
+    except ValueError:
+        raise InputError(
+            "command line", "--speed-ratio", text, "MIN:MAX:STEP, three numbers (for example 0:1:0.01)"
+        ) from None
+    return lo, hi, step
+
+
+def speed_ratio_sweep(text: str) -> np.ndarray:
+    """The grid of ``--speed-ratio MIN:MAX:STEP``: MIN, MIN + STEP, ... up to MAX (included when it
+    falls on the grid to 1e-9 of a step).
+
+    Rules (else an :class:`InputError` about ``--speed-ratio``): finite numbers,
+    ``-MAX_ABS_SPEED_RATIO ≤ MIN < MAX ≤ MAX_ABS_SPEED_RATIO``, ``STEP > 0``, at most
+    :data:`MAX_SWEEP_POINTS` points.
+    """
+    lo, hi, step = parse_speed_ratio_sweep(text)
+    limit = MAX_ABS_SPEED_RATIO
+    if not all(np.isfinite([lo, hi, step])):
+        raise InputError("command line", "--speed-ratio", text, "finite numbers MIN:MAX:STEP")
+    if not (-limit <= lo < hi <= limit):
+        raise InputError(
+            "command line", "--speed-ratio", text, f"MIN < MAX, both from {-limit:g} to {limit:g} (MIN:MAX:STEP)"
+        )
+    if not step > 0:
+        raise InputError("command line", "--speed-ratio", text, "a positive STEP (MIN:MAX:STEP)")
+    n = int(np.floor((hi - lo) / step + 1e-9)) + 1
+    if n > MAX_SWEEP_POINTS:
+        raise InputError(
+            "command line", "--speed-ratio", text, f"at most {MAX_SWEEP_POINTS} points (this sweep has {n})"
+        )
+    grid = lo + step * np.arange(n)
+    if n >= 2 and abs(grid[-1] - hi) <= 1e-9 * step:
+        grid[-1] = hi
+    return grid
+
+
+def sweep_speed_ratios(conv: Converter, model: str, text: str) -> np.ndarray:
+    """The speed ratios of ``characterise --speed-ratio text``: the grid of :func:`speed_ratio_sweep`
+    with, inside its range, the table's own speed ratios (table, quasi-dynamic) or the coupling
+    point (hrovat-tobler), as in the default sweeps; a grid point within 1e-9 of a step of one of
+    those is replaced by it."""
+    grid = speed_ratio_sweep(text)
+    if model == "hrovat-tobler":
+        cp = coupling_point(conv)
+        extra = np.array([] if cp is None else [cp])
+    else:
+        assert conv.characteristic is not None  # the caller's conv.require checked it
+        extra = conv.characteristic.speed_ratio
+    inside = extra[(extra >= grid[0]) & (extra <= grid[-1])]
+    step = float(grid[1] - grid[0]) if grid.size > 1 else 1.0
+    # a grid point within round-off of an added one is that point (0.05·6 is the table's 0.3)
+    near = np.zeros(grid.shape, dtype=bool)
+    for x in inside:
+        near |= np.abs(grid - x) <= 1e-9 * step
+    return np.unique(np.concatenate([grid[~near], inside]))
+
+
+#: The models :func:`steady_state` and :func:`characterise` know.
+MODELS: tuple[str, ...] = ("table", "quasi-dynamic", "hrovat-tobler")
+
+
+def _finite_speeds(**speeds) -> tuple[np.ndarray, np.ndarray]:
+    """The two speed arguments as flat float arrays, broadcast against each other; a value that is not
+    a finite number is an :class:`InputError` naming the argument and its index."""
+    arrays = []
+    for name, value in speeds.items():
+        try:
+            a = np.asarray(value, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("steady_state", name, value, "numbers (rad/s)") from None
+        bad = np.argwhere(~np.isfinite(a))
+        if bad.size:
+            index = tuple(int(i) for i in bad[0])
+            where = "[" + ", ".join(map(str, index)) + "]" if index else ""
+            raise InputError("steady_state", f"{name}{where}", float(a[index]), "a finite speed in rad/s")
+        arrays.append(a)
+    try:
+        wp, wt = np.broadcast_arrays(*arrays)
+    except ValueError:
+        shapes = " and ".join(str(a.shape) for a in arrays)
+        raise InputError("steady_state", "turbine_speed_rad_s", f"shape {shapes}", "shapes that broadcast") from None
+    return np.ascontiguousarray(wp, dtype=float).reshape(-1), np.ascontiguousarray(wt, dtype=float).reshape(-1)
+
+
+def steady_state(conv: Converter, model: str, pump_speed_rad_s, turbine_speed_rad_s) -> pd.DataFrame:
+    """Steady states of ``model`` at arbitrary pump and turbine speeds, any sign, in the core.
+
+    Parameters
+    ----------
+    conv : Converter
+        The converter; it must have the sections of ``model``.
+    model : str
+        ``"table"``, ``"quasi-dynamic"`` or ``"hrovat-tobler"``.
+    pump_speed_rad_s, turbine_speed_rad_s : array_like
+        Speeds, rad/s, any sign; broadcast against each other and flattened (C order), one row per point.
+
+    Returns
+    -------
+    pandas.DataFrame
+        The columns of ``characteristic.csv`` for ``model`` in the same order (as :func:`characterise`),
+        ``speed_ratio`` = ω_t/ω_p. Every quadrant is defined (docs/models.md); with the pump at rest
+        ``speed_ratio``, the capacity factor and the K-factor are NaN or infinite but the torques are
+        the model's. A point where the model has no finite steady state (torques that overflow) is a
+        row of NaN torques and ratios: ``stator_mode`` ``no-steady-state`` (Hrovat & Tobler),
+        ``extrapolated`` false (table, quasi-dynamic). Never an error for such a point.
+
+    Raises
+    ------
+    InputError
+        An unknown model, a converter without the model's sections, a speed that is not finite
+        (``pump_speed_rad_s[i]``) or shapes that do not broadcast.
+    """
+    if model not in MODELS:
+        raise InputError("steady_state", "model", model, f"one of {', '.join(MODELS)}")
+    conv.require(model)
+    wp, wt = _finite_speeds(pump_speed_rad_s=pump_speed_rad_s, turbine_speed_rad_s=turbine_speed_rad_s)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        if model == "hrovat-tobler":
+            df = _ht_frame(conv, wp, wt, wt / wp, strict=False)
+        else:
+            assert conv.characteristic is not None  # conv.require checked it
+            rules = conv.characteristic.core_rules()
+            out = _core.table_steady_states(*conv.characteristic.arrays(), wp, wt, **rules, lenient=True)
+            conv.characteristic.warn_if_extended(wp, wt, "the steady states")
+            df = _table_frame(out, out["speed_ratio"], wp, wt)
+        return _order(_derived(df))
 
 
 def characterise(

@@ -73,7 +73,8 @@ def _options(rtol: float | None, **extra) -> dict[str, Any]:
     return o
 
 
-#: Columns that may hold ±inf by definition: the K-factor is infinite where the capacity is zero.
+#: Columns that may hold ±inf or NaN by definition: the K-factor is infinite where the capacity is
+#: zero and undefined (NaN) where it is negative (overrun rows of a table, ``conventions.md``).
 INFINITE_ALLOWED: frozenset[str] = frozenset({"k_factor_rpm_per_sqrt_nm"})
 #: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies): a run that has
 #: such a quantity never leaves it NaN at some samples; ratios, times not reached and metrics may be
@@ -147,6 +148,10 @@ def simulate(
 ) -> TransientResult:
     """Run one model under one drive; samples at ``times_s`` (default: the drive's time stamps).
 
+    The run always integrates from the drive's first time stamp; ``times_s`` (s, increasing, within
+    the drive's span) only chooses the samples, so a later first sample gives the same values as a
+    full run at the same times (:func:`output_times`). Events before the first sample are kept.
+
     The initial state is the steady state consistent with the first input sample (drive c: with
     the turbine at rest) unless ``initial`` gives ``pump_speed_rad_s``, ``turbine_speed_rad_s``,
     ``stator_speed_rad_s`` or ``flow_m3_s``. ``files`` names the file of an input the core may
@@ -176,11 +181,12 @@ def simulate_batch(
     ``speed_atol_rad_s``, ``flow_atol_m3_s``, ``first_step_s``, ``max_events`` and
     ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs is refused above it
     before anything runs)."""
-    specs = []
+    specs, skip = [], []
     for d in drives:
         s = d.spec()
+        skip.append(0)
         if times_s is not None:
-            s["output_time_s"] = np.asarray(times_s, dtype=float).tolist()
+            s["output_time_s"], skip[-1] = output_times(s["time_s"], times_s)
         specs.append(s)
     try:
         raw = _core.transient_runs(
@@ -194,4 +200,47 @@ def simulate_batch(
     failed = next((i for i, r in enumerate(raw) if r.error is not None), None)
     if failed is not None:  # raised before any run's warning: a failure is one line
         _unpack(raw[failed], models[failed if len(models) > 1 else 0], failed if n > 1 else None, files)
-    return [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None, files) for i, r in enumerate(raw)]
+    results = [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None, files) for i, r in enumerate(raw)]
+    return [_drop_first(r, skip[i if len(skip) > 1 else 0]) for i, r in enumerate(results)]
+
+
+def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]) -> tuple[list[float], int]:
+    """The output times a run is given for the samples ``times_s`` of a drive with time stamps
+    ``drive_time_s``, and how many leading samples to drop.
+
+    A run always starts at the drive's first time stamp (its initial state is the steady state of
+    the first input sample), and ``times_s`` only chooses where it is sampled: a first sample after
+    the drive's start is reached by integrating from the start, which is then prepended to the
+    output times and dropped (returned count 1). ``times_s`` must be finite, increasing and within
+    the drive's span, else :class:`InputError` about ``times_s[i]``; a first sample closer to the
+    start than the engine's time resolution (1 µs, or 1024 ulp of the time) is refused likewise.
+    """
+    t = np.atleast_1d(np.asarray(times_s, dtype=float))
+    span = np.atleast_1d(np.asarray(drive_time_s, dtype=float))
+    start, end = float(span[0]), float(span[-1])
+    if t.ndim != 1 or t.size < 1:
+        raise InputError("simulate", "times_s", f"shape {t.shape}", "a one-dimensional sequence of output times")
+    outside = np.flatnonzero(~np.isfinite(t) | (t < start) | (t > end))
+    if outside.size:
+        i = int(outside[0])
+        raise InputError(
+            "simulate", f"times_s[{i}]", float(t[i]), f"a time within the drive's span, {start:g} to {end:g} s"
+        )
+    if t[0] == start:
+        return t.tolist(), 0
+    resolution = _core.time_resolution_s(start)
+    if t[0] - start < (1.0 - 1e-3) * resolution:
+        raise InputError(
+            "simulate",
+            "times_s[0]",
+            float(t[0]),
+            f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
+        )
+    return [start, *t.tolist()], 1
+
+
+def _drop_first(result: TransientResult, n: int) -> TransientResult:
+    """``result`` without its first ``n`` samples (the drive's start, prepended by :func:`output_times`)."""
+    if n == 0:
+        return result
+    return TransientResult(result.model, {k: np.asarray(v)[n:] for k, v in result.columns.items()}, result.events)

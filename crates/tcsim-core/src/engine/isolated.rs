@@ -38,13 +38,13 @@
 //! exactly (the held flow does no work). This is the state the closed-form steady state calls
 //! `no-flow`.
 
-use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::converter::dynamics::{ConverterDynamics, Mat4, SteadyPoint, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::{self, ConverterRoot};
 use crate::engine::converter_events::{EventKind, Mode, Sample};
 use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
 use crate::engine::segment::SmoothSegment;
 use crate::engine::signal::Signal;
-use crate::error::{sig, CoreError, InputSource};
+use crate::error::{sig, CoreError, CoreResult, InputSource};
 
 /// How the converter is driven (issue: drives a, b, c).
 #[derive(Debug, Clone)]
@@ -483,8 +483,7 @@ fn steady_start(
     let mut u = if init.flow_m3_s.is_some() && init.stator_speed_rad_s.is_some() {
         [wp, wt, 0.0, 0.0]
     } else {
-        model
-            .steady_point(wp, wt)
+        steady_point_scaled(model, wp, wt)
             .map_err(|e| {
                 CoreError::of(
                     source,
@@ -568,8 +567,39 @@ fn check_steady_pump_speed(wp: f64, pump_torque_nm: f64) -> TransientResult<()> 
     Err(CoreError::of(InputSource::Converter, "initial pump_speed_rad_s", wp, expected).into())
 }
 
+/// Speeds below which [`steady_point_scaled`] solves at speeds scaled up to this, rad/s.
+const STEADY_SCALE_RAD_S: f64 = 1.0;
+
+/// The model's steady state at (`wp`, `wt`), defined continuously down to standstill.
+///
+/// A steady state is homogeneous in speed: the speeds and the flow scale with a factor `s`, the
+/// torques with `s²` (the table's `CF(SR)·ω_p|ω_p|`, Hrovat & Tobler's `q ∝ ω_p`). So below
+/// [`STEADY_SCALE_RAD_S`] the state is solved at the speeds scaled to it and scaled back (a speed
+/// ratio of two tiny speeds is as well-conditioned as of two large ones), and at rest (both
+/// speeds exactly 0) it is the limit of that scaling, all zero, whatever the model.
+pub fn steady_point_scaled(model: &dyn ConverterDynamics, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
+    let s = wp.abs().max(wt.abs());
+    if s == 0.0 {
+        return Ok(SteadyPoint { u: [0.0; 4], pump_torque_nm: 0.0 });
+    }
+    if s.is_nan() || s >= STEADY_SCALE_RAD_S {
+        return model.steady_point(wp, wt);
+    }
+    let k = STEADY_SCALE_RAD_S / s;
+    let p = model.steady_point(wp * k, wt * k)?;
+    let mut u = p.u.map(|x| x / k);
+    u[PUMP] = wp;
+    u[TURBINE] = wt;
+    Ok(SteadyPoint { u, pump_torque_nm: p.pump_torque_nm / (k * k) })
+}
+
 /// The pump speed at which the steady-state pump torque equals `pump_torque_nm` at turbine
 /// speed `wt` ≥ 0 (from the input `wt_source`).
+///
+/// With `C(SR)` the steady pump torque at a pump speed of 1 rad/s (homogeneity: `T_p = C(SR)·ω_p²`),
+/// the speed ratio solves `SR·√T_p = ω_t·√C(SR)`, whose left side rises and right side falls with
+/// SR on [0, 1]: bisection from SR = 0, so that any tiny turbine speed (1e-13 rad/s) converges to
+/// the stall solution continuously, and a pump at rest (`T_p = 0`, `ω_t = 0`) gives `ω_p = 0`.
 fn steady_pump_speed(
     model: &dyn ConverterDynamics,
     pump_torque_nm: f64,
@@ -584,9 +614,13 @@ fn steady_pump_speed(
             expected.to_string(),
         ))
     };
+    if pump_torque_nm == 0.0 && wt == 0.0 {
+        return Ok(0.0); // at rest: the converter stands still with no torque on it
+    }
     if !pump_torque_nm.is_finite() || pump_torque_nm <= 0.0 {
         return Err(bad(
-            "a positive pump torque at the start for a steady initial state; give the initial pump speed explicitly",
+            "a positive pump torque at the start for a steady initial state (or zero with the turbine at rest); give \
+             the initial pump speed explicitly",
         ));
     }
     if wt < 0.0 {
@@ -599,8 +633,8 @@ fn steady_pump_speed(
         .into());
     }
     // a failure of the steady state itself: no steady state at this turbine speed
-    let torque_at = |wp: f64| {
-        model.steady_point(wp, wt).map(|p| p.pump_torque_nm).map_err(|e| {
+    let unit_torque = |sr: f64| {
+        model.steady_point(1.0, sr).map(|p| p.pump_torque_nm).map_err(|e| {
             TransientError::from(CoreError::of(
                 wt_source,
                 format!("initial {}", e.field),
@@ -609,37 +643,36 @@ fn steady_pump_speed(
             ))
         })
     };
-    if wt == 0.0 {
-        let t1 = torque_at(1.0)?;
-        let wp = (pump_torque_nm / t1).sqrt();
-        if !wp.is_finite() {
-            return Err(bad(
-                "a pump torque for which the steady pump speed is finite; give the initial pump speed explicitly",
-            ));
+    let root_tp = pump_torque_nm.sqrt();
+    let h = |sr: f64| -> TransientResult<f64> { Ok(sr * root_tp - wt * unit_torque(sr)?.max(0.0).sqrt()) };
+    let sr = if wt == 0.0 {
+        0.0
+    } else {
+        if h(1.0)? <= 0.0 {
+            return Err(bad("a pump torque above the steady torque at SR = 1 for the first turbine speed (the start is in overrun); give the initial pump speed explicitly"));
         }
-        return Ok(wp);
-    }
-    // pump torque falls with SR: bisect on SR in (0, 1]
-    let f = |sr: f64| -> TransientResult<f64> { Ok(torque_at(wt / sr)? - pump_torque_nm) };
-    if f(1.0)? >= 0.0 {
-        return Err(bad("a pump torque above the steady torque at SR = 1 for the first turbine speed (the start is in overrun); give the initial pump speed explicitly"));
-    }
-    let (mut lo, mut hi) = (1e-9_f64, 1.0_f64);
-    if f(lo)? <= 0.0 {
-        return Err(bad("a pump torque the converter can absorb at the first turbine speed"));
-    }
-    for _ in 0..200 {
-        let mid = 0.5 * (lo + hi);
-        if f(mid)? > 0.0 {
-            lo = mid;
-        } else {
-            hi = mid;
+        let (mut lo, mut hi) = (0.0_f64, 1.0_f64);
+        for _ in 0..2200 {
+            let mid = 0.5 * (lo + hi);
+            if mid <= lo || mid >= hi || hi - lo <= 1e-15 * hi {
+                break;
+            }
+            if h(mid)? < 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
         }
-        if hi - lo <= 1e-15 * hi {
-            break;
-        }
+        0.5 * (lo + hi)
+    };
+    let c = unit_torque(sr)?;
+    let wp = if c > 0.0 { (pump_torque_nm / c).sqrt() } else { wt / sr };
+    if !wp.is_finite() {
+        return Err(bad(
+            "a pump torque for which the steady pump speed is finite; give the initial pump speed explicitly",
+        ));
     }
-    Ok(wt / (0.5 * (lo + hi)))
+    Ok(wp)
 }
 
 /// Run `model` under `drive`, sampled at `times_s` (sorted, the first is the start time).
