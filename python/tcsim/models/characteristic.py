@@ -5,6 +5,7 @@ from __future__ import annotations
 import re
 import warnings
 from dataclasses import dataclass
+from typing import TypedDict
 
 import numpy as np
 
@@ -12,6 +13,14 @@ from .. import _core
 from ..errors import InputError, TcsimWarning, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .plausibility import warn_implausible
+
+
+class CoreRules(TypedDict, total=False):
+    """The ``[characteristic]`` rules the core's table functions take (absent: the core's default)."""
+
+    overrun: str
+    interpolation: str
+
 
 CAPACITY_KEYS = tuple(_core.capacity_conventions())
 
@@ -120,11 +129,15 @@ class Characteristic:
             raise from_core(e, source, where) from None
         return cls(sr, tr, cf, convention, source, overrun, interpolation)
 
-    def core_rules(self) -> dict[str, str]:
+    def core_rules(self) -> CoreRules:
         """The ``overrun`` and ``interpolation`` keys the file gave, for the core's table functions
         and model specification (absent keys: the core's defaults)."""
-        rules = {"overrun": self.overrun, "interpolation": self.interpolation}
-        return {k: v for k, v in rules.items() if v is not None}
+        rules = CoreRules()
+        if self.overrun is not None:
+            rules["overrun"] = self.overrun
+        if self.interpolation is not None:
+            rules["interpolation"] = self.interpolation
+        return rules
 
     def warn_if_extended(self, pump_speed_rad_s, turbine_speed_rad_s, what: str = "the run") -> None:
         """:func:`warn_if_extended` for this table."""
@@ -155,7 +168,7 @@ class Characteristic:
 def warn_if_extended(
     source: str,
     table: tuple[np.ndarray, np.ndarray, np.ndarray],
-    rules: dict[str, str],
+    rules: CoreRules,
     pump_speed_rad_s,
     turbine_speed_rad_s,
     what: str = "the run",

@@ -13,7 +13,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError, from_core
 from ..units import DEFAULT_PUMP_SPEED_RAD_S
-from .characteristic import warn_if_extended
+from .characteristic import CoreRules, warn_if_extended
 from .converter import MODELS, Converter, load_converter
 
 #: Pump speed at which the default quasi-dynamic flow time constant is evaluated (stall), rad/s:
@@ -48,7 +48,11 @@ class DynamicModel:
             return
         s = self.spec
         table = (np.asarray(s["speed_ratio"]), np.asarray(s["torque_ratio"]), np.asarray(s["capacity_factor_nm_s2"]))
-        rules: dict[str, str] = {k: str(s[k]) for k in ("overrun", "interpolation") if k in s}
+        rules = CoreRules()
+        if "overrun" in s:
+            rules["overrun"] = str(s["overrun"])
+        if "interpolation" in s:
+            rules["interpolation"] = str(s["interpolation"])
         warn_if_extended(self.source, table, rules, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"], what)
 
     def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:

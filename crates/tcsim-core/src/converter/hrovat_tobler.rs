@@ -640,10 +640,19 @@ pub fn steady_state<T: Scalar>(
         with_clutch(locked, || solve(StatorMode::FreeWheeling), wt, scale)
     };
     let first = in_direction(direction)?;
-    // where the flow could start either way (F_Q(0⁺) > 0 > F_Q(0⁻), shock coefficients below 1) and
-    // the preferred direction has no flowing steady state, the other one's is taken if it has one
-    if first.mode == StatorMode::NoFlow && forward > 0.0 && reverse < 0.0 {
-        let other = in_direction(-direction)?;
+    // where the direction the flow starts in has no flowing steady state, the other direction's is
+    // taken if it has one: the free-wheeling stator spins up while the flow dies away and the flow
+    // then settles in the other direction (coast just above SR 1: Appendix D at SR 1.0084–1.0303
+    // starts forwards with the stator at rest and settles on reverse flow, as the transient does)
+    if first.mode == StatorMode::NoFlow {
+        let solve = |mode| if direction < 0 { solve_mode(g, wp, wt, mode) } else { solve_reverse(g, wp, wt, mode) };
+        let other = match solve(StatorMode::Locked) {
+            Some(locked) => with_clutch(locked, || solve(StatorMode::FreeWheeling), wt, scale)?,
+            None => match solve(StatorMode::FreeWheeling) {
+                Some(free) if free.is_finite() && free.stator_speed_rad_s.re() >= 0.0 => free,
+                _ => first,
+            },
+        };
         if other.mode != StatorMode::NoFlow {
             return Ok(other);
         }
