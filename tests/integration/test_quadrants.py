@@ -134,21 +134,27 @@ def test_coast_with_the_speeds_given_brakes_the_pump_and_absorbs_energy(name, mo
 @pytest.mark.parametrize("model", TABLE_MODELS)
 def test_the_isolated_tip_out_never_creates_energy(model):
     """The isolated take-off with its tip-out (−30 N·m on the pump from 5.1 s, the load inertia
-    still turning the turbine): overrun, then a reversed pump with the turbine forward. The loss
-    power is never negative (before issue 11 it reached −658 W), and for the table model the energy
-    identity holds to 1e-6 of the energy through the pump. (The quasi-dynamic model's flow row is a
-    lag, not a power balance: its bookkeeping leaves 3e-4 here, as in drive.)"""
+    still turning the turbine): overrun, then a reversed pump with the turbine forward. The energy
+    identity holds to 1e-6 of the energy through the pump for both models, and the converter absorbs
+    energy over the run. The table model's loss power is never negative (before issue 11 it reached
+    −658 W). The quasi-dynamic model's loss includes the power of its fluid terms ρQ̇(S_p ω_p + S_t ω_t),
+    which it stores nowhere: that dips below zero for a moment in the tip-out (about −1.2 kW against
+    64 kJ absorbed over the run; docs/models.md)."""
     t = np.linspace(0.0, 10.0, 100_001)
     with pytest.warns(TcsimWarning, match='overrun = "mirror"'):
         f = simulate("li-sunden-2016", isolated_takeoff(tip_out=True), model=model, times_s=t).frame()
     assert f["speed_ratio"].max() > 3.0 and f["pump_speed_rad_s"].min() < -50.0  # every quadrant visited
     scale = (f["pump_torque_nm"].abs() * f["pump_speed_rad_s"].abs()).max()
-    assert f["fluid_loss_power_w"].min() >= -1e-12 * scale
+    loss = np.trapezoid(f["fluid_loss_power_w"], f["time_s"])
+    net = np.trapezoid(f["converter_input_power_w"], f["time_s"]) - loss
+    stored = f["stored_energy_j"].iloc[-1] - f["stored_energy_j"].iloc[0]
+    through = np.trapezoid((f["pump_torque_nm"] * f["pump_speed_rad_s"]).abs(), f["time_s"])
+    assert abs(stored - net) < 1e-6 * through, (stored, net, through)
+    assert loss > 0.0
     if model == "table":
-        net = np.trapezoid(f["converter_input_power_w"] - f["fluid_loss_power_w"], f["time_s"])
-        stored = f["stored_energy_j"].iloc[-1] - f["stored_energy_j"].iloc[0]
-        through = np.trapezoid((f["pump_torque_nm"] * f["pump_speed_rad_s"]).abs(), f["time_s"])
-        assert abs(stored - net) < 1e-6 * through
+        assert f["fluid_loss_power_w"].min() >= -1e-12 * scale
+    else:
+        assert f["fluid_loss_power_w"].min() > -0.05 * f["fluid_loss_power_w"].max()
 
 
 @pytest.mark.parametrize("model", TABLE_MODELS)

@@ -65,6 +65,13 @@ pub trait ConverterDynamics: Sync {
     fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
         -(u[0] * f[0] + u[1] * f[1] + u[2] * f[2] + u[3] * f[3])
     }
+    /// The energy the model stores at `u`, J: `½uᵀMu` (the kinetic energy of the elements and, for
+    /// Hrovat & Tobler, of the fluid with its coupling to the elements). With [`Self::loss_power_w`]
+    /// it closes the energy identity `∫T_ext·ω dt = ΔE + ∫loss dt`.
+    fn stored_energy_j(&self, u: &Vec4) -> f64 {
+        let m = self.mass();
+        0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| m[r][c] * u[c]).sum::<f64>()).sum::<f64>()
+    }
     /// The steady state at the given pump and turbine speeds (0 ≤ SR ≤ 1, ω_p > 0).
     fn steady_point(&self, pump_speed_rad_s: f64, turbine_speed_rad_s: f64) -> CoreResult<SteadyPoint>;
     /// Whether the model has a stator one-way clutch (and so stator events).
@@ -597,6 +604,9 @@ impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
     fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
         (**self).loss_power_w(u, f)
     }
+    fn stored_energy_j(&self, u: &Vec4) -> f64 {
+        (**self).stored_energy_j(u)
+    }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         (**self).steady_point(wp, wt)
     }
@@ -749,6 +759,30 @@ mod tests {
             if wt.abs() > wp.abs() {
                 assert!(u[FLOW] < 0.0, "Q_ss = {} at ({wp}, {wt})", u[FLOW]);
             }
+        }
+    }
+
+    /// The quasi-dynamic model's energy bookkeeping: with any external torques, the power they put
+    /// in is the rate of change of the stored (kinetic) energy plus the loss power, the fluid terms
+    /// `ρQ̇(S_p ω_p + S_t ω_t)` included (before issue 11 they were left out: 133 J over the isolated
+    /// tip-out).
+    #[test]
+    fn qd_loss_and_stored_energy_close_the_power_balance() {
+        let m = qd();
+        let (ip, it) = (m.inertia.pump_kg_m2, m.inertia.turbine_kg_m2);
+        for u in [[200.0, 50.0, 0.0, 0.03], [150.0, 260.0, 0.0, -0.01], [-80.0, 120.0, 0.0, 0.02]] {
+            let (f, mass) = (m.forces(&u, 1.0), m.mass());
+            let t_ext = [35.0, -20.0];
+            // M u̇ = F + T_ext: the flow row is the unit row, then the speed rows
+            let q_dot = f[FLOW];
+            let wp_dot = (f[PUMP] + t_ext[0] - mass[PUMP][FLOW] * q_dot) / ip;
+            let wt_dot = (f[TURBINE] + t_ext[1] - mass[TURBINE][FLOW] * q_dot) / it;
+            let stored_rate = ip * u[PUMP] * wp_dot + it * u[TURBINE] * wt_dot;
+            let input = t_ext[0] * u[PUMP] + t_ext[1] * u[TURBINE];
+            let loss = m.loss_power_w(&u, &f);
+            assert!((input - stored_rate - loss).abs() < 1e-9 * (input.abs() + loss.abs()), "{u:?}");
+            let kinetic = 0.5 * (ip * u[PUMP] * u[PUMP] + it * u[TURBINE] * u[TURBINE]);
+            assert!((m.stored_energy_j(&u) - kinetic).abs() <= 1e-12 * kinetic);
         }
     }
 

@@ -103,9 +103,20 @@ impl ConverterDynamics for QuasiDynamics {
         j[FLOW][FLOW] = -1.0 / tau;
         j
     }
+    /// The power the converter takes from the shafts and does not store: the table's loss
+    /// `T_p,tr ω_p − T_t,tr ω_t` plus the power of the fluid terms `ρQ̇(S_p ω_p + S_t ω_t)`, which the
+    /// model stores nowhere (its flow row is a lag, not a power balance; `Q̇ = f[FLOW]` since that
+    /// row of `M` is the unit row). With [`Self::stored_energy_j`] this closes the energy identity;
+    /// the fluid terms can make it negative for a moment (docs/models.md, "Quasi-dynamic model").
     fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
-        // the flow row is a lag, not a power balance
-        -(u[PUMP] * f[PUMP] + u[TURBINE] * f[TURBINE])
+        let fluid = self.fluid_density_kg_m3
+            * f[FLOW]
+            * (self.pump_shape_effect_m2 * u[PUMP] + self.turbine_shape_effect_m2 * u[TURBINE]);
+        -(u[PUMP] * f[PUMP] + u[TURBINE] * f[TURBINE]) + fluid
+    }
+    /// The kinetic energy of pump and turbine, J (the flow coordinate stores none).
+    fn stored_energy_j(&self, u: &Vec4) -> f64 {
+        0.5 * (self.inertia.pump_kg_m2 * u[PUMP] * u[PUMP] + self.inertia.turbine_kg_m2 * u[TURBINE] * u[TURBINE])
     }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         let tp = table_steady(&self.characteristic, wp, wt)?;

@@ -196,7 +196,7 @@ pub fn external_torques(mass: &Mat4, u_dot: &Vec4, f: &Vec4) -> Vec4 {
 pub fn sample(model: &dyn ConverterDynamics, mode: Mode, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
     let mass = model.mass();
     let e = external_torques(&mass, &u_dot, &f);
-    let stored = 0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| mass[r][c] * u[c]).sum::<f64>()).sum::<f64>();
+    let stored = model.stored_energy_j(&u);
     let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
     let transferred = model.transferred(&f);
     if !model.coordinates()[STATOR] {
