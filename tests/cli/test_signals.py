@@ -98,6 +98,7 @@ def test_an_interrupted_run_exits_128_plus_the_signal_and_leaves_nothing(tmp_pat
 #: A batch of launch runs far longer than any hang guard (some hours of work), started in a
 #: subprocess that reports its thread count first; the signal is sent once the batch's threads exist.
 BATCH_SCRIPT = """
+import signal
 import sys
 from pathlib import Path
 from tcsim import _core
@@ -107,6 +108,9 @@ from tcsim.models.dynamic import dynamic_model
 from tcsim.models.vehicle import load_vehicle
 from tcsim.simulation.scenarios import flip_flop
 
+# Python installs its Ctrl-C handler only where SIGINT is not ignored; a shell without job control
+# starts background jobs (CI under `nohup ... &`) with SIGINT ignored. Install it as a terminal would.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 veh = load_vehicle(None)
 spec = dynamic_model(veh.converter, "quasi-dynamic").spec
 threads = next(l for l in Path("/proc/self/status").read_text().splitlines() if l.startswith("Threads:"))
