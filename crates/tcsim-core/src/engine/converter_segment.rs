@@ -284,9 +284,9 @@ impl<'a> Segment<'a> {
         if self.n > 0 {
             let mut r = [0.0; 4];
             self.reduced_rhs(&u, &f, t, &mut r[..self.n]);
-            for c in 0..4 {
+            for (c, rate) in ud.iter_mut().enumerate() {
                 if let Some(i) = self.col[c] {
-                    ud[c] = (0..self.n).map(|k| self.inv[i][k] * r[k]).sum();
+                    *rate = (0..self.n).map(|k| self.inv[i][k] * r[k]).sum();
                 }
             }
         }

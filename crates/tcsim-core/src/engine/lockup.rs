@@ -188,5 +188,8 @@ mod tests {
         assert_eq!(state_code(ClutchMode::Unarmed { since_s: 0.0 }, 0.0), 0.0);
         assert_eq!(initial_mode(-0.7, 0.0), ClutchMode::Armed);
         assert_eq!(initial_mode(0.1, 2.0), ClutchMode::Unarmed { since_s: 2.0 });
+        let columns = &crate::engine::outputs::COLUMNS[crate::engine::outputs::LOCKUP_COLUMNS_START..];
+        assert_eq!(columns[0], "lockup_torque_nm");
+        assert!(columns.iter().all(|c| c.starts_with("lockup_")));
     }
 }

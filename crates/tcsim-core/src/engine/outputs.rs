@@ -24,6 +24,9 @@ use crate::engine::converter_events::Sample;
 use crate::engine::isolated::Trajectory;
 use crate::engine::options::{try_reserve, OutputSize, SolverOptions, TransientResult};
 
+/// Index in [`COLUMNS`] of the first lock-up clutch column (the clutch's columns come last).
+pub const LOCKUP_COLUMNS_START: usize = 27;
+
 /// Column names, in order.
 pub const COLUMNS: [&str; 33] = [
     "time_s",
