@@ -11,7 +11,7 @@
 
 use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::{self, ConverterRoot, EventKind, LockupSample, Mode, Sample};
-use crate::engine::isolated::Drive;
+use crate::engine::drive::Drive;
 use crate::engine::lockup::{self, ClutchMode, LockupCommand, LockupRoot};
 use crate::engine::options::{Hysteresis, SolverOptions};
 use crate::engine::segment::SmoothSegment;
