@@ -21,6 +21,7 @@ fn main() {
         pump_torque_nm: Signal::new("pump_torque_nm", vec![0.0, 0.1, 0.3, 10.0], vec![40.0, 40.0, 250.0, 250.0], 0.0)
             .unwrap(),
         load: TurbineLoad { torque_nm: Signal::constant(10.0), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 },
+        lockup: None,
     };
     let t: Vec<f64> = (0..=1000).map(|i| i as f64 * 0.01).collect();
     let mut times = Vec::new();

@@ -97,6 +97,7 @@ fn held(wp: f64, wt: f64, until: f64) -> Drive {
     Drive::Speeds {
         pump_speed_rad_s: signal("pump_speed_rad_s", &[(0.0, wp), (until, wp)]),
         turbine_speed_rad_s: signal("turbine_speed_rad_s", &[(0.0, wt), (until, wt)]),
+        lockup: None,
     }
 }
 
@@ -200,6 +201,7 @@ fn coast_at_held_speeds_brakes_the_pump_with_reverse_flow() {
     let drive = Drive::Speeds {
         pump_speed_rad_s: signal("pump", &[(0.0, wp), (0.7, wp)]),
         turbine_speed_rad_s: signal("turbine", &[(0.0, wp), (0.7, 1.06 * wp)]),
+        lockup: None,
     };
     let t = grid(0.0, 0.7, 701);
     let (traj, cols) = run(&ht(SHAPE), &drive, &t, InitialState::default());
@@ -220,6 +222,7 @@ fn stator_clutch_releases_at_the_coupling_point_and_locks_again() {
     let drive = Drive::Speeds {
         pump_speed_rad_s: signal("pump", &[(0.0, wp), (40.0, wp)]),
         turbine_speed_rad_s: signal("turbine", &[(0.0, 0.0), (20.0, 0.97 * wp), (120.0, 0.5 * wp)]),
+        lockup: None,
     };
     // the free stator lags the flow by I_s/(ρR_s²Q) ≈ 0.1 s, so the return ramp is slow
     let t = grid(0.0, 120.0, 401);
@@ -294,6 +297,7 @@ fn hrovat_tobler_follows_its_steady_state_when_the_flow_is_quasi_steady() {
     let drive = Drive::Speeds {
         pump_speed_rad_s: signal("pump", &[(0.0, 150.0), (10.0, 250.0)]),
         turbine_speed_rad_s: signal("turbine", &[(0.0, 0.0), (10.0, 200.0)]),
+        lockup: None,
     };
     let t = grid(0.0, 10.0, 101);
     let (_, cols) = run(&ht([0.0; 3]), &drive, &t, InitialState::default());
@@ -350,13 +354,17 @@ fn the_three_drives_agree_on_one_take_off() {
     let pump = Signal::new("pump_speed_rad_s", t.clone(), col(&c, "pump_speed_rad_s").to_vec(), 0.0).unwrap();
     let (_, a) = run(
         &model,
-        &Drive::PumpTorqueTurbineSpeed { pump_torque_nm: takeoff_torque(false), turbine_speed_rad_s: turbine.clone() },
+        &Drive::PumpTorqueTurbineSpeed {
+            pump_torque_nm: takeoff_torque(false),
+            turbine_speed_rad_s: turbine.clone(),
+            lockup: None,
+        },
         &t,
         InitialState::default(),
     );
     let (_, b) = run(
         &model,
-        &Drive::Speeds { pump_speed_rad_s: pump, turbine_speed_rad_s: turbine },
+        &Drive::Speeds { pump_speed_rad_s: pump, turbine_speed_rad_s: turbine, lockup: None },
         &t,
         InitialState::default(),
     );
@@ -376,6 +384,7 @@ fn bad_runs_are_input_errors() {
     let drive = Drive::PumpTorqueTurbineSpeed {
         pump_torque_nm: Signal::constant(-10.0),
         turbine_speed_rad_s: Signal::constant(0.0),
+        lockup: None,
     };
     match simulate(&ht(SHAPE), &drive, &t, &InitialState::default(), &SolverOptions::default()) {
         Err(tcsim_core::engine::options::TransientError::Input(e)) => {
@@ -418,6 +427,7 @@ fn a_run_stepped_interval_by_interval_follows_the_single_run() {
     let drive = Drive::PumpTorqueTurbineSpeed {
         pump_torque_nm: signal("pump_torque_nm", &[(0.0, 40.0), (0.1, 40.0), (0.3, 250.0), (t_end, 250.0)]),
         turbine_speed_rad_s: signal("turbine_speed_rad_s", &[(0.0, 0.0), (t_end, wt(t_end))]),
+        lockup: None,
     };
     let model = ht(SHAPE);
     for h in [0.01, 0.1] {

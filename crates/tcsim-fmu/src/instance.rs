@@ -409,10 +409,12 @@ impl Instance {
             Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
                 pump_torque_nm: Signal::constant(s(vr::PUMP_TORQUE)),
                 turbine_speed_rad_s: turbine,
+                lockup: None,
             },
             Causality::Speeds => Drive::Speeds {
                 pump_speed_rad_s: line("pump_speed_rad_s", s(vr::PUMP_SPEED), s(vr::PUMP_ACCEL))?,
                 turbine_speed_rad_s: turbine,
+                lockup: None,
             },
         })
     }

@@ -34,6 +34,7 @@ use tcsim_core::converter::hrovat_tobler::{
 use tcsim_core::converter::table::Characteristic;
 use tcsim_core::engine::converter_events::EventKind;
 use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
+use tcsim_core::engine::lockup::LockupCommand;
 use tcsim_core::engine::options::{SolverOptions, TransientError};
 use tcsim_core::engine::outputs::isolated_output_size;
 use tcsim_core::engine::signal::Signal;
@@ -620,6 +621,37 @@ fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal
     }
 }
 
+/// The lock-up clutch's command of a drive dict: `lockup_capacity_nm` (a constant or one value per
+/// time, N·m ≥ 0) and `lockup_static_to_kinetic` (≥ 1, default
+/// [`tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC`]); None without a capacity.
+fn lockup_from(d: &Bound<'_, PyDict>, window: f64) -> PyResult<Option<LockupCommand>> {
+    if d.get_item("lockup_capacity_nm")?.is_none() {
+        return Ok(None);
+    }
+    let capacity_nm = signal_from(d, "lockup_capacity_nm", window)?;
+    if let Some((i, v)) = capacity_nm.values().iter().enumerate().find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
+        let field = format!("lockup_capacity_nm[{i}]");
+        return Err(input_error(CoreError::of(
+            InputSource::Drive,
+            field,
+            v,
+            "a finite capacity of zero or more in N·m",
+        )));
+    }
+    let static_to_kinetic: f64 =
+        opt_item(d, "lockup_static_to_kinetic")?.unwrap_or(tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC);
+    if !(static_to_kinetic.is_finite() && static_to_kinetic >= 1.0) {
+        let expected = "a finite static-to-kinetic friction ratio of 1 or more";
+        return Err(input_error(CoreError::of(
+            InputSource::Drive,
+            "lockup_static_to_kinetic",
+            static_to_kinetic,
+            expected,
+        )));
+    }
+    Ok(Some(LockupCommand { capacity_nm, static_to_kinetic }))
+}
+
 fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
     let kind: String = item(d, "kind")?;
     let window: f64 =
@@ -632,10 +664,12 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
         "pump-torque-turbine-speed" => Drive::PumpTorqueTurbineSpeed {
             pump_torque_nm: signal_from(d, "pump_torque_nm", window)?,
             turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)?,
+            lockup: lockup_from(d, window)?,
         },
         "speeds" => Drive::Speeds {
             pump_speed_rad_s: signal_from(d, "pump_speed_rad_s", window)?,
             turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)?,
+            lockup: lockup_from(d, window)?,
         },
         "pump-torque-load" => {
             let load = TurbineLoad {
@@ -659,7 +693,11 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
                     "a finite drag coefficient of zero or more",
                 )));
             }
-            Drive::PumpTorqueLoad { pump_torque_nm: signal_from(d, "pump_torque_nm", window)?, load }
+            Drive::PumpTorqueLoad {
+                pump_torque_nm: signal_from(d, "pump_torque_nm", window)?,
+                load,
+                lockup: lockup_from(d, window)?,
+            }
         }
         other => return Err(PyValueError::new_err(format!("unknown drive kind {other:?}"))),
     };

@@ -36,6 +36,14 @@ the models compute the pump and turbine torques. Measured ``pump_torque_nm`` and
 A channel mapped with ``--channel`` that a model also outputs (for example
 ``--channel flow_m3_s=Q``) is compared as well.
 
+Lock-up clutch
+--------------
+An optional input channel ``lockup_capacity_nm`` (found like the others: ``lockup_capacity_knm``,
+``--channel lockup_capacity_nm=LuCap``, ...) commands the converter's lock-up clutch, its torque
+capacity against time (N·m, zero or more; a negative or non-finite value is an input error naming
+the file, the column and the value). Without it the converter has no clutch. See docs/lockup.md:
+the clutch slips, locks and breaks away, and the outputs gain its torque, state and slip.
+
 Models
 ------
 ``--model`` is repeatable: ``table``, ``hrovat-tobler``, ``quasi-dynamic``. By default every
@@ -143,6 +151,8 @@ METRIC_COLUMNS = [
     "n",
 ]
 EVENT_COLUMNS = ["model", "time_s", "kind", "stator_locked", "flow_direction"]
+#: The optional input channel that commands the converter's lock-up clutch (N·m, docs/lockup.md).
+LOCKUP_CHANNEL = "lockup_capacity_nm"
 
 
 @dataclass(frozen=True)
@@ -156,7 +166,8 @@ class DriveKind:
 
     def make(self, meas: Measurement, window_s: float) -> Drive:
         a, b = (meas.channels[c] for c in self.inputs)
-        return self.cls(meas.time_s, a, b, derivative_window_s=window_s)
+        lockup = meas.channels.get(LOCKUP_CHANNEL)
+        return self.cls(meas.time_s, a, b, derivative_window_s=window_s, lockup_capacity_nm=lockup)
 
 
 DRIVES: dict[str, DriveKind] = {
@@ -291,7 +302,7 @@ def run_models(
 def reference_channels(meas: Measurement, drive: DriveKind, effective: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     """The measured channels to compare with the models: every measured channel that is not an input
     of the drive (the models output all of them), then the measured effective torques."""
-    refs = {c: v for c, v in meas.channels.items() if c not in drive.inputs}
+    refs = {c: v for c, v in meas.channels.items() if c not in drive.inputs and c != LOCKUP_CHANNEL}
     refs.update(effective)
     return refs
 

@@ -35,7 +35,7 @@ def replay_files(
     the record's span, nor ``metrics_window_s`` (s; ``None``: the whole record only) unless it is
     the default 1 s, and ``metrics_window_s`` may not be shorter than the median sample spacing.
     Measured values outside the plausibility ranges are refused unless ``allow_implausible``."""
-    from ..analysis.replay import check_window, drive_kind, replay_measurement
+    from ..analysis.replay import LOCKUP_CHANNEL, check_window, drive_kind, replay_measurement
     from ..io.measurement import read_measurement
     from ..models.converter import load_converter
     from ..models.dynamic import select_models
@@ -48,7 +48,11 @@ def replay_files(
     conv = converter if not isinstance(converter, (str, Path)) else load_converter(converter)
     select_models(conv, models)  # a bad --model is reported before the measurement is read
     meas = read_measurement(
-        measurement, channels, required=kind.inputs, optional=kind.outputs, allow_implausible=allow_implausible
+        measurement,
+        channels,
+        required=kind.inputs,
+        optional=(*kind.outputs, LOCKUP_CHANNEL),
+        allow_implausible=allow_implausible,
     )
     return replay_measurement(conv, meas, models, kind, initial, window_s, metrics_window_s)
 

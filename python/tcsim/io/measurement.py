@@ -74,6 +74,7 @@ _QUANTITY: dict[str, str] = {
     "turbine_torque_nm": "torque",
     "turbine_load_torque_nm": "torque",
     "flow_m3_s": "flow",
+    "lockup_capacity_nm": "torque",
 }
 
 INPUT_CHANNELS: tuple[str, ...] = tuple(_QUANTITY)
@@ -510,6 +511,20 @@ def check_finite(path: Path, column: str, values: np.ndarray, time_s: np.ndarray
         )
 
 
+#: Channels that cannot be negative: the lock-up clutch's capacity command (docs/lockup.md).
+NON_NEGATIVE: tuple[str, ...] = ("lockup_capacity_nm",)
+
+
+def check_non_negative(path: Path, column: str, values: np.ndarray, time_s: np.ndarray | None) -> None:
+    """An InputError naming the first negative value (a capacity command of a clutch)."""
+    bad = np.flatnonzero(values < 0)
+    if len(bad):
+        row = int(bad[0])
+        raise InputError(
+            str(path), column, f"{values[row]:g} at {_at(row, time_s)}", "a lock-up capacity of zero or more in N·m"
+        )
+
+
 def check_increasing(path: Path, column: str, time: np.ndarray) -> None:
     steps = np.flatnonzero(np.diff(time) <= 0)
     if len(steps):
@@ -601,6 +616,8 @@ def read_measurement(
         if factor != 1.0:
             values = values * factor
         _plausible(path, p.column, p.canonical, values, time_s, allow_implausible)
+        if p.canonical in NON_NEGATIVE:
+            check_non_negative(path, p.column, values, time_s)
         out[p.canonical] = values
     time_s = out.pop("time_s")
     return Measurement(str(path), time_s, out)

@@ -1,5 +1,10 @@
 """Drives of the isolated converter (what the transient engine is given against time): pump torque
-and turbine speed (a), both speeds (b), pump torque against a load (c)."""
+and turbine speed (a), both speeds (b), pump torque against a load (c).
+
+Every drive may command the converter's lock-up clutch (docs/lockup.md): ``lockup_capacity_nm``, a
+constant or one value per time stamp (N·m, zero or more; None: no clutch, the same run as a command
+of zero), and ``lockup_static_to_kinetic`` (the static-to-kinetic friction ratio, 1 or more; None:
+the core's default, 1.2)."""
 
 from __future__ import annotations
 
@@ -23,16 +28,29 @@ def _arr(x: Any) -> list[float] | float:
     return np.asarray(x, dtype=float).tolist()
 
 
+def _lockup(capacity_nm: ArrayLike | None, static_to_kinetic: float | None) -> dict[str, Any]:
+    """The lock-up keys of a drive's spec (none without a capacity command)."""
+    spec: dict[str, Any] = {}
+    if capacity_nm is not None:
+        spec["lockup_capacity_nm"] = _arr(capacity_nm)
+        if static_to_kinetic is not None:
+            spec["lockup_static_to_kinetic"] = float(static_to_kinetic)
+    return spec
+
+
 @dataclass(frozen=True)
 class PumpTorqueTurbineSpeed:
     """Drive (a), the thesis/VSIM causality: pump torque and turbine speed given (time series);
     pump speed and turbine torque come out. The turbine speed's derivative is smoothed over
-    ``derivative_window_s`` (local least-squares slope)."""
+    ``derivative_window_s`` (local least-squares slope). A locked lock-up clutch makes the pump
+    follow the turbine speed."""
 
     time_s: ArrayLike
     pump_torque_nm: ArrayLike
     turbine_speed_rad_s: ArrayLike
     derivative_window_s: float = DERIVATIVE_WINDOW_S
+    lockup_capacity_nm: ArrayLike | None = None
+    lockup_static_to_kinetic: float | None = None
 
     def spec(self) -> dict[str, Any]:
         return {
@@ -41,17 +59,21 @@ class PumpTorqueTurbineSpeed:
             "pump_torque_nm": _arr(self.pump_torque_nm),
             "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
             "derivative_window_s": self.derivative_window_s,
+            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic),
         }
 
 
 @dataclass(frozen=True)
 class Speeds:
-    """Drive (b): pump and turbine speeds given; the torques come out."""
+    """Drive (b): pump and turbine speeds given; the torques come out. A lock-up clutch can only
+    slip (both speeds are given)."""
 
     time_s: ArrayLike
     pump_speed_rad_s: ArrayLike
     turbine_speed_rad_s: ArrayLike
     derivative_window_s: float = DERIVATIVE_WINDOW_S
+    lockup_capacity_nm: ArrayLike | None = None
+    lockup_static_to_kinetic: float | None = None
 
     def spec(self) -> dict[str, Any]:
         return {
@@ -60,19 +82,23 @@ class Speeds:
             "pump_speed_rad_s": _arr(self.pump_speed_rad_s),
             "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
             "derivative_window_s": self.derivative_window_s,
+            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic),
         }
 
 
 @dataclass(frozen=True)
 class PumpTorqueLoad:
     """Drive (c): pump torque given; the turbine drives a load inertia against
-    ``load_torque_nm + load_drag_nm_s2·ω_t|ω_t|``. Both speeds come out."""
+    ``load_torque_nm + load_drag_nm_s2·ω_t|ω_t|``. Both speeds come out. A locked lock-up clutch
+    makes pump and turbine turn as one."""
 
     time_s: ArrayLike
     pump_torque_nm: ArrayLike
     load_inertia_kg_m2: float
     load_torque_nm: ArrayLike = 0.0
     load_drag_nm_s2: float = 0.0
+    lockup_capacity_nm: ArrayLike | None = None
+    lockup_static_to_kinetic: float | None = None
 
     def spec(self) -> dict[str, Any]:
         return {
@@ -82,6 +108,7 @@ class PumpTorqueLoad:
             "load_torque_nm": _arr(self.load_torque_nm),
             "load_inertia_kg_m2": float(self.load_inertia_kg_m2),
             "load_drag_nm_s2": float(self.load_drag_nm_s2),
+            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic),
         }
 
 

@@ -13,6 +13,7 @@
 //! See [`crate::engine::isolated`] for the physics of the events (the Filippov treatment of sgn Q).
 
 use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::engine::lockup::ClutchMode;
 use crate::engine::options::Hysteresis;
 
 /// Discrete state of the piecewise-smooth converter.
@@ -22,6 +23,27 @@ pub struct Mode {
     /// Sign of Q in the losses: +1, −1, or 0 while the flow is held at zero. The output column
     /// `flow_direction` ([`crate::engine::outputs::COLUMNS`]) and the events' flow field carry it.
     pub flow_sign: f64,
+    /// The lock-up clutch ([`crate::engine::lockup`]); the isolated engine's (the vehicle keeps its
+    /// own schedule state and leaves this at its default).
+    pub lockup: ClutchMode,
+}
+
+/// The lock-up clutch at one instant (all zero, and not `present`, without a clutch command).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LockupSample {
+    /// The drive commands a clutch (the output columns are NaN without one).
+    pub present: bool,
+    /// Torque the clutch transmits from pump to turbine, N·m (locked: the constraint torque).
+    pub torque_nm: f64,
+    /// 0 open, 1 slipping, 2 locked ([`crate::engine::lockup::state_code`]).
+    pub state: f64,
+    /// Power the slipping clutch dissipates, `T_lu·(ω_p − ω_t)`, W.
+    pub loss_power_w: f64,
+    /// Energy the clutch dissipated at the lock events so far, J (cumulative, ≥ 0).
+    pub lock_loss_j: f64,
+    /// Work of the impulses at the converter's shafts at the lock events so far, J (cumulative):
+    /// at the given turbine speed in drive (a), from the load inertia in drive (c).
+    pub lock_work_j: f64,
 }
 
 /// One sampled instant of the converter.
@@ -36,6 +58,7 @@ pub struct Sample {
     pub mode: Mode,
     pub loss_power_w: f64,
     pub stored_energy_j: f64,
+    pub lockup: LockupSample,
 }
 
 /// What a converter event did.
@@ -45,16 +68,24 @@ pub enum EventKind {
     StatorLock,
     FlowZero,
     FlowStart,
+    LockupLock,
+    LockupSlip,
+    LockupArm,
 }
 
 impl EventKind {
-    /// The event's name in outputs (`stator-release`, `stator-lock`, `flow-zero`, `flow-start`).
+    /// The event's name in outputs (`stator-release`, `stator-lock`, `flow-zero`, `flow-start`, and
+    /// the lock-up clutch's `lockup-lock`, `lockup-slip`, `lockup-slipping`, named like the
+    /// vehicle's).
     pub fn name(self) -> &'static str {
         match self {
             EventKind::StatorRelease => "stator-release",
             EventKind::StatorLock => "stator-lock",
             EventKind::FlowZero => "flow-zero",
             EventKind::FlowStart => "flow-start",
+            EventKind::LockupLock => "lockup-lock",
+            EventKind::LockupSlip => "lockup-slip",
+            EventKind::LockupArm => "lockup-slipping",
         }
     }
 }
@@ -204,5 +235,6 @@ pub fn sample(model: &dyn ConverterDynamics, mode: Mode, t: f64, u: Vec4, u_dot:
         torque[2] = transferred.1 - transferred.0;
     }
     let loss = if flow_held(model, mode) { 0.0 } else { model.loss_power_w(&u, &f) };
-    Sample { time_s: t, u, u_dot, torque, transferred, mode, loss_power_w: loss, stored_energy_j: stored }
+    let lockup = LockupSample::default();
+    Sample { time_s: t, u, u_dot, torque, transferred, mode, loss_power_w: loss, stored_energy_j: stored, lockup }
 }

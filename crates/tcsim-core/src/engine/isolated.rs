@@ -38,73 +38,14 @@
 //! exactly (the held flow does no work). This is the state the closed-form steady state calls
 //! `no-flow`.
 
-use crate::converter::dynamics::{ConverterDynamics, Mat4, SteadyPoint, Vec4, FLOW, PUMP, STATOR, TURBINE};
-use crate::engine::converter_events::{self, ConverterRoot};
+use crate::converter::dynamics::{ConverterDynamics, SteadyPoint, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::{EventKind, Mode, Sample};
-use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
-use crate::engine::segment::SmoothSegment;
-use crate::engine::signal::Signal;
+use crate::engine::converter_segment::{flow_sign_at_zero, lock_energies, switch, Root, Segment};
+use crate::engine::lockup;
+use crate::engine::options::{SolverOptions, TransientError, TransientResult};
 use crate::error::{sig, CoreError, CoreResult, InputSource};
 
-/// How the converter is driven (issue: drives a, b, c).
-#[derive(Debug, Clone)]
-pub enum Drive {
-    /// (a) Pump torque and turbine speed given (the thesis/VSIM causality): pump speed and
-    /// turbine torque come out.
-    PumpTorqueTurbineSpeed { pump_torque_nm: Signal, turbine_speed_rad_s: Signal },
-    /// (b) Both speeds given: the torques come out.
-    Speeds { pump_speed_rad_s: Signal, turbine_speed_rad_s: Signal },
-    /// (c) Pump torque given, the turbine loaded by an inertia and a torque: both speeds come out.
-    PumpTorqueLoad { pump_torque_nm: Signal, load: TurbineLoad },
-}
-
-/// The load on the turbine in drive (c): `T_load = torque(t) + drag·ω_t|ω_t|`, opposing rotation,
-/// with an extra inertia (the driveline reflected to the turbine).
-#[derive(Debug, Clone)]
-pub struct TurbineLoad {
-    pub torque_nm: Signal,
-    pub inertia_kg_m2: f64,
-    pub drag_nm_s2: f64,
-}
-
-impl Drive {
-    pub(super) fn given(&self, coordinate: usize) -> Option<&Signal> {
-        match (self, coordinate) {
-            (Drive::PumpTorqueTurbineSpeed { turbine_speed_rad_s, .. }, TURBINE) => Some(turbine_speed_rad_s),
-            (Drive::Speeds { turbine_speed_rad_s, .. }, TURBINE) => Some(turbine_speed_rad_s),
-            (Drive::Speeds { pump_speed_rad_s, .. }, PUMP) => Some(pump_speed_rad_s),
-            _ => None,
-        }
-    }
-
-    fn pump_torque(&self) -> Option<&Signal> {
-        match self {
-            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, .. } | Drive::PumpTorqueLoad { pump_torque_nm, .. } => {
-                Some(pump_torque_nm)
-            }
-            Drive::Speeds { .. } => None,
-        }
-    }
-
-    fn load(&self) -> Option<&TurbineLoad> {
-        match self {
-            Drive::PumpTorqueLoad { load, .. } => Some(load),
-            _ => None,
-        }
-    }
-
-    /// Earliest time at which every signal has a sample.
-    pub fn start_time(&self) -> f64 {
-        let signals: Vec<&Signal> = match self {
-            Drive::PumpTorqueTurbineSpeed { pump_torque_nm, turbine_speed_rad_s } => {
-                vec![pump_torque_nm, turbine_speed_rad_s]
-            }
-            Drive::Speeds { pump_speed_rad_s, turbine_speed_rad_s } => vec![pump_speed_rad_s, turbine_speed_rad_s],
-            Drive::PumpTorqueLoad { pump_torque_nm, load } => vec![pump_torque_nm, &load.torque_nm],
-        };
-        signals.iter().map(|s| s.times()[0]).fold(f64::NEG_INFINITY, f64::max)
-    }
-}
+pub use crate::engine::drive::{Drive, TurbineLoad};
 
 /// Optional initial values; what is not given comes from the steady state consistent with the
 /// first input sample ([`initial_state`]).
@@ -124,7 +65,9 @@ pub struct Event {
     pub mode: Mode,
 }
 
-/// The result of a run: samples at the requested times, the events, and solver statistics.
+/// The result of a run: samples at the requested times, the events, and solver statistics. The
+/// samples carry the clutch's columns ([`crate::engine::converter_events::LockupSample`]), the
+/// energy the lock events took out of the stored energy among them.
 #[derive(Debug, Clone, Default)]
 pub struct Trajectory {
     pub samples: Vec<Sample>,
@@ -137,231 +80,9 @@ pub struct Trajectory {
 
 // ---------------------------------------------------------------------------------------------
 
-#[derive(Debug, Clone, Copy, PartialEq)]
-enum Role {
-    Free,
-    Given,
-    Held,
-    Absent,
-}
-
-/// One smooth piece of a run: a mode, the roles of the coordinates and the reduced mass matrix.
-pub(super) struct Segment<'a> {
-    model: &'a dyn ConverterDynamics,
-    drive: &'a Drive,
-    /// The model's mass matrix.
-    mass: Mat4,
-    /// The mass matrix of the dynamics (with the load inertia on the turbine in drive c).
-    dyn_mass: Mat4,
-    mode: Mode,
-    role: [Role; 4],
-    free: Vec<usize>,
-    /// Inverse of `M_xx`.
-    inv: Mat4,
-    pub(super) roots: Vec<ConverterRoot>,
-}
-
-impl<'a> Segment<'a> {
-    pub(super) fn new(model: &'a dyn ConverterDynamics, drive: &'a Drive, mode: Mode) -> Self {
-        let present = model.coordinates();
-        let role: [Role; 4] = std::array::from_fn(|c| {
-            if !present[c] {
-                Role::Absent
-            } else if drive.given(c).is_some() {
-                Role::Given
-            } else if (c == STATOR && mode.stator_locked) || (c == FLOW && converter_events::flow_held(model, mode)) {
-                Role::Held
-            } else {
-                Role::Free
-            }
-        });
-        let free: Vec<usize> = (0..4).filter(|&c| role[c] == Role::Free).collect();
-        let mass = model.mass();
-        let mut dyn_mass = mass;
-        if let Some(load) = drive.load() {
-            dyn_mass[TURBINE][TURBINE] += load.inertia_kg_m2;
-        }
-        let n = free.len();
-        let mut sub = [[0.0; 4]; 4];
-        for (i, &r) in free.iter().enumerate() {
-            for (j, &c) in free.iter().enumerate() {
-                sub[i][j] = dyn_mass[r][c];
-            }
-        }
-        let inv = invert(n, &sub).expect("the reduced mass matrix of a positive-definite M is invertible");
-        let roots = converter_events::roots(model, mode);
-        Self { model, drive, mass, dyn_mass, mode, role, free, inv, roots }
-    }
-
-    /// Number of ODE states (one dummy state when every coordinate is given or held).
-    fn n_states(&self) -> usize {
-        self.free.len().max(1)
-    }
-
-    pub(super) fn full(&self, x: &[f64], t: f64) -> Vec4 {
-        let mut u = [0.0; 4];
-        for (i, &c) in self.free.iter().enumerate() {
-            u[c] = x[i];
-        }
-        for (c, value) in u.iter_mut().enumerate() {
-            if self.role[c] == Role::Given {
-                *value = self.drive.given(c).map_or(0.0, |s| s.value(t));
-            }
-        }
-        u
-    }
-
-    pub(super) fn state(&self, u: &Vec4) -> Vec<f64> {
-        if self.free.is_empty() {
-            vec![0.0]
-        } else {
-            self.free.iter().map(|&c| u[c]).collect()
-        }
-    }
-
-    fn given_rates(&self, t: f64) -> Vec4 {
-        std::array::from_fn(|c| {
-            if self.role[c] == Role::Given {
-                self.drive.given(c).map_or(0.0, |s| s.rate(t))
-            } else {
-                0.0
-            }
-        })
-    }
-
-    /// External torques acting on the free coordinates, and their derivative with respect to ω_t.
-    fn external(&self, u: &Vec4, t: f64) -> (Vec4, f64) {
-        let mut e = [0.0; 4];
-        let mut de_dwt = 0.0;
-        if self.role[PUMP] == Role::Free {
-            e[PUMP] = self.drive.pump_torque().map_or(0.0, |s| s.value(t));
-        }
-        if let (Some(load), Role::Free) = (self.drive.load(), self.role[TURBINE]) {
-            let w = u[TURBINE];
-            e[TURBINE] = -(load.torque_nm.value(t) + load.drag_nm_s2 * w * w.abs());
-            de_dwt = -2.0 * load.drag_nm_s2 * w.abs();
-        }
-        (e, de_dwt)
-    }
-
-    /// Right-hand side of the reduced system, `F_x + T_x − M_xz ż`, given `u` and `f = F(u)`.
-    fn reduced_rhs(&self, u: &Vec4, f: &Vec4, t: f64, out: &mut [f64]) {
-        let (e, _) = self.external(u, t);
-        let zd = self.given_rates(t);
-        for (i, &r) in self.free.iter().enumerate() {
-            let coupling: f64 = (0..4).map(|c| self.dyn_mass[r][c] * zd[c]).sum();
-            out[i] = f[r] + e[r] - coupling;
-        }
-    }
-
-    fn rhs(&self, x: &[f64], t: f64, out: &mut [f64]) {
-        if self.free.is_empty() {
-            out[0] = 0.0;
-            return;
-        }
-        let u = self.full(x, t);
-        let f = self.model.forces(&u, self.mode.flow_sign);
-        self.reduced_rhs(&u, &f, t, out);
-    }
-
-    fn jacobian_times(&self, x: &[f64], t: f64, v: &[f64], out: &mut [f64]) {
-        if self.free.is_empty() {
-            out[0] = 0.0;
-            return;
-        }
-        let u = self.full(x, t);
-        let j = self.model.force_jacobian(&u, self.mode.flow_sign);
-        let (_, de_dwt) = self.external(&u, t);
-        for (i, &r) in self.free.iter().enumerate() {
-            out[i] = self
-                .free
-                .iter()
-                .enumerate()
-                .map(|(k, &c)| (j[r][c] + if r == TURBINE && c == TURBINE { de_dwt } else { 0.0 }) * v[k])
-                .sum();
-        }
-    }
-
-    fn mass_times(&self, v: &[f64], beta: f64, y: &mut [f64]) {
-        if self.free.is_empty() {
-            y[0] = v[0] + beta * y[0];
-            return;
-        }
-        for (i, &r) in self.free.iter().enumerate() {
-            let mv: f64 = self.free.iter().enumerate().map(|(k, &c)| self.dyn_mass[r][c] * v[k]).sum();
-            y[i] = mv + beta * y[i];
-        }
-    }
-
-    /// All coordinates, their rates and the forces at (x, t).
-    pub(super) fn kinematics(&self, x: &[f64], t: f64) -> (Vec4, Vec4, Vec4) {
-        let u = self.full(x, t);
-        let f = self.model.forces(&u, self.mode.flow_sign);
-        let mut ud = self.given_rates(t);
-        let n = self.free.len();
-        if n > 0 {
-            let mut r = [0.0; 4];
-            self.reduced_rhs(&u, &f, t, &mut r[..n]);
-            for (i, &c) in self.free.iter().enumerate() {
-                ud[c] = (0..n).map(|k| self.inv[i][k] * r[k]).sum();
-            }
-        }
-        (u, ud, f)
-    }
-
-    /// `M u̇ − F` with the converter's own mass: the external torque on every coordinate.
-    fn external_torques(&self, ud: &Vec4, f: &Vec4) -> Vec4 {
-        converter_events::external_torques(&self.mass, ud, f)
-    }
-
-    /// The net force on a held flow starting forwards and backwards, `d± = F_Q(0±) − (M u̇)_Q`.
-    fn held_flow_balance(&self, u: &Vec4, ud: &Vec4) -> (f64, f64) {
-        converter_events::held_flow_balance(self.model, u, &self.mass[FLOW], ud)
-    }
-
-    /// Root functions, each positive while the mode holds (with the hysteresis `h`).
-    pub(super) fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
-        let (u, ud, f) = self.kinematics(x, t);
-        for (k, root) in self.roots.iter().enumerate() {
-            out[k] = converter_events::root_value(
-                *root,
-                self.mode,
-                &u,
-                h,
-                || self.external_torques(&ud, &f)[STATOR],
-                || self.held_flow_balance(&u, &ud),
-            );
-        }
-    }
-
-    pub(super) fn sample(&self, x: &[f64], t: f64) -> Sample {
-        let (u, ud, f) = self.kinematics(x, t);
-        converter_events::sample(self.model, self.mode, t, u, ud, f)
-    }
-
-    fn atol(&self, o: &SolverOptions) -> Vec<f64> {
-        if self.free.is_empty() {
-            return vec![1.0];
-        }
-        self.free.iter().map(|&c| if c == FLOW { o.flow_atol_m3_s } else { o.speed_atol_rad_s }).collect()
-    }
-}
-
-/// Inverse of the leading n×n block.
-fn invert(n: usize, a: &Mat4) -> Option<Mat4> {
-    let block: Vec<Vec<f64>> = a.iter().take(n).map(|row| row[..n].to_vec()).collect();
-    let inv = crate::linalg::invert(&block)?;
-    let mut out = [[0.0; 4]; 4];
-    for (r, row) in inv.iter().enumerate() {
-        out[r][..n].copy_from_slice(row);
-    }
-    Some(out)
-}
-
-// ---------------------------------------------------------------------------------------------
-
 /// The mode a state starts in: the stator locked if it stands and the clutch would hold; the flow
-/// sign from Q, or from the held-flow balance when Q = 0.
+/// sign from Q, or from the held-flow balance when Q = 0; the lock-up clutch not locked, armed
+/// unless its slip is below the sync threshold ([`lockup::initial_mode`]).
 pub fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64) -> Mode {
     let mut mode = Mode {
         stator_locked: false,
@@ -372,9 +93,11 @@ pub fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f
         } else {
             0.0
         },
+        lockup: lockup::initial_mode(u[PUMP] - u[TURBINE], t),
     };
     if model.has_flow_sign() && u[FLOW] == 0.0 {
-        mode.flow_sign = flow_sign_at_zero(model, drive, u, t, mode.stator_locked || u[STATOR] <= 0.0);
+        let stator_locked = mode.stator_locked || u[STATOR] <= 0.0;
+        mode.flow_sign = flow_sign_at_zero(model, drive, u, t, Mode { stator_locked, ..mode });
     }
     if model.has_stator_clutch() && u[STATOR] <= 0.0 {
         let locked = Mode { stator_locked: true, ..mode };
@@ -383,15 +106,6 @@ pub fn initial_mode(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f
         mode.stator_locked = seg.external_torques(&ud, &f)[STATOR] >= 0.0;
     }
     mode
-}
-
-/// Sign of the flow that starts from Q = 0 ([`converter_events::flow_sign_from_balance`]).
-fn flow_sign_at_zero(model: &dyn ConverterDynamics, drive: &Drive, u: &Vec4, t: f64, stator_locked: bool) -> f64 {
-    let seg = Segment::new(model, drive, Mode { stator_locked, flow_sign: 0.0 });
-    let mut u0 = *u;
-    u0[FLOW] = 0.0;
-    let (uu, ud, _) = seg.kinematics(&seg.state(&u0), t);
-    converter_events::flow_sign_from_balance(seg.held_flow_balance(&uu, &ud))
 }
 
 /// The steady state consistent with the inputs at time `t0` (documented default of
@@ -726,8 +440,10 @@ pub fn simulate_from(
     let mut traj = Trajectory::default();
     crate::engine::options::try_reserve(&mut traj.samples, times_s.len())?;
     let (mut t, mut u, mut mode) = (times_s[0], u0, mode0);
+    let mut lock_energy_j = (0.0, 0.0);
     loop {
-        let seg = Segment::new(model, drive, mode);
+        let mut seg = Segment::new(model, drive, mode);
+        seg.lock_energy_j = lock_energy_j;
         let integrated = t < t_end;
         match run_segment(&seg, &u, t, t_end, times_s, options, &mut traj)? {
             None => {
@@ -752,7 +468,13 @@ pub fn simulate_from(
             }
             Some((t_root, root, x_root)) => {
                 let mut next = seg.full(&x_root, t_root);
+                let before = next;
                 let (kind, new_mode) = switch(&seg, root, &mut next, t_root);
+                if kind == EventKind::LockupLock {
+                    // the projection removes the energy of the closing slip: the clutch's loss
+                    let (loss, work) = lock_energies(&seg, &before, &next);
+                    lock_energy_j = (lock_energy_j.0 + loss, lock_energy_j.1 + work);
+                }
                 traj.events.push(Event { time_s: t_root, kind, mode: new_mode });
                 if traj.events.len() > options.max_events {
                     return Err(TransientError::Solver {
@@ -769,48 +491,6 @@ pub fn simulate_from(
     }
 }
 
-/// The mode after `root` fired, with the state adjusted (a locking stator stops, a reversing flow
-/// passes zero).
-pub(super) fn switch(seg: &Segment, root: ConverterRoot, u: &mut Vec4, t: f64) -> (EventKind, Mode) {
-    let mut mode = seg.mode;
-    let stator_locked = seg.mode.stator_locked;
-    let kind =
-        converter_events::switch(root, &mut mode, u, |u| flow_sign_at_zero(seg.model, seg.drive, u, t, stator_locked));
-    (kind, mode)
-}
-
-impl SmoothSegment for Segment<'_> {
-    type Root = ConverterRoot;
-    type Sample = Sample;
-    fn n_states(&self) -> usize {
-        Segment::n_states(self)
-    }
-    fn atol(&self, o: &SolverOptions) -> Vec<f64> {
-        Segment::atol(self, o)
-    }
-    fn rhs(&self, x: &[f64], t: f64, out: &mut [f64]) {
-        Segment::rhs(self, x, t, out)
-    }
-    fn jacobian_times(&self, x: &[f64], t: f64, v: &[f64], out: &mut [f64]) {
-        Segment::jacobian_times(self, x, t, v, out)
-    }
-    fn mass_times(&self, v: &[f64], beta: f64, y: &mut [f64]) {
-        Segment::mass_times(self, v, beta, y)
-    }
-    fn roots(&self) -> &[ConverterRoot] {
-        &self.roots
-    }
-    fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
-        Segment::root_values(self, x, t, h, out)
-    }
-    fn sample(&self, x: &[f64], t: f64) -> Sample {
-        Segment::sample(self, x, t)
-    }
-    fn coordinates(&self, x: &[f64], t: f64) -> Vec<f64> {
-        self.full(x, t).to_vec()
-    }
-}
-
 /// Integrate one segment (see [`crate::engine::segment::run_segment`]).
 fn run_segment(
     seg: &Segment,
@@ -820,6 +500,6 @@ fn run_segment(
     times_s: &[f64],
     o: &SolverOptions,
     traj: &mut Trajectory,
-) -> TransientResult<Option<(f64, ConverterRoot, Vec<f64>)>> {
+) -> TransientResult<Option<(f64, Root, Vec<f64>)>> {
     crate::engine::segment::run_segment(seg, seg.state(u0), t0, t_end, times_s, o, &mut traj.samples, &mut traj.steps)
 }

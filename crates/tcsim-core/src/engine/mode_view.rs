@@ -3,11 +3,13 @@
 
 use crate::converter::dynamics::{ConverterDynamics, Vec4};
 use crate::engine::converter_events::{ConverterRoot, EventKind, Mode, Sample};
-use crate::engine::isolated::{switch, Drive, Segment};
+use crate::engine::converter_segment::{switch, Root, Segment};
+use crate::engine::isolated::Drive;
 use crate::engine::options::Hysteresis;
 
 /// Number of event indicators of a model in [`ModeView`]: the stator clutch, and two for the flow
-/// direction (for models without them, indicators that never change sign).
+/// direction (for models without them, indicators that never change sign). The host's drives have
+/// no lock-up clutch.
 pub const EVENT_INDICATORS: usize = 3;
 
 /// One mode of a model under a drive, seen from outside: the coordinates that are states in some
@@ -45,9 +47,10 @@ impl<'a> ModeView<'a> {
         self.seg.root_values(&self.seg.state(u), t, h, &mut values);
         for (root, v) in self.seg.roots.iter().zip(values) {
             let slot = match root {
-                ConverterRoot::StatorTorque | ConverterRoot::StatorSpeed => 0,
-                ConverterRoot::Flow | ConverterRoot::FlowStartsPositive => 1,
-                ConverterRoot::FlowStartsNegative => 2,
+                Root::Converter(ConverterRoot::StatorTorque | ConverterRoot::StatorSpeed) => 0,
+                Root::Converter(ConverterRoot::Flow | ConverterRoot::FlowStartsPositive) => 1,
+                Root::Converter(ConverterRoot::FlowStartsNegative) => 2,
+                Root::Lockup(_) => continue, // not in a host's drive
             };
             g[slot] = v;
         }

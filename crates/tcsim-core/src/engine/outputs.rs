@@ -10,15 +10,25 @@
 //!     effective TR = effective turbine output torque / effective pump input torque
 //! ```
 //!
-//! `T_t` is the torque delivered to the transmission (`turbine_torque_nm`).
+//! `T_t` is the torque delivered to the transmission (`turbine_torque_nm`). With the lock-up clutch
+//! ([`crate::engine::lockup`]) `T_p` and `T_t` are the torques at the converter's shafts, the
+//! clutch's torque included; the energy identity of the columns is
+//!
+//! ```text
+//!     ∫ converter_input_power_w dt + lockup_lock_work_j(end)
+//!         = Δ stored_energy_j + ∫ (fluid_loss_power_w + lockup_loss_power_w) dt + lockup_lock_loss_j(end)
+//! ```
 
 use crate::converter::dynamics::{ConverterDynamics, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::Sample;
 use crate::engine::isolated::Trajectory;
 use crate::engine::options::{try_reserve, OutputSize, SolverOptions, TransientResult};
 
+/// Index in [`COLUMNS`] of the first lock-up clutch column (the clutch's columns come last).
+pub const LOCKUP_COLUMNS_START: usize = 27;
+
 /// Column names, in order.
-pub const COLUMNS: [&str; 27] = [
+pub const COLUMNS: [&str; 33] = [
     "time_s",
     "pump_speed_rad_s",
     "turbine_speed_rad_s",
@@ -46,6 +56,12 @@ pub const COLUMNS: [&str; 27] = [
     "fluid_loss_power_w",
     "stored_energy_j",
     "converter_input_power_w",
+    "lockup_torque_nm",
+    "lockup_state",
+    "lockup_slip_rad_s",
+    "lockup_loss_power_w",
+    "lockup_lock_loss_j",
+    "lockup_lock_work_j",
 ];
 
 fn ratio(a: f64, b: f64) -> f64 {
@@ -58,11 +74,13 @@ fn ratio(a: f64, b: f64) -> f64 {
 
 /// One sample as a row in the order of [`COLUMNS`]. Coordinates the model lacks are NaN, and so
 /// are the stator mode (0 locked, 1 free-wheeling) and the flow direction (+1, −1, 0 held) of
-/// models without them.
-pub fn row(model: &dyn ConverterDynamics, s: &Sample) -> [f64; 27] {
+/// models without them. The lock-up columns are NaN without a clutch command (so a run without one
+/// has the columns of a converter without a clutch).
+pub fn row(model: &dyn ConverterDynamics, s: &Sample) -> [f64; 33] {
     let present = model.coordinates();
     let m = model.mass();
     let coord = |c: usize, v: f64| if present[c] { v } else { f64::NAN };
+    let lockup = |v: f64| if s.lockup.present { v } else { f64::NAN };
     let (u, ud) = (s.u, s.u_dot);
     let pump = s.torque[0];
     let turbine = -s.torque[1];
@@ -109,6 +127,12 @@ pub fn row(model: &dyn ConverterDynamics, s: &Sample) -> [f64; 27] {
         s.loss_power_w,
         s.stored_energy_j,
         input,
+        lockup(s.lockup.torque_nm),
+        lockup(s.lockup.state),
+        lockup(u[PUMP] - u[TURBINE]),
+        lockup(s.lockup.loss_power_w),
+        lockup(s.lockup.lock_loss_j),
+        lockup(s.lockup.lock_work_j),
     ]
 }
 

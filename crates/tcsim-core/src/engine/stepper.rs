@@ -43,7 +43,7 @@ impl<M: ConverterDynamics> Stepper<M> {
             time_s: 0.0,
             inputs: [0.0; 2],
             u: [0.0; 4],
-            mode: Mode { stator_locked: false, flow_sign: 1.0 },
+            mode: Mode { stator_locked: false, flow_sign: 1.0, ..Mode::default() },
             last: None,
         }
     }
@@ -54,10 +54,12 @@ impl<M: ConverterDynamics> Stepper<M> {
             Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
                 pump_torque_nm: sig("pump_torque_nm", 0)?,
                 turbine_speed_rad_s: sig("turbine_speed_rad_s", 1)?,
+                lockup: None,
             },
             Causality::Speeds => Drive::Speeds {
                 pump_speed_rad_s: sig("pump_speed_rad_s", 0)?,
                 turbine_speed_rad_s: sig("turbine_speed_rad_s", 1)?,
+                lockup: None,
             },
         })
     }

@@ -9,8 +9,9 @@ use crate::interp::{blend_held, linear_held};
 
 /// Speed below which the tyre slip is regularised, m/s.
 pub const SLIP_SPEED_M_S: f64 = 0.5;
-/// Slip scale of the regularised clutch friction (tanh), rad/s.
-pub const CLUTCH_SLIP_RAD_S: f64 = 0.2;
+/// Slip scale of the regularised clutch friction (tanh), rad/s: the lock-up component's, shared by
+/// the shift clutches.
+pub use crate::engine::lockup::CLUTCH_SLIP_RAD_S;
 /// Scale of the regularised brake sign, rad/s.
 pub const BRAKE_SPEED_RAD_S: f64 = 0.002;
 /// Scale of the regularised rolling-resistance sign, m/s.

@@ -234,7 +234,11 @@ fn output_times(v: &Vehicle, sc: &Scenario, output_step_s: f64, options: &Solver
 /// flow sign ignores the sign; it is +1 for all models.
 fn initial_mode(model: &dyn ConverterDynamics, sc: &Scenario) -> VehicleMode {
     VehicleMode {
-        converter: ConverterMode { stator_locked: model.has_stator_clutch(), flow_sign: 1.0 },
+        converter: ConverterMode {
+            stator_locked: model.has_stator_clutch(),
+            flow_sign: 1.0,
+            ..ConverterMode::default()
+        },
         gear: 0,
         shift: None,
         lockup: LockupState::Open,

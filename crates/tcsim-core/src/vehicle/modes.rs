@@ -66,11 +66,9 @@ pub struct VehicleEvent {
     pub gear: usize,
 }
 
-/// Slip below which a synchronising clutch locks, rad/s: with the regularised friction a clutch
-/// carrying 96 % of its capacity slips by 2·CLUTCH_SLIP_RAD_S, so a smaller slip means it holds.
-pub(super) const SYNC_SLIP_RAD_S: f64 = 0.5;
-/// After a breakaway the lock-up clutch slips at least this long before it may lock again, s.
-pub(super) const REARM_DELAY_S: f64 = 0.1;
+/// The sync threshold and the re-arm delay of the lock-up clutch component (the sync threshold
+/// also closes the gearbox's shift clutches).
+pub(super) use crate::engine::lockup::{REARM_DELAY_S, SYNC_SLIP_RAD_S};
 /// The lock-up clutch opens below this fraction of its engage speed (hysteresis), and on a
 /// downshift.
 pub(super) const LOCKUP_RELEASE_FRACTION: f64 = 0.7;

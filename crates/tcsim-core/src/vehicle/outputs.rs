@@ -6,6 +6,7 @@ use super::parameters::Scenario;
 use super::{FRONT, GEARBOX_OUT, REAR, SPEED};
 use crate::converter::dynamics::ConverterDynamics;
 use crate::engine::options::{try_reserve, TransientResult};
+use crate::engine::outputs::LOCKUP_COLUMNS_START;
 
 /// Columns of a launch after the converter's [`crate::engine::outputs::COLUMNS`] (whose `pump_*` refer to
 /// the converter pump, which turns with the engine).
@@ -30,10 +31,11 @@ pub const LAUNCH_COLUMNS: [&str; 18] = [
     "vehicle_stored_energy_j",
 ];
 
-/// All columns of a launch: the converter's, then [`LAUNCH_COLUMNS`], then
+/// All columns of a launch: the converter's (without the isolated converter's lock-up columns, the
+/// vehicle has its own `lockup_state`), then [`LAUNCH_COLUMNS`], then
 /// `event_energy_loss_j` (cumulative energy booked at switching events).
 pub fn launch_column_names() -> Vec<&'static str> {
-    crate::engine::outputs::COLUMNS
+    crate::engine::outputs::COLUMNS[..LOCKUP_COLUMNS_START]
         .iter()
         .chain(LAUNCH_COLUMNS.iter())
         .chain(std::iter::once(&"event_energy_loss_j"))
@@ -89,6 +91,7 @@ pub fn launch_columns(
             s.loss_power_w,
             s.stored_energy_j,
         ];
+        let conv = &conv[..LOCKUP_COLUMNS_START];
         for (c, v) in cols.iter_mut().zip(conv.iter().chain(extra.iter()).chain(std::iter::once(&booked))) {
             c.push(*v);
         }

@@ -9,6 +9,7 @@ use super::parameters::{Scenario, Vehicle};
 use super::{FRONT, GEARBOX_OUT, N_COORDS, REAR, SPEED, TORQUE_BOOST, TORQUE_FAST, TWIST_F, TWIST_R};
 use crate::converter::dynamics::{ConverterDynamics, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::{self, Sample as ConverterSample};
+use crate::engine::lockup;
 use crate::engine::options::{Hysteresis, SolverOptions};
 use crate::engine::segment::SmoothSegment;
 use crate::linalg::invert;
@@ -238,13 +239,14 @@ impl<'a> Plant<'a> {
         (fc, net, engine_power)
     }
 
-    /// The lock-up clutch while it slips: returns its torque.
+    /// The lock-up clutch while it slips ([`lockup`], the scheduled capacity as its command):
+    /// returns its torque.
     fn lockup_forces(&self, u: &Coords, t: f64, f: &mut Coords, loss: &mut f64) -> f64 {
         let slip = u[PUMP] - u[TURBINE];
-        let t_lu = self.lockup_capacity(t) * (slip / CLUTCH_SLIP_RAD_S).tanh();
+        let t_lu = lockup::slipping_torque_nm(self.lockup_capacity(t), slip);
         f[PUMP] -= t_lu;
         f[TURBINE] += t_lu;
-        *loss += t_lu * slip;
+        *loss += lockup::dissipation_w(t_lu, slip);
         t_lu
     }
 
@@ -398,7 +400,7 @@ impl<'a> Plant<'a> {
             Root::LockupSlip => {
                 // torque through the locked clutch: the engine side's constraint torque
                 let r = self.reactions(ud, f);
-                self.v.lockup.static_to_kinetic * self.v.lockup.capacity_nm - r[PUMP].abs()
+                lockup::breakaway_root(self.v.lockup.capacity_nm, self.v.lockup.static_to_kinetic, r[PUMP])
             }
             Root::LockupRelease => u[SPEED] - LOCKUP_RELEASE_FRACTION * self.v.lockup.engage_speed(p),
             Root::Stop => self.sc.stop_speed_m_s.unwrap_or(f64::INFINITY) - u[SPEED],

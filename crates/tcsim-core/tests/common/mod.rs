@@ -70,6 +70,7 @@ pub fn takeoff(tip_out: bool) -> Drive {
     Drive::PumpTorqueLoad {
         pump_torque_nm: takeoff_torque(tip_out),
         load: TurbineLoad { torque_nm: Signal::constant(10.0), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 },
+        lockup: None,
     }
 }
 
