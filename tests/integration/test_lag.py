@@ -190,3 +190,27 @@ def test_the_fmu_carries_the_lag(fmu_library, tmp_path, monkeypatch):
     frac = (res["pump_torque_nm"] - old) / (new - old)
     at_tc = np.interp(T_STEP + RAMP / 2 + T_C, res["time"], frac)
     assert abs(at_tc - (1.0 - math.exp(-1.0))) < 0.01, at_tc
+
+
+@pytest.mark.fmu
+def test_the_fmu_refuses_model_exchange_with_the_lag(fmu_library, tmp_path, monkeypatch):
+    """Model Exchange declares the table model's states without the lag's: the instance refuses to
+    initialise with a message naming Co-Simulation, instead of integrating a state the host does not
+    know."""
+    fmpy = pytest.importorskip("fmpy")
+    from tcsim.io import fmu as tfmu  # noqa: PLC0415  after the importorskip of fmpy above
+
+    monkeypatch.setenv(tfmu.LIBRARY_ENV, str(fmu_library))
+    path = tfmu.export_fmu(lagged(), "table", tmp_path / "lag.fmu", causality="speeds")
+    inp = np.array(
+        [(0.0, 200.0, 60.0), (0.2, 200.0, 60.0)],
+        dtype=[("time", float), ("pump_speed_rad_s", float), ("turbine_speed_rad_s", float)],
+    )
+    messages: list[str] = []
+
+    def log(*args):
+        messages.append(" ".join(a.decode() if isinstance(a, bytes) else str(a) for a in args))
+
+    with pytest.raises(Exception, match="fmi2"):
+        fmpy.simulate_fmu(str(path), fmi_type="ModelExchange", input=inp, stop_time=0.2, logger=log)
+    assert any("use Co-Simulation" in m for m in messages), messages
