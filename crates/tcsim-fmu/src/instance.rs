@@ -421,6 +421,12 @@ impl Instance {
 
     fn me_initialize(&mut self) -> Result<(), String> {
         let model = self.model().map_err(|e| e.to_string())?;
+        if model.lag_state() {
+            // the modelDescription declares the table model's states without the lag's
+            return Err("Model Exchange of the table model with lag_time_constant_s is not supported (its lag state \
+                        is not among the FMU's declared states): use Co-Simulation (docs/lag.md)"
+                .to_string());
+        }
         let t = self.start_time;
         let drive = self.me_drive(t)?;
         let u = initial_state(&model, &drive, t, &self.initial()).map_err(|e| e.to_string())?;

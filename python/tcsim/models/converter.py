@@ -47,6 +47,8 @@ class CharacteristicSection(_Section):
     overrun: str | None = None
     #: The quantity interpolated in SR between rows (checked by the core; docs/models.md).
     interpolation: str | None = None
+    #: First-order lag of the table model's pump torque, s (docs/lag.md); absent: no lag.
+    lag_time_constant_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)
 
     @model_validator(mode="after")
     def _one_capacity(self):
@@ -161,6 +163,8 @@ class Converter:
     quasi_dynamic: QuasiDynamicSection | None = None
     description: str | None = None
     sources: dict[str, str] = field(default_factory=dict)
+    #: ``[characteristic] lag_time_constant_s``: the table model's first-order lag, s (docs/lag.md).
+    lag_time_constant_s: float | None = None
 
     @property
     def models(self) -> tuple[str, ...]:
@@ -193,6 +197,8 @@ class Converter:
                 "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
                 **c.core_rules(),
             }
+            if self.lag_time_constant_s is not None:
+                out["characteristic"]["lag_time_constant_s"] = self.lag_time_constant_s
         for section in ("inertia", "geometry", "quasi_dynamic"):
             model = getattr(self, section)
             if model is not None:
@@ -294,6 +300,7 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
         doc.quasi_dynamic,
         doc.description,
         dict(doc.sources),
+        None if doc.characteristic is None else doc.characteristic.lag_time_constant_s,
     )
 
 

@@ -104,17 +104,23 @@ def default_flow_time_constant_s(conv: Converter) -> float:
 def dynamic_model(converter: Converter | str, model: str = "hrovat-tobler") -> DynamicModel:
     """The transient model ``model`` of a converter (a :class:`Converter`, bundled name or file).
 
-    * ``table``: [characteristic] and [inertia];
+    * ``table``: [characteristic] (with its optional first-order lag ``lag_time_constant_s``,
+      docs/lag.md) and [inertia];
     * ``hrovat-tobler``: [geometry] (with fluid length and shape effects) and [inertia];
     * ``quasi-dynamic``: [characteristic], [inertia] and [quasi_dynamic]; the fluid density and
       pump radius come from [quasi_dynamic] or else [geometry], and τ_Q from
-      ``flow_time_constant_s`` or else :func:`default_flow_time_constant_s`.
+      ``flow_time_constant_s`` or else :func:`default_flow_time_constant_s`; a
+      ``[characteristic] lag_time_constant_s`` is the table model's and ignored here (the fluid
+      inertia is this model's dynamics), as it is by ``hrovat-tobler``.
     """
     conv = converter if isinstance(converter, Converter) else load_converter(converter)
     conv.require(model)
     spec: dict[str, Any] = {"kind": model, "inertia_kg_m2": _inertia(conv, model)}
     if model == "table":
         spec.update(_table_spec(conv))
+        if conv.lag_time_constant_s is not None:
+            # the table model's only: the quasi-dynamic model has its own flow lag (docs/lag.md)
+            spec["lag_time_constant_s"] = conv.lag_time_constant_s
     elif model == "hrovat-tobler":
         g = conv.geometry
         assert g is not None  # conv.require(model) checked it

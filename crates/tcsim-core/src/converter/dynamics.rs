@@ -88,6 +88,12 @@ pub trait ConverterDynamics: Sync {
     fn zero_flow_head(&self, _u: &Vec4) -> (f64, f64) {
         (0.0, 0.0)
     }
+    /// Whether the fourth coordinate holds a lagged pump torque (N·m, the table model's
+    /// [`TorqueLag`]) rather than a flow: it is then a state of the ODE like a flow, but no flow in
+    /// outputs, initial values or events.
+    fn lag_state(&self) -> bool {
+        false
+    }
 }
 
 /// Inertias of the rotating elements (each including the fluid it carries).
@@ -121,11 +127,59 @@ pub use crate::error::sig;
 /// The steady-state table model with inertias (Li & Sundén 2016, eqs 2.8–2.11):
 /// `I_p ω̇_p = T_p − CF(SR) ω_p|ω_p|`, `I_t ω̇_t = TR(SR) CF(SR) ω_p|ω_p| + T_t` in drive, and
 /// the table's law in every other quadrant as [`Characteristic::torques`] defines it (passive,
-/// continuous; the overrun rule beyond the table's rows).
+/// continuous; the overrun rule beyond the table's rows). With a [`TorqueLag`] the pump torque
+/// follows the table's with a first-order lag (docs/lag.md).
 #[derive(Debug, Clone)]
 pub struct TableDynamics {
     pub characteristic: Characteristic,
     pub inertia: Inertias,
+    /// The first-order lag of the transferred torques (`[characteristic] lag_time_constant_s`);
+    /// None: the table's torques act at once, the model of eqs 2.8–2.11.
+    pub lag: Option<TorqueLag>,
+}
+
+/// The first-order transmission lag of the table model (docs/lag.md), the form of Simscape
+/// Driveline's Torque Converter ("Model transmission lag") and SimCreator's `TCTorque` state:
+///
+/// ```text
+///     t_c·Ṫ_lag = T_p,ss(ω_p, ω_t) − T_lag
+///     T_p,tr = T_lag,   T_t,tr = TR(ω_p, ω_t)·T_lag            (the candidate pair)
+/// ```
+///
+/// with `T_p,ss` and `TR` the table's pump torque and (passivity-projected) torque ratio at the
+/// current speeds ([`Characteristic::torques`]). **Passivity rule**: where the candidate pair
+/// would deliver power, `P = T_p,tr·ω_p − T_t,tr·ω_t < 0` (the lagged torque keeps its sign while
+/// the steady one has turned: a reversing pump, an overrun reached faster than t_c), the pair is
+/// projected orthogonally onto `P = 0` in the (T_p,tr, T_t,tr) plane:
+///
+/// ```text
+///     (T_p,tr, T_t,tr) ← (T_p,tr, T_t,tr) − P/(ω_p² + ω_t²)·(ω_p, −ω_t)
+/// ```
+///
+/// so the converter never delivers power, and the pair is continuous. The lag stores no energy:
+/// the loss is the absorbed power `T_p,tr·ω_p − T_t,tr·ω_t ≥ 0`.
+///
+/// The lag state `T_lag` (N·m) lives in the model's unused fourth coordinate (the table model has
+/// no flow), a mass-matrix row with mass `t_c`; [`ConverterDynamics::lag_state`] tells the engine
+/// and the outputs that it is not a flow.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct TorqueLag {
+    /// `t_c`, s: finite and positive.
+    pub time_constant_s: f64,
+}
+
+impl TorqueLag {
+    /// A lag with time constant `t_c` (s), finite and positive.
+    pub fn new(time_constant_s: f64) -> CoreResult<Self> {
+        if !(time_constant_s.is_finite() && time_constant_s > 0.0) {
+            return Err(CoreError::new(
+                "characteristic.lag_time_constant_s",
+                time_constant_s,
+                "a finite, positive time constant in s",
+            ));
+        }
+        Ok(Self { time_constant_s })
+    }
 }
 
 /// Table torques `(T_p,tr, T_t,tr)` and their gradients with respect to (ω_p, ω_t), in every
@@ -141,31 +195,96 @@ pub(super) fn table_steady(c: &Characteristic, wp: f64, wt: f64) -> CoreResult<f
     Ok(op.pump_torque_nm)
 }
 
+/// The lagged torques `(T_p,tr, T_t,tr)` at speeds (`wp`, `wt`) and lagged pump torque `z`, with
+/// their gradients with respect to (ω_p, ω_t, T_lag), after the passivity rule ([`TorqueLag`]).
+pub(super) fn lagged_torques(c: &Characteristic, wp: f64, wt: f64, z: f64) -> (f64, f64, [f64; 3], [f64; 3]) {
+    let t = c.torques(wp, wt);
+    let tr = t.torque_ratio;
+    let (tp, td) = (z, tr * z);
+    let dtp = [0.0, 0.0, 1.0];
+    let dtd = [t.d_torque_ratio[0] * z, t.d_torque_ratio[1] * z, tr];
+    let power = tp * wp - td * wt;
+    let norm = wp * wp + wt * wt;
+    if power >= 0.0 || norm == 0.0 {
+        return (tp, td, dtp, dtd);
+    }
+    // orthogonal projection onto T_p ω_p − T_t ω_t = 0 (k = P/N)
+    let k = power / norm;
+    let dpower = [dtp[0] * wp + tp - dtd[0] * wt, dtp[1] * wp - dtd[1] * wt - td, wp - tr * wt];
+    let dnorm = [2.0 * wp, 2.0 * wt, 0.0];
+    let dk: [f64; 3] = std::array::from_fn(|i| (dpower[i] - k * dnorm[i]) / norm);
+    let unit = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 };
+    (
+        tp - k * wp,
+        td + k * wt,
+        std::array::from_fn(|i| dtp[i] - dk[i] * wp - k * unit(i, 0)),
+        std::array::from_fn(|i| dtd[i] + dk[i] * wt + k * unit(i, 1)),
+    )
+}
+
 impl ConverterDynamics for TableDynamics {
     fn coordinates(&self) -> [bool; 4] {
-        [true, true, false, false]
+        [true, true, false, self.lag.is_some()]
     }
     fn mass(&self) -> Mat4 {
         let mut m = [[0.0; 4]; 4];
         m[PUMP][PUMP] = self.inertia.pump_kg_m2;
         m[TURBINE][TURBINE] = self.inertia.turbine_kg_m2;
+        if let Some(lag) = self.lag {
+            m[FLOW][FLOW] = lag.time_constant_s;
+        }
         m
     }
     fn forces(&self, u: &Vec4, _s: f64) -> Vec4 {
+        if self.lag.is_some() {
+            let (tp, tt, _, _) = lagged_torques(&self.characteristic, u[PUMP], u[TURBINE], u[FLOW]);
+            let steady = self.characteristic.torques(u[PUMP], u[TURBINE]).pump_nm;
+            return [-tp, tt, 0.0, steady - u[FLOW]];
+        }
         let (tp, tt, _, _) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
         [-tp, tt, 0.0, 0.0]
     }
     fn force_jacobian(&self, u: &Vec4, _s: f64) -> Mat4 {
-        let (_, _, dtp, dtt) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
         let mut j = [[0.0; 4]; 4];
+        if self.lag.is_some() {
+            let (_, _, dtp, dtt) = lagged_torques(&self.characteristic, u[PUMP], u[TURBINE], u[FLOW]);
+            let steady = self.characteristic.torques(u[PUMP], u[TURBINE]).d_pump;
+            for (k, c) in [PUMP, TURBINE, FLOW].into_iter().enumerate() {
+                j[PUMP][c] = -dtp[k];
+                j[TURBINE][c] = dtt[k];
+            }
+            j[FLOW] = [steady[0], steady[1], 0.0, -1.0];
+            return j;
+        }
+        let (_, _, dtp, dtt) = table_torques(&self.characteristic, u[PUMP], u[TURBINE]);
         j[PUMP][PUMP] = -dtp[0];
         j[PUMP][TURBINE] = -dtp[1];
         j[TURBINE][PUMP] = dtt[0];
         j[TURBINE][TURBINE] = dtt[1];
         j
     }
+    /// The power the table's torques absorb, `T_p,tr ω_p − T_t,tr ω_t` (≥ 0, with the lag too: its
+    /// row is a lag, not a power balance, so it is left out).
+    fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
+        let mut g = *f;
+        if self.lag.is_some() {
+            g[FLOW] = 0.0;
+        }
+        -(u[0] * g[0] + u[1] * g[1] + u[2] * g[2] + u[3] * g[3])
+    }
+    /// The kinetic energy of pump and turbine, J: the lag stores none.
+    fn stored_energy_j(&self, u: &Vec4) -> f64 {
+        let mut m = self.mass();
+        m[FLOW][FLOW] = 0.0;
+        0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| m[r][c] * u[c]).sum::<f64>()).sum::<f64>()
+    }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
-        Ok(SteadyPoint { u: [wp, wt, 0.0, 0.0], pump_torque_nm: table_steady(&self.characteristic, wp, wt)? })
+        let tp = table_steady(&self.characteristic, wp, wt)?;
+        let lagged = if self.lag.is_some() { tp } else { 0.0 };
+        Ok(SteadyPoint { u: [wp, wt, 0.0, lagged], pump_torque_nm: tp })
+    }
+    fn lag_state(&self) -> bool {
+        self.lag.is_some()
     }
 }
 
@@ -619,6 +738,9 @@ impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
     fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
         (**self).zero_flow_head(u)
     }
+    fn lag_state(&self) -> bool {
+        (**self).lag_state()
+    }
 }
 
 #[cfg(test)]
@@ -707,7 +829,7 @@ mod tests {
         }
         // points inside table segments (the table is piecewise linear)
         for u in [[200.0, 33.0, 0.0, 0.1], [210.0, 170.0, 0.0, 0.05], [150.0, 160.0, 0.0, 0.02]] {
-            check_jacobian(&TableDynamics { characteristic: c1(), inertia: inertia() }, u, 1.0);
+            check_jacobian(&TableDynamics { characteristic: c1(), inertia: inertia(), lag: None }, u, 1.0);
             check_jacobian(&qd(), u, 1.0);
         }
     }
@@ -736,12 +858,92 @@ mod tests {
             [-130.0, -370.0],
         ];
         for t in tables {
-            let table = TableDynamics { characteristic: t.clone(), inertia: inertia() };
+            let table = TableDynamics { characteristic: t.clone(), inertia: inertia(), lag: None };
             let q = QuasiDynamics { characteristic: t, ..qd() };
             for [wp, wt] in points {
                 check_jacobian(&table, [wp, wt, 0.0, 0.0], 1.0);
                 check_jacobian(&q, [wp, wt, 0.0, 0.01], 1.0);
             }
+        }
+    }
+
+    fn lagged(t: Characteristic, tc: f64) -> TableDynamics {
+        TableDynamics { characteristic: t, inertia: inertia(), lag: Some(TorqueLag::new(tc).unwrap()) }
+    }
+
+    /// The lag's Jacobian, with the passivity rule inactive (drive) and active (a lagged torque of
+    /// the wrong sign for the speeds), in every quadrant.
+    #[test]
+    fn lagged_table_jacobian_matches_finite_differences() {
+        let m = lagged(c1(), 0.05);
+        for [wp, wt] in [[200.0, 90.0], [200.0, -60.0], [-90.0, 270.0], [-200.0, -70.0], [150.0, 410.0], [0.5, 330.0]] {
+            let tss = c1().torques(wp, wt).pump_nm;
+            for z in [tss, 0.5 * tss, -tss - 30.0, 40.0, -40.0] {
+                check_jacobian(&m, [wp, wt, 0.0, z], 1.0);
+            }
+        }
+    }
+
+    /// Passivity of the lag: for random speeds and lagged torques the absorbed power is ≥ 0, the
+    /// loss power is that absorbed power, and where the candidate pair is passive it is unchanged
+    /// (the Simscape form `T_t = TR·T_lag`).
+    #[test]
+    fn lagged_table_is_passive_at_any_state() {
+        let coast = Characteristic::new(
+            vec![-0.1, 0.0, 0.5, 0.9, 1.0, 1.5, 2.1],
+            vec![1.81, 1.81, 1.36, 1.0, 1.0, 1.0, 1.0],
+            vec![3.5e-3, 3.5e-3, 3.9e-3, 2.7e-3, 0.0, -1.5e-3, -2.4e-3],
+        )
+        .unwrap();
+        let mut seed = 12345u64;
+        let mut rnd = |lo: f64, hi: f64| {
+            seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            lo + (hi - lo) * ((seed >> 11) as f64 / (1u64 << 53) as f64)
+        };
+        let (mut projected, mut unchanged) = (0, 0);
+        for t in [c1(), coast] {
+            let m = lagged(t.clone(), 0.1);
+            for _ in 0..20000 {
+                let (wp, wt, z) = (rnd(-400.0, 400.0), rnd(-400.0, 400.0), rnd(-300.0, 300.0));
+                let u = [wp, wt, 0.0, z];
+                let f = m.forces(&u, 1.0);
+                let absorbed = -f[PUMP] * wp - f[TURBINE] * wt;
+                let scale = (z.abs() + 1.0) * (wp.abs() + wt.abs() + 1.0);
+                assert!(absorbed >= -1e-12 * scale, "{u:?}: absorbed {absorbed}");
+                assert_eq!(m.loss_power_w(&u, &f), absorbed);
+                let tq = t.torques(wp, wt);
+                assert_eq!(f[FLOW], tq.pump_nm - z);
+                if z * wp - tq.torque_ratio * z * wt >= 0.0 {
+                    assert_eq!((-f[PUMP], f[TURBINE]), (z, tq.torque_ratio * z));
+                    unchanged += 1;
+                } else {
+                    assert!(absorbed.abs() <= 1e-12 * scale, "{u:?}: projected onto P = 0, {absorbed}");
+                    projected += 1;
+                }
+            }
+        }
+        assert!(projected > 1000 && unchanged > 1000, "{projected} projected, {unchanged} unchanged");
+    }
+
+    /// With the lag state at its steady value the lagged model is the table; the lag stores no
+    /// energy; no lag is the old model exactly.
+    #[test]
+    fn lagged_table_steady_state_is_the_table() {
+        let m = lagged(c1(), 0.2);
+        let plain = TableDynamics { characteristic: c1(), inertia: inertia(), lag: None };
+        for (wp, wt) in [(200.0, 100.0), (200.0, 400.0), (0.0, 300.0), (-150.0, 40.0), (100.0, -350.0)] {
+            let p = m.steady_point(wp, wt).unwrap();
+            assert_eq!(p.u[FLOW], p.pump_torque_nm);
+            let (f, g) = (m.forces(&p.u, 1.0), plain.forces(&[wp, wt, 0.0, 0.0], 1.0));
+            assert_eq!(f[FLOW], 0.0);
+            assert_eq!((f[PUMP], f[TURBINE]), (g[PUMP], g[TURBINE]), "({wp}, {wt})");
+            assert_eq!(m.stored_energy_j(&p.u), plain.stored_energy_j(&[wp, wt, 0.0, 0.0]));
+            assert_eq!(plain.steady_point(wp, wt).unwrap().u[FLOW], 0.0);
+        }
+        assert_eq!(m.mass()[FLOW][FLOW], 0.2);
+        assert!(m.lag_state() && !plain.lag_state() && plain.mass()[FLOW][FLOW] == 0.0);
+        for bad in [0.0, -1.0, f64::NAN, f64::INFINITY] {
+            assert_eq!(TorqueLag::new(bad).unwrap_err().field, "characteristic.lag_time_constant_s");
         }
     }
 

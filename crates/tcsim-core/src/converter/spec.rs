@@ -1,6 +1,6 @@
 //! Building a converter model from a specification (the binding's dicts, the FMU's model.json).
 
-use super::dynamics::{ConverterDynamics, HtDynamics, Inertias, TableDynamics};
+use super::dynamics::{ConverterDynamics, HtDynamics, Inertias, TableDynamics, TorqueLag};
 use super::hrovat_tobler::{steady_state, HtGeometry, HtParam, N_PARAMS};
 use super::quasi_dynamic::QuasiDynamics;
 use super::table::Characteristic;
@@ -80,6 +80,17 @@ fn check_finite_model(spec: &dyn ModelSpec, model: &dyn ConverterDynamics) -> Co
     ))
 }
 
+/// The key of the table model's first-order lag time constant, s (docs/lag.md); absent: no lag.
+pub const LAG_KEY: &str = "lag_time_constant_s";
+
+/// The table model's lag ([`TorqueLag`]) from the optional key [`LAG_KEY`].
+fn lag(spec: &dyn ModelSpec) -> CoreResult<Option<TorqueLag>> {
+    match spec.numbers(LAG_KEY) {
+        None => Ok(None),
+        Some(_) => Ok(Some(TorqueLag::new(number(spec, LAG_KEY)?)?)),
+    }
+}
+
 fn build_unchecked(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics + Send>> {
     let kind = spec.kind()?;
     let i = numbers(spec, "inertia_kg_m2", Some(3))?;
@@ -92,8 +103,15 @@ fn build_unchecked(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics
         )?
         .with_rules(spec.text("overrun").as_deref(), spec.text("interpolation").as_deref())
     };
+    if kind != "table" && spec.numbers(LAG_KEY).is_some() {
+        return Err(CoreError::new(
+            "characteristic.lag_time_constant_s",
+            kind,
+            "the table model: the quasi-dynamic model has its own flow lag and Hrovat & Tobler its fluid inertia (docs/lag.md)",
+        ));
+    }
     Ok(match kind.as_str() {
-        "table" => Box::new(TableDynamics { characteristic: table()?, inertia }),
+        "table" => Box::new(TableDynamics { characteristic: table()?, inertia, lag: lag(spec)? }),
         "quasi-dynamic" => {
             let shape = numbers(spec, "shape_effect_m2", Some(2))?;
             let m = QuasiDynamics {

@@ -129,6 +129,9 @@ pub struct TableTorques {
     pub d_delivered: [f64; 2],
     /// The torque ratio used, after the passivity projection.
     pub torque_ratio: f64,
+    /// Gradient of `torque_ratio` with respect to (ω_p, ω_t) (the table model's lag,
+    /// [`crate::converter::dynamics::TorqueLag`], carries it).
+    pub d_torque_ratio: [f64; 2],
     /// `Q_ss·ρR_p² = flow_factor·flow_speed`, N·m/(rad/s): the quasi-dynamic model's steady flow
     /// scaled (see [`Characteristic::torques`]): `flow_factor` is CF or −C·m, N·m/(rad/s)², and
     /// `flow_speed` is |ω_p| or |ω_t|, rad/s.
@@ -389,6 +392,7 @@ impl Characteristic {
                 d_pump: [0.0; 2],
                 d_delivered: [0.0; 2],
                 torque_ratio: self.torque_ratio[0],
+                d_torque_ratio: [0.0; 2],
                 flow_factor: 0.0,
                 flow_speed: 0.0,
                 d_flow: [0.0; 2],
@@ -426,6 +430,7 @@ impl Characteristic {
             d_pump,
             d_delivered: [dtr[0] * tp + tr * d_pump[0], dtr[1] * tp + tr * d_pump[1]],
             torque_ratio: tr,
+            d_torque_ratio: dtr,
             flow_factor: cf,
             flow_speed: wp.abs(),
             d_flow: [dcf * dsr[0] * wp.abs() + cf * wp.signum(), dcf * dsr[1] * wp.abs()],
@@ -452,6 +457,7 @@ impl Characteristic {
             d_pump,
             d_delivered: [dtr[0] * tp + tr * d_pump[0], dtr[1] * tp + tr * d_pump[1]],
             torque_ratio: tr,
+            d_torque_ratio: dtr,
             flow_factor: -g,
             flow_speed: wt.abs(),
             d_flow: [-dg * dx[0] * wt.abs(), -dg * dx[1] * wt.abs() - g * wt.signum()],

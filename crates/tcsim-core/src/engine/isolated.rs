@@ -194,7 +194,9 @@ fn steady_start(
     init: &InitialState,
     source: InputSource,
 ) -> TransientResult<Vec4> {
-    let mut u = if init.flow_m3_s.is_some() && init.stator_speed_rad_s.is_some() {
+    // a lag state is not a flow: it starts at its steady value whatever `init` says of the flow
+    let init_flow = if model.lag_state() { None } else { init.flow_m3_s };
+    let mut u = if init_flow.is_some() && init.stator_speed_rad_s.is_some() {
         [wp, wt, 0.0, 0.0]
     } else {
         steady_point_scaled(model, wp, wt)
@@ -213,7 +215,7 @@ fn steady_start(
     if let Some(ws) = init.stator_speed_rad_s {
         u[STATOR] = ws;
     }
-    if let Some(q) = init.flow_m3_s {
+    if let Some(q) = init_flow {
         u[FLOW] = q;
     }
     let present = model.coordinates();

@@ -74,10 +74,13 @@ fn ratio(a: f64, b: f64) -> f64 {
 
 /// One sample as a row in the order of [`COLUMNS`]. Coordinates the model lacks are NaN, and so
 /// are the stator mode (0 locked, 1 free-wheeling) and the flow direction (+1, −1, 0 held) of
-/// models without them. The lock-up columns are NaN without a clutch command (so a run without one
-/// has the columns of a converter without a clutch).
+/// models without them. The table model's lag state (in the fourth coordinate,
+/// [`ConverterDynamics::lag_state`]) is no flow: the flow columns stay NaN. The lock-up columns are
+/// NaN without a clutch command (so a run without one has the columns of a converter without a
+/// clutch).
 pub fn row(model: &dyn ConverterDynamics, s: &Sample) -> [f64; 33] {
-    let present = model.coordinates();
+    let mut present = model.coordinates();
+    present[FLOW] &= !model.lag_state();
     let m = model.mass();
     let coord = |c: usize, v: f64| if present[c] { v } else { f64::NAN };
     let lockup = |v: f64| if s.lockup.present { v } else { f64::NAN };

@@ -34,7 +34,7 @@ pub fn ht(shape: [f64; 3]) -> HtDynamics {
 }
 
 pub fn table() -> TableDynamics {
-    TableDynamics { characteristic: c1(), inertia: inertia() }
+    TableDynamics { characteristic: c1(), inertia: inertia(), lag: None }
 }
 
 pub fn qd(sp: f64, st: f64) -> QuasiDynamics {
