@@ -294,8 +294,7 @@ fn characteristic(
     input_torque_nm: Option<Vec<f64>>,
     table_rows: Option<Vec<f64>>,
 ) -> PyResult<TorqueCharacteristic> {
-    let (sr, tr, cf) =
-        (slice(sr, "speed_ratio")?, slice(tr, "torque_ratio")?, slice(cf, "capacity_factor_nm_s2")?);
+    let (sr, tr, cf) = (slice(sr, "speed_ratio")?, slice(tr, "torque_ratio")?, slice(cf, "capacity_factor_nm_s2")?);
     match input_torque_nm {
         None => Characteristic::new(sr.to_vec(), tr.to_vec(), cf.to_vec())
             .and_then(|c| c.with_rules(overrun, interpolation))

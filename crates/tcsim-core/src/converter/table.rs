@@ -523,7 +523,11 @@ impl Characteristic {
         if !turbine_speed_rad_s.is_finite() {
             return Err(CoreError::new("turbine_speed_rad_s", turbine_speed_rad_s, "a finite turbine speed"));
         }
-        operating_point_from(pump_speed_rad_s, turbine_speed_rad_s, &self.torques(pump_speed_rad_s, turbine_speed_rad_s))
+        operating_point_from(
+            pump_speed_rad_s,
+            turbine_speed_rad_s,
+            &self.torques(pump_speed_rad_s, turbine_speed_rad_s),
+        )
     }
 }
 
@@ -548,8 +552,7 @@ pub(crate) fn operating_point_from(
             "a speed at which the steady torques are finite (they grow as the speed squared and overflow)",
         ));
     }
-    let capacity =
-        if pump_speed_rad_s == 0.0 { f64::NAN } else { tp / (pump_speed_rad_s * pump_speed_rad_s.abs()) };
+    let capacity = if pump_speed_rad_s == 0.0 { f64::NAN } else { tp / (pump_speed_rad_s * pump_speed_rad_s.abs()) };
     Ok(TableOperatingPoint {
         speed_ratio: turbine_speed_rad_s / pump_speed_rad_s,
         torque_ratio: t.torque_ratio,
