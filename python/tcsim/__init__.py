@@ -44,11 +44,17 @@ __all__ = [
 
 
 def characterise(
-    converter, model: str = "hrovat-tobler", pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM, speed_ratio=None
+    converter,
+    model: str = "hrovat-tobler",
+    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
+    speed_ratio=None,
+    input_torque_nm: float | None = None,
 ):
-    """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`)."""
+    """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`) at a fixed
+    pump speed, or with ``input_torque_nm`` (N·m) at a fixed pump torque, the pump speed solved
+    (docs/torque_capacity.md)."""
     conv = converter if isinstance(converter, Converter) else load_converter(converter)
-    return _steady.characterise(conv, model, pump_speed_rpm, speed_ratio)
+    return _steady.characterise(conv, model, pump_speed_rpm, speed_ratio, input_torque_nm=input_torque_nm)
 
 
 def steady_state(converter, model: str, pump_speed_rad_s, turbine_speed_rad_s):

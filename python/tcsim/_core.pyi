@@ -104,6 +104,8 @@ def table_check(
     capacity_factor_nm_s2: _ArrayLike,
     overrun: str | None = None,
     interpolation: str | None = None,
+    input_torque_nm: list[float] | None = None,
+    table_rows: list[float] | None = None,
 ) -> None: ...
 def table_steady_states(
     speed_ratio: _ArrayLike,
@@ -114,7 +116,21 @@ def table_steady_states(
     overrun: str | None = None,
     interpolation: str | None = None,
     lenient: bool = False,
+    input_torque_nm: list[float] | None = None,
+    table_rows: list[float] | None = None,
 ) -> dict[str, Any]: ...
+def table_steady_states_at_pump_torque(
+    speed_ratio: _ArrayLike,
+    torque_ratio: _ArrayLike,
+    capacity_factor_nm_s2: _ArrayLike,
+    pump_torque_nm: float,
+    at_speed_ratio: _ArrayLike,
+    overrun: str | None = None,
+    interpolation: str | None = None,
+    input_torque_nm: list[float] | None = None,
+    table_rows: list[float] | None = None,
+) -> dict[str, Any]: ...
+def ht_pump_speeds_at_pump_torque(geometry: _ArrayLike, pump_torque_nm: float, speed_ratio: _ArrayLike) -> _Array: ...
 def smoothed_rate(time_s: _ArrayLike, values: _ArrayLike, window_s: float) -> _Array: ...
 def transient_columns() -> list[str]: ...
 def transient_runs(

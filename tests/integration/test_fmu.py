@@ -22,11 +22,14 @@ import numpy as np
 import pytest
 
 fmpy = pytest.importorskip("fmpy")
+import tomli_w  # noqa: E402
 from fmpy.fmi2 import FMU2Slave  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
+from tcsim import steady_state  # noqa: E402
 from tcsim.errors import InputError  # noqa: E402
 from tcsim.io import fmu as tfmu  # noqa: E402
+from tcsim.models.converter import load_converter  # noqa: E402
 from tcsim.transient import PumpTorqueTurbineSpeed, Speeds, dynamic_model, isolated_takeoff, simulate  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
@@ -583,3 +586,25 @@ def test_tip_out_flow_events_in_both_interfaces(fmus, fmi_type):
     for col in ("pump_speed_rad_s", "turbine_torque_nm"):
         excess = _tube_excess(res["time"], res[col], ref["time_s"], ref[col], 1e-3)
         assert excess.max() == 0.0, (col, excess.max())
+
+
+def test_a_torque_dependent_converter_runs_in_the_fmu(library_env, tmp_path):
+    """Issue 12: the FMU's model.json carries the tables of a torque-dependent converter and the FMU
+    solves the pump torque's fixed point as the engine does (speeds given, held constant)."""
+    doc = load_converter(CONVERTER).to_toml_dict()
+    c1 = doc.pop("characteristic")
+    heavy = {**c1, "capacity_factor_nm_s2": [0.8 * c for c in c1["capacity_factor_nm_s2"]]}
+    doc["characteristic"] = [{"input_torque_nm": 100.0, **c1}, {"input_torque_nm": 300.0, **heavy}]
+    conv = tmp_path / "two.toml"
+    conv.write_text(tomli_w.dumps(doc))
+    path = tfmu.export_fmu(str(conv), "table", tmp_path / "two.fmu", causality="speeds")
+    spec = json.loads(zipfile.ZipFile(path).read("resources/model.json"))
+    assert "input_torque_nm" in json.dumps(spec)
+    inp = np.array(
+        [(0.0, 250.0, 50.0), (1.0, 250.0, 50.0)],
+        dtype=[("time", float), ("pump_speed_rad_s", float), ("turbine_speed_rad_s", float)],
+    )
+    res = fmpy.simulate_fmu(str(path), fmi_type="CoSimulation", input=inp, output_interval=0.1, stop_time=1.0)
+    ref = steady_state(str(conv), "table", 250.0, 50.0)["pump_torque_nm"][0]
+    assert 163.6 < ref < 204.5  # between the two tables' torques at these speeds
+    np.testing.assert_allclose(res["pump_torque_nm"][1:], ref, rtol=1e-9)

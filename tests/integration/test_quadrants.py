@@ -31,7 +31,10 @@ from tcsim.simulation.scenarios import Scenario
 from tcsim.transient import PumpTorqueTurbineSpeed, Speeds, isolated_takeoff, simulate
 
 TABLE_FILES = sorted(p.name for p in CONVERTER_DATA.glob("*.csv"))
-CONVERTERS = [*bundled_names(), *TABLE_FILES]
+#: A synthetic torque-dependent converter (issue 12): Table C.1 at 100 N·m, and at 300 N·m with CF
+#: lower at low SR and TR nearer 1 (docs/torque_capacity.md), li-sunden-2016's other sections.
+TWO_TABLES = "two-tables (synthetic)"
+CONVERTERS = [*bundled_names(), *TABLE_FILES, TWO_TABLES]
 TABLE_MODELS = ("table", "quasi-dynamic")
 #: Tables ending at SR ≤ 1 (continued by the mirror rule, with a warning).
 MIRRORED = {name for name in CONVERTERS if name != "jambe_trami_9at.csv"}
@@ -45,6 +48,18 @@ def converter(name: str) -> Converter:
         warnings.simplefilter("ignore", TcsimWarning)  # the Allison table's implausible stall torque
         if name in bundled_names():
             return load_converter(name)
+        if name == TWO_TABLES:
+            doc = load_converter("li-sunden-2016").to_toml_dict()
+            c1 = doc.pop("characteristic")
+            heavy = {
+                "speed_ratio": c1["speed_ratio"],
+                "torque_ratio": [1.0 + 0.8 * (t - 1.0) for t in c1["torque_ratio"]],
+                "capacity_factor_nm_s2": [
+                    c * (0.8 + 0.2 * s) for s, c in zip(c1["speed_ratio"], c1["capacity_factor_nm_s2"], strict=True)
+                ],
+            }
+            tables = [{"input_torque_nm": 100.0, **c1}, {"input_torque_nm": 300.0, **heavy}]
+            return parse_converter({**doc, "characteristic": tables}, name)
         table = load_converter(CONVERTER_DATA / name).characteristic
         return dataclasses.replace(load_converter("li-sunden-2016"), name=name, path=name, characteristic=table)
 
@@ -56,7 +71,7 @@ def steady(conv: Converter, wp, wt) -> dict[str, np.ndarray]:
     c = conv.characteristic
     assert c is not None
     wp, wt = np.ascontiguousarray(wp, dtype=float), np.ascontiguousarray(wt, dtype=float)
-    return _core.table_steady_states(*c.arrays(), wp, wt, **c.core_rules())
+    return _core.table_steady_states(**c.core_table(), pump_speed_rad_s=wp, turbine_speed_rad_s=wt)
 
 
 def absorbed_w(out: dict[str, np.ndarray], wp, wt) -> np.ndarray:

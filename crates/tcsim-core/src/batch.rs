@@ -108,6 +108,38 @@ pub fn ht_steady_states_cancellable(
     Ok(Some(out))
 }
 
+/// Iterations of [`ht_pump_speed_at_pump_torque`] at most.
+const PUMP_TORQUE_ITERATIONS: usize = 60;
+
+/// The positive pump speed (rad/s) at which the Hrovat & Tobler steady state at speed ratio
+/// `speed_ratio` takes the pump torque `pump_torque_nm` (`characterise --input-torque-nm`), or None
+/// where there is none (a torque of the other sign than the model's at that speed ratio, or no
+/// steady state). A fixed-point iteration `ω ← ω·√(T/T_p(ω))` from the reference pump speed: the
+/// steady torques grow as ω² at a fixed speed ratio, so it converges in one or two steps; it stops
+/// when ω changes by less than 1e-14 relative.
+pub fn ht_pump_speed_at_pump_torque(geometry: &HtGeometry<f64>, pump_torque_nm: f64, speed_ratio: f64) -> Option<f64> {
+    if !(pump_torque_nm.is_finite() && pump_torque_nm != 0.0 && speed_ratio.is_finite()) {
+        return None;
+    }
+    let mut w = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
+    for _ in 0..PUMP_TORQUE_ITERATIONS {
+        let tp = steady_state(geometry, w, speed_ratio * w).ok()?.pump_torque_nm;
+        let ratio = pump_torque_nm / tp;
+        if !(ratio > 0.0 && ratio.is_finite()) {
+            return None;
+        }
+        let next = w * ratio.sqrt();
+        if !next.is_finite() {
+            return None;
+        }
+        if (next - w).abs() <= 1e-14 * next {
+            return Some(next);
+        }
+        w = next;
+    }
+    None
+}
+
 /// Torque ratio and capacity factor at the given speed ratios (pump speed `pump_speed_rad_s`),
 /// with their exact derivatives with respect to the parameters `free`.
 ///
@@ -252,6 +284,21 @@ pub fn run_transient_jobs_cancellable(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn ht_pump_speed_carries_the_given_pump_torque() {
+        let g = HtGeometry::appendix_d();
+        for sr in [0.0, 0.3, 0.6, 0.85, 0.95] {
+            for t in [50.0, 150.0, 400.0] {
+                let w = ht_pump_speed_at_pump_torque(&g, t, sr).unwrap();
+                let tp = steady_state(&g, w, sr * w).unwrap().pump_torque_nm;
+                assert!((tp - t).abs() <= 1e-9 * t, "SR {sr}, {t} N·m: ω_p {w}, T_p {tp}");
+            }
+        }
+        // a drive torque in drive can't be negative at SR 0.5 with a positive pump speed
+        assert_eq!(ht_pump_speed_at_pump_torque(&g, -100.0, 0.5), None);
+        assert_eq!(ht_pump_speed_at_pump_torque(&g, f64::NAN, 0.5), None);
+    }
 
     #[test]
     fn batch_matches_pointwise_and_reports_failures() {

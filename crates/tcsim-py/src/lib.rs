@@ -31,7 +31,8 @@ use tcsim_core::converter::hrovat_tobler::{
     coupling_point, steady_mode_names as steady_mode_names_core, steady_torque_ratio as steady_torque_ratio_core,
     HtGeometry, HtParam, N_PARAMS,
 };
-use tcsim_core::converter::table::Characteristic;
+use tcsim_core::converter::table::{Characteristic, TableOperatingPoint};
+use tcsim_core::converter::torque_capacity::TorqueCharacteristic;
 use tcsim_core::engine::converter_events::EventKind;
 use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
 use tcsim_core::engine::lockup::LockupCommand;
@@ -282,32 +283,46 @@ fn ht_ratio_gradients<'py>(
     })
 }
 
+/// The table(s) of the binding's table functions: one table, or with `input_torque_nm` several
+/// concatenated, `table_rows` rows each (torque-dependent capacity).
+#[allow(clippy::too_many_arguments)]
 fn characteristic(
     sr: &PyReadonlyArray1<'_, f64>,
     tr: &PyReadonlyArray1<'_, f64>,
     cf: &PyReadonlyArray1<'_, f64>,
     overrun: Option<&str>,
     interpolation: Option<&str>,
-) -> PyResult<Characteristic> {
-    Characteristic::new(
-        slice(sr, "speed_ratio")?.to_vec(),
-        slice(tr, "torque_ratio")?.to_vec(),
-        slice(cf, "capacity_factor_nm_s2")?.to_vec(),
-    )
-    .and_then(|c| c.with_rules(overrun, interpolation))
+    input_torque_nm: Option<Vec<f64>>,
+    table_rows: Option<Vec<f64>>,
+) -> PyResult<TorqueCharacteristic> {
+    let (sr, tr, cf) = (slice(sr, "speed_ratio")?, slice(tr, "torque_ratio")?, slice(cf, "capacity_factor_nm_s2")?);
+    match input_torque_nm {
+        None => Characteristic::new(sr.to_vec(), tr.to_vec(), cf.to_vec())
+            .and_then(|c| c.with_rules(overrun, interpolation))
+            .map(TorqueCharacteristic::from),
+        Some(torques) => TorqueCharacteristic::from_columns(
+            torques,
+            &table_rows.unwrap_or_default(),
+            [sr, tr, cf],
+            overrun,
+            interpolation,
+        ),
+    }
     .map_err(input_error)
 }
 
 /// Validate a characteristic table (finite, strictly increasing SR, equal lengths, passive on its
 /// rows) with its overrun rule and interpolation domain (None: the defaults).
 #[pyfunction]
-#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, overrun=None, interpolation=None))]
+#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, overrun=None, interpolation=None, input_torque_nm=None, table_rows=None))]
 fn table_check(
     speed_ratio: PyReadonlyArray1<'_, f64>,
     torque_ratio: PyReadonlyArray1<'_, f64>,
     capacity_factor_nm_s2: PyReadonlyArray1<'_, f64>,
     overrun: Option<String>,
     interpolation: Option<String>,
+    input_torque_nm: Option<Vec<f64>>,
+    table_rows: Option<Vec<f64>>,
 ) -> PyResult<()> {
     guard(|| {
         characteristic(
@@ -316,6 +331,8 @@ fn table_check(
             &capacity_factor_nm_s2,
             overrun.as_deref(),
             interpolation.as_deref(),
+            input_torque_nm,
+            table_rows,
         )
         .map(|_| ())
     })
@@ -326,7 +343,7 @@ fn table_check(
 /// without a steady state (torques that overflow) is an error naming the point, or with `lenient`
 /// a row of NaN with `solved` false.
 #[pyfunction]
-#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, pump_speed_rad_s, turbine_speed_rad_s, overrun=None, interpolation=None, lenient=false))]
+#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, pump_speed_rad_s, turbine_speed_rad_s, overrun=None, interpolation=None, lenient=false, input_torque_nm=None, table_rows=None))]
 #[allow(clippy::too_many_arguments)]
 fn table_steady_states<'py>(
     py: Python<'py>,
@@ -338,6 +355,8 @@ fn table_steady_states<'py>(
     overrun: Option<String>,
     interpolation: Option<String>,
     lenient: bool,
+    input_torque_nm: Option<Vec<f64>>,
+    table_rows: Option<Vec<f64>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let t = characteristic(
@@ -346,6 +365,8 @@ fn table_steady_states<'py>(
             &capacity_factor_nm_s2,
             overrun.as_deref(),
             interpolation.as_deref(),
+            input_torque_nm,
+            table_rows,
         )?;
         let (wp, wt) =
             (slice(&pump_speed_rad_s, "pump_speed_rad_s")?, slice(&turbine_speed_rad_s, "turbine_speed_rad_s")?);
@@ -358,23 +379,91 @@ fn table_steady_states<'py>(
                 return Err(input_error(CoreError { field: format!("{} (point {i})", e.field), ..e.clone() }));
             }
         }
-        let col = |f: fn(&tcsim_core::converter::table::TableOperatingPoint) -> f64| {
-            points.iter().map(|p| p.as_ref().map_or(f64::NAN, f)).collect::<Vec<_>>().into_pyarray(py)
-        };
-        let flag = |f: fn(&tcsim_core::converter::table::TableOperatingPoint) -> bool| {
-            points.iter().map(|p| p.as_ref().is_ok_and(f)).collect::<Vec<_>>()
-        };
-        let d = PyDict::new(py);
-        d.set_item("speed_ratio", col(|p| p.speed_ratio))?;
-        d.set_item("torque_ratio", col(|p| p.torque_ratio))?;
-        d.set_item("capacity_factor_nm_s2", col(|p| p.capacity_factor_nm_s2))?;
-        d.set_item("pump_torque_nm", col(|p| p.pump_torque_nm))?;
-        d.set_item("turbine_torque_nm", col(|p| p.turbine_torque_nm))?;
-        d.set_item("stator_torque_nm", col(|p| p.stator_torque_nm))?;
-        d.set_item("extrapolated", flag(|p| p.extrapolated))?;
-        d.set_item("extension", flag(|p| p.extension))?;
-        d.set_item("solved", points.iter().map(Result::is_ok).collect::<Vec<_>>())?;
+        operating_point_dict(py, &points)
+    })
+}
+
+/// The columns of table steady states `points` (NaN where a point has none, `solved` false).
+fn operating_point_dict<'py>(
+    py: Python<'py>,
+    points: &[tcsim_core::CoreResult<TableOperatingPoint>],
+) -> PyResult<Bound<'py, PyDict>> {
+    let col = |f: fn(&TableOperatingPoint) -> f64| {
+        points.iter().map(|p| p.as_ref().map_or(f64::NAN, f)).collect::<Vec<_>>().into_pyarray(py)
+    };
+    let flag = |f: fn(&TableOperatingPoint) -> bool| points.iter().map(|p| p.as_ref().is_ok_and(f)).collect::<Vec<_>>();
+    let d = PyDict::new(py);
+    d.set_item("speed_ratio", col(|p| p.speed_ratio))?;
+    d.set_item("torque_ratio", col(|p| p.torque_ratio))?;
+    d.set_item("capacity_factor_nm_s2", col(|p| p.capacity_factor_nm_s2))?;
+    d.set_item("pump_torque_nm", col(|p| p.pump_torque_nm))?;
+    d.set_item("turbine_torque_nm", col(|p| p.turbine_torque_nm))?;
+    d.set_item("stator_torque_nm", col(|p| p.stator_torque_nm))?;
+    d.set_item("extrapolated", flag(|p| p.extrapolated))?;
+    d.set_item("extension", flag(|p| p.extension))?;
+    d.set_item("solved", points.iter().map(Result::is_ok).collect::<Vec<_>>())?;
+    Ok(d)
+}
+
+/// Steady states of the table model at input (pump) torque `pump_torque_nm` and the speed ratios
+/// `at_speed_ratio`, the pump speed solved (positive; `characterise --input-torque-nm`). The dict of
+/// [`table_steady_states`] with `pump_speed_rad_s` and `turbine_speed_rad_s`; a speed ratio where no
+/// positive pump speed carries the torque is a row of NaN with `solved` false.
+#[pyfunction]
+#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, pump_torque_nm, at_speed_ratio, overrun=None, interpolation=None, input_torque_nm=None, table_rows=None))]
+#[allow(clippy::too_many_arguments)]
+fn table_steady_states_at_pump_torque<'py>(
+    py: Python<'py>,
+    speed_ratio: PyReadonlyArray1<'py, f64>,
+    torque_ratio: PyReadonlyArray1<'py, f64>,
+    capacity_factor_nm_s2: PyReadonlyArray1<'py, f64>,
+    pump_torque_nm: f64,
+    at_speed_ratio: PyReadonlyArray1<'py, f64>,
+    overrun: Option<String>,
+    interpolation: Option<String>,
+    input_torque_nm: Option<Vec<f64>>,
+    table_rows: Option<Vec<f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let t = characteristic(
+            &speed_ratio,
+            &torque_ratio,
+            &capacity_factor_nm_s2,
+            overrun.as_deref(),
+            interpolation.as_deref(),
+            input_torque_nm,
+            table_rows,
+        )?;
+        let sr = slice(&at_speed_ratio, "at_speed_ratio")?;
+        let solved: Vec<_> = py.detach(|| sr.iter().map(|&s| t.at_pump_torque(pump_torque_nm, s)).collect());
+        let wp: Vec<f64> = solved.iter().map(|p| p.as_ref().map_or(f64::NAN, |(w, _)| *w)).collect();
+        let points: Vec<_> = solved.into_iter().map(|p| p.map(|(_, op)| op)).collect();
+        let d = operating_point_dict(py, &points)?;
+        let wt: Vec<f64> = wp.iter().zip(sr).map(|(w, s)| w * s).collect();
+        d.set_item("pump_speed_rad_s", wp.into_pyarray(py))?;
+        d.set_item("turbine_speed_rad_s", wt.into_pyarray(py))?;
         Ok(d)
+    })
+}
+
+/// Pump speeds (rad/s, positive) at which the Hrovat & Tobler steady state at the speed ratios
+/// `speed_ratio` takes the pump torque `pump_torque_nm`; NaN where there is none.
+#[pyfunction]
+fn ht_pump_speeds_at_pump_torque<'py>(
+    py: Python<'py>,
+    geometry: PyReadonlyArray2<'py, f64>,
+    pump_torque_nm: f64,
+    speed_ratio: PyReadonlyArray1<'py, f64>,
+) -> PyResult<Bound<'py, PyArray1<f64>>> {
+    guard(|| {
+        let g = one_geometry(&geometry)?;
+        let sr = slice(&speed_ratio, "speed_ratio")?;
+        let w: Vec<f64> = py.detach(|| {
+            sr.iter()
+                .map(|&s| tcsim_core::batch::ht_pump_speed_at_pump_torque(&g, pump_torque_nm, s).unwrap_or(f64::NAN))
+                .collect()
+        });
+        Ok(w.into_pyarray(py))
     })
 }
 
@@ -1152,6 +1241,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(ht_ratio_gradients, m)?)?;
     m.add_function(wrap_pyfunction!(table_check, m)?)?;
     m.add_function(wrap_pyfunction!(table_steady_states, m)?)?;
+    m.add_function(wrap_pyfunction!(table_steady_states_at_pump_torque, m)?)?;
+    m.add_function(wrap_pyfunction!(ht_pump_speeds_at_pump_torque, m)?)?;
     m.add_function(wrap_pyfunction!(transient_columns, m)?)?;
     m.add_function(wrap_pyfunction!(smoothed_rate, m)?)?;
     m.add_function(wrap_pyfunction!(launch_columns, m)?)?;

@@ -594,6 +594,14 @@ def target_table(target: str) -> Characteristic:
             "missing",
             "a characteristic table to fit (.csv, .vtcc, or a converter .toml with [characteristic])",
         )
+    if conv.characteristic.by_torque:
+        raise InputError(
+            conv.path,
+            "[characteristic]",
+            f"{len(conv.characteristic.by_torque)} tables",
+            "one characteristic table to fit (this converter's capacity depends on the input torque: "
+            "fit one table at a time)",
+        )
     return conv.characteristic
 
 

@@ -14,7 +14,17 @@ from .app import AllowImplausibleOpt, ModelOpt, OutOpt, say
 def characterise(
     converter: Annotated[str, typer.Argument(help="bundled name, converter .toml, or table .csv/.vtcc")],
     model: ModelOpt = "",
-    pump_speed_rpm: Annotated[float, typer.Option(help="fixed pump speed of the sweep")] = DEFAULT_PUMP_SPEED_RPM,
+    pump_speed_rpm: Annotated[
+        float | None, typer.Option(help=f"fixed pump speed of the sweep [default: {DEFAULT_PUMP_SPEED_RPM:g}]")
+    ] = None,
+    input_torque_nm: Annotated[
+        float | None,
+        typer.Option(
+            "--input-torque-nm",
+            help="fixed pump (input) torque of the sweep, N·m, the pump speed solved at each speed ratio "
+            "(instead of --pump-speed-rpm)",
+        ),
+    ] = None,
     out: OutOpt = Path("characteristic"),
     allow_implausible: AllowImplausibleOpt = False,
     speed_ratio: Annotated[
@@ -27,6 +37,7 @@ def characterise(
     ] = None,
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
+    from ..errors import InputError
     from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_frames
     from ..models.converter import load_converter
@@ -34,8 +45,16 @@ def characterise(
     from ..models.steady import coupling_point, speed_ratio_sweep, sweep_speed_ratios
     from ..plots.characteristic import plot_characteristic
 
+    if pump_speed_rpm is not None and input_torque_nm is not None:
+        raise InputError(
+            "command line",
+            "--input-torque-nm",
+            input_torque_nm,
+            "either --input-torque-nm or --pump-speed-rpm, not both",
+        )
     if speed_ratio is not None:
         speed_ratio_sweep(speed_ratio)  # the command line first, before any file is read
+    rpm = DEFAULT_PUMP_SPEED_RPM if pump_speed_rpm is None else pump_speed_rpm
     check_output_dir(out, [converter])
     conv = load_converter(converter)
     inputs = [converter, conv.path]
@@ -43,7 +62,7 @@ def characterise(
     model = model or ("hrovat-tobler" if "hrovat-tobler" in conv.models else "table")
     conv.require(model)
     sr = None if speed_ratio is None else sweep_speed_ratios(conv, model, speed_ratio)
-    df = run(conv, model, pump_speed_rpm, sr, allow_implausible=allow_implausible)
+    df = run(conv, model, rpm, sr, allow_implausible=allow_implausible, input_torque_nm=input_torque_nm)
     cp = coupling_point(conv) if model == "hrovat-tobler" else None
     if cp is not None and sr is not None and not sr[0] <= cp <= sr[-1]:
         cp = None
@@ -53,7 +72,9 @@ def characterise(
         plot_characteristic(
             {f"{model} model": df},
             stage,
-            f"{conv.name}, pump at {pump_speed_rpm:g} rpm",
+            f"{conv.name}, pump at {rpm:g} rpm"
+            if input_torque_nm is None
+            else f"{conv.name}, input torque {input_torque_nm:g} N·m",
             table=table,
             coupling_point=cp,
         )

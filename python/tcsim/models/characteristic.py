@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import re
 import warnings
-from dataclasses import dataclass
-from typing import TypedDict
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+from typing import Any, TypedDict
 
 import numpy as np
 
 from .. import _core
-from ..errors import InputError, TcsimWarning, from_core
+from ..errors import InputError, TcsimWarning, core_value, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .plausibility import warn_implausible
 
@@ -41,6 +42,12 @@ class Characteristic:
     given; the core owns their values and defaults (``"mirror"`` or ``"table"``, the latter the
     default for a table with rows above SR 1; ``"capacity_factor"`` or ``"k_factor"``;
     docs/models.md).
+
+    Torque-dependent capacity (docs/torque_capacity.md): ``input_torque_nm`` is the input (pump)
+    torque a table was measured at, N·m (None: not given). A converter with several tables is the
+    first (lowest-torque) table with ``by_torque``, all its tables by increasing input torque; its
+    own arrays (``speed_ratio``, ...) are then those of the first table, and the core functions take
+    :meth:`core_table`, which holds them all.
     """
 
     speed_ratio: np.ndarray
@@ -50,6 +57,55 @@ class Characteristic:
     source: str = ""
     overrun: str | None = None
     interpolation: str | None = None
+    input_torque_nm: float | None = None
+    by_torque: tuple[Characteristic, ...] = ()
+
+    @classmethod
+    def torque_dependent(cls, tables: Sequence[Characteristic], source: str, prefixes: Sequence[str]) -> Characteristic:
+        """The converter's characteristic from several ``tables``, each with its ``input_torque_nm``
+        (in any order; sorted here), checked by the core as a whole. ``prefixes[i]`` names table i in
+        messages (``"[characteristic][2]."``). Two tables at the same input torque are an error about
+        the later one's ``input_torque_nm``."""
+        order = sorted(range(len(tables)), key=lambda i: (float(tables[i].input_torque_nm or 0.0), i))
+        for a, b in zip(order, order[1:], strict=False):
+            if tables[a].input_torque_nm == tables[b].input_torque_nm:
+                later, first = max(a, b), min(a, b)
+                raise InputError(
+                    source,
+                    f"{prefixes[later]}input_torque_nm",
+                    tables[later].input_torque_nm,
+                    f"an input torque of its own ({prefixes[first].rstrip('. ,')} has it too; one table per torque)",
+                )
+        ordered = tuple(tables[i] for i in order)
+        top = replace(ordered[0], by_torque=ordered)
+        try:
+            _core.table_check(**top.core_table())
+        except _core.CoreInputError as e:
+            m = re.fullmatch(r"characteristic\[(\d+)\]\.(.+)", e.args[1])
+            if m is None:
+                raise from_core(e, source) from None
+            raise InputError(source, f"{prefixes[order[int(m[1])]]}{m[2]}", core_value(e.args[2]), e.args[3]) from None
+        return top
+
+    def tables(self) -> tuple[Characteristic, ...]:
+        """The converter's tables by increasing input torque (this one alone for a single table)."""
+        return self.by_torque or (self,)
+
+    def core_table(self) -> dict[str, Any]:
+        """Keyword arguments of the core's table functions (``tcsim._core.table_steady_states``, ...)
+        and the table keys of the model specification: ``speed_ratio``, ``torque_ratio``,
+        ``capacity_factor_nm_s2``, the :meth:`core_rules`, and for several tables their columns one
+        after the other with ``input_torque_nm`` and ``table_rows`` (rows per table)."""
+        tables = self.tables()
+        out: dict[str, Any] = {
+            k: np.ascontiguousarray(np.concatenate([getattr(t, k) for t in tables]), dtype=float)
+            for k in ("speed_ratio", "torque_ratio", "capacity_factor_nm_s2")
+        }
+        out.update(self.core_rules())
+        if self.by_torque:
+            out["input_torque_nm"] = [float(t.input_torque_nm or 0.0) for t in tables]
+            out["table_rows"] = [float(len(t.speed_ratio)) for t in tables]
+        return out
 
     @classmethod
     def from_columns(
@@ -63,8 +119,10 @@ class Characteristic:
         rows: list[int] | None = None,
         overrun: str | None = None,
         interpolation: str | None = None,
+        input_torque_nm: float | None = None,
     ) -> Characteristic:
-        """Validate and convert a table read in capacity ``convention``.
+        """Validate and convert a table read in capacity ``convention`` (measured at input torque
+        ``input_torque_nm``, N·m, where the converter's capacity depends on it).
 
         ``where`` prefixes field names (``"[characteristic]."`` for TOML); ``rows`` maps each
         point to its line number in a text file, so that messages name the line. ``overrun`` and
@@ -127,7 +185,7 @@ class Characteristic:
             if row is not None and rows is not None:
                 raise InputError(source, name("torque_ratio", int(row[1])), float(tr[int(row[1])]), e.args[3]) from None
             raise from_core(e, source, where) from None
-        return cls(sr, tr, cf, convention, source, overrun, interpolation)
+        return cls(sr, tr, cf, convention, source, overrun, interpolation, input_torque_nm)
 
     def core_rules(self) -> CoreRules:
         """The ``overrun`` and ``interpolation`` keys the file gave, for the core's table functions
@@ -141,7 +199,7 @@ class Characteristic:
 
     def warn_if_extended(self, pump_speed_rad_s, turbine_speed_rad_s, what: str = "the run") -> None:
         """:func:`warn_if_extended` for this table."""
-        warn_if_extended(self.source, self.arrays(), self.core_rules(), pump_speed_rad_s, turbine_speed_rad_s, what)
+        warn_if_extended(self.source, self.core_table(), pump_speed_rad_s, turbine_speed_rad_s, what)
 
     def stall_torque_nm(self, pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM) -> float:
         """Pump torque at SR = 0 (or the table's first SR ≥ 0) and the given pump speed."""
@@ -167,14 +225,13 @@ class Characteristic:
 
 def warn_if_extended(
     source: str,
-    table: tuple[np.ndarray, np.ndarray, np.ndarray],
-    rules: CoreRules,
+    table: dict[str, Any],
     pump_speed_rad_s,
     turbine_speed_rad_s,
     what: str = "the run",
 ) -> None:
     """One :class:`~tcsim.errors.TcsimWarning` when the core's overrun rule extended the table
-    ``(speed_ratio, torque_ratio, capacity_factor_nm_s2)`` beyond its rows at any of the points
+    ``table`` (:meth:`Characteristic.core_table`) beyond its rows at any of the points
     (rad/s; the core says where, by the ``extension`` flag of ``tcsim._core.table_steady_states``):
     the results there rest on the extension rule, not on data (docs/models.md)."""
     wp = np.asarray(pump_speed_rad_s, dtype=float).reshape(-1)
@@ -183,9 +240,9 @@ def warn_if_extended(
     if not ok.any():
         return
     wp, wt = np.ascontiguousarray(wp[ok]), np.ascontiguousarray(wt[ok])
-    sr, tr, cf = (np.ascontiguousarray(v, dtype=float) for v in table)
+    sr = np.asarray(table["speed_ratio"], dtype=float)
     try:
-        ext = np.asarray(_core.table_steady_states(sr, tr, cf, wp, wt, **rules)["extension"], dtype=bool)
+        ext = np.asarray(_core.table_steady_states(**table, pump_speed_rad_s=wp, turbine_speed_rad_s=wt)["extension"])
     except _core.CoreInputError:  # speeds whose torques overflow: the run itself says so
         return
     if not ext.any():

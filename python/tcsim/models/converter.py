@@ -49,6 +49,9 @@ class CharacteristicSection(_Section):
     interpolation: str | None = None
     #: First-order lag of the table model's pump torque, s (docs/lag.md); absent: no lag.
     lag_time_constant_s: float | None = Field(default=None, gt=0, allow_inf_nan=False)
+    #: The input (pump) torque the table was measured at, N·m: required in each table of an array
+    #: ``[[characteristic]]`` (torque-dependent capacity, docs/torque_capacity.md).
+    input_torque_nm: float | None = Field(default=None, gt=0, allow_inf_nan=False)
 
     @model_validator(mode="after")
     def _one_capacity(self):
@@ -190,15 +193,10 @@ class Converter:
         if self.description:
             out["description"] = self.description
         if self.characteristic is not None:
-            c = self.characteristic
-            out["characteristic"] = {
-                "speed_ratio": c.speed_ratio.tolist(),
-                "torque_ratio": c.torque_ratio.tolist(),
-                "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
-                **c.core_rules(),
-            }
+            out["characteristic"] = _characteristic_toml(self.characteristic)
             if self.lag_time_constant_s is not None:
-                out["characteristic"]["lag_time_constant_s"] = self.lag_time_constant_s
+                first = out["characteristic"]
+                (first[0] if isinstance(first, list) else first)["lag_time_constant_s"] = self.lag_time_constant_s
         for section in ("inertia", "geometry", "quasi_dynamic"):
             model = getattr(self, section)
             if model is not None:
@@ -208,9 +206,98 @@ class Converter:
         return out
 
 
-def _pydantic_to_input_error(err: ValidationError, path: str) -> InputError:
+def _characteristic_toml(c: Characteristic) -> dict[str, Any] | list[dict[str, Any]]:
+    """``[characteristic]``, or for several tables ``[[characteristic]]`` with the converter-wide
+    rules written in the first table."""
+
+    def one(t: Characteristic, rules: bool) -> dict[str, Any]:
+        out: dict[str, Any] = {}
+        if t.input_torque_nm is not None:
+            out["input_torque_nm"] = float(t.input_torque_nm)
+        out |= {
+            "speed_ratio": t.speed_ratio.tolist(),
+            "torque_ratio": t.torque_ratio.tolist(),
+            "capacity_factor_nm_s2": t.capacity_factor_nm_s2.tolist(),
+        }
+        return out | (dict(t.core_rules()) if rules else {})
+
+    if not c.by_torque:
+        return one(c, True)
+    return [one(t, i == 0) for i, t in enumerate(c.by_torque)]
+
+
+#: The keys of ``[characteristic]`` that apply to the whole converter: in ``[[characteristic]]`` each
+#: may be given in any of the tables, with the same value wherever it is given more than once.
+CONVERTER_WIDE_KEYS = ("overrun", "interpolation", "lag_time_constant_s")
+
+
+def _table_sections(items: Any, path: str) -> list[CharacteristicSection]:
+    """The tables of ``[[characteristic]]``, validated one by one (fields ``[characteristic][i].key``),
+    each with its ``input_torque_nm``."""
+    if not items:
+        raise InputError(path, "[characteristic]", "[]", "at least one [[characteristic]] table")
+    sections = []
+    for i, item in enumerate(items):
+        try:
+            section = CharacteristicSection.model_validate(item)
+        except ValidationError as err:
+            raise _pydantic_to_input_error(err, path, ("characteristic", i)) from None
+        if section.input_torque_nm is None:
+            raise InputError(
+                path,
+                f"[characteristic][{i}].input_torque_nm",
+                "missing",
+                "the input torque in N·m the table was measured at, in each [[characteristic]] table",
+            )
+        sections.append(section)
+    for key in CONVERTER_WIDE_KEYS:
+        given = [(i, getattr(t, key)) for i, t in enumerate(sections) if getattr(t, key) is not None]
+        for i, value in given[1:]:
+            if value != given[0][1]:
+                raise InputError(
+                    path,
+                    f"[characteristic][{i}].{key}",
+                    value,
+                    f"{given[0][1]!r} as in [characteristic][{given[0][0]}] ({key} applies to the whole converter)",
+                )
+    return sections
+
+
+def _rule(sections: list[CharacteristicSection], key: str) -> str | None:
+    return next((getattr(t, key) for t in sections if getattr(t, key) is not None), None)
+
+
+def _characteristic(doc: ConverterFile, tables: list[CharacteristicSection] | None, path: str) -> Characteristic | None:
+    """The validated characteristic of ``[characteristic]``, or of the ``[[characteristic]]`` ``tables``."""
+    sections = tables if tables is not None else ([doc.characteristic] if doc.characteristic is not None else [])
+    if not sections:
+        return None
+    overrun, interpolation = _rule(sections, "overrun"), _rule(sections, "interpolation")
+    prefixes = ["[characteristic]."] if tables is None else [f"[characteristic][{i}]." for i in range(len(sections))]
+    out = []
+    for section, where in zip(sections, prefixes, strict=True):
+        key, values = section.capacity()
+        out.append(
+            Characteristic.from_columns(
+                section.speed_ratio,
+                section.torque_ratio,
+                values,
+                key,
+                path,
+                where,
+                overrun=overrun,
+                interpolation=interpolation,
+                input_torque_nm=section.input_torque_nm,
+            )
+        )
+    if len(out) == 1:  # [characteristic], or an array of one table: that table alone
+        return out[0]
+    return Characteristic.torque_dependent(out, path, prefixes)
+
+
+def _pydantic_to_input_error(err: ValidationError, path: str, prefix: tuple[Any, ...] = ()) -> InputError:
     e = err.errors()[0]
-    loc = [str(x) for x in e["loc"]]
+    loc = [str(x) for x in (*prefix, *e["loc"])]
     if loc and loc[0] in _SECTIONS + ("sources",):
         head = f"[{loc[0]}]"
         rest = "".join(f"[{x}]" if x.isdigit() else f".{x}" for x in loc[1:])
@@ -261,6 +348,10 @@ def warn_implausible_design(doc: ConverterFile, path: str) -> None:
 
 def parse_converter(data: dict[str, Any], path: str) -> Converter:
     """Validate a parsed TOML document."""
+    tables = None
+    if isinstance(data.get("characteristic"), list):  # [[characteristic]]: torque-dependent capacity
+        tables = _table_sections(data["characteristic"], path)
+        data = {k: v for k, v in data.items() if k != "characteristic"}
     try:
         doc = ConverterFile.model_validate(data)
     except ValidationError as err:
@@ -268,22 +359,11 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
     for key in doc.sources:
         section, _, name = key.partition(".")
         model = getattr(doc, section, None) if section in _SECTIONS else None
+        if section == "characteristic" and tables is not None:
+            model = tables[0]
         if model is None or name not in type(model).model_fields:
             raise InputError(path, "[sources]", key, "a key 'section.name' naming a value of this converter")
-    characteristic = None
-    if doc.characteristic is not None:
-        key, values = doc.characteristic.capacity()
-        table = doc.characteristic
-        characteristic = Characteristic.from_columns(
-            table.speed_ratio,
-            table.torque_ratio,
-            values,
-            key,
-            path,
-            "[characteristic].",
-            overrun=table.overrun,
-            interpolation=table.interpolation,
-        )
+    characteristic = _characteristic(doc, tables, path)
     if doc.geometry is not None:
         try:
             _core.ht_check_geometry(doc.geometry.core_row())
@@ -300,7 +380,9 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
         doc.quasi_dynamic,
         doc.description,
         dict(doc.sources),
-        None if doc.characteristic is None else doc.characteristic.lag_time_constant_s,
+        _rule(tables if tables is not None else [doc.characteristic], "lag_time_constant_s")
+        if tables is not None or doc.characteristic is not None
+        else None,
     )
 
 

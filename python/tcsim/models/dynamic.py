@@ -13,7 +13,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError, from_core
 from ..units import DEFAULT_PUMP_SPEED_RAD_S
-from .characteristic import CoreRules, warn_if_extended
+from .characteristic import warn_if_extended
 from .converter import MODELS, Converter, load_converter
 
 #: Pump speed at which the default quasi-dynamic flow time constant is evaluated (stall), rad/s:
@@ -46,14 +46,14 @@ class DynamicModel:
         reached the overrun rule's extension of the table (:func:`~.characteristic.warn_if_extended`)."""
         if self.name not in ("table", "quasi-dynamic"):
             return
-        s = self.spec
-        table = (np.asarray(s["speed_ratio"]), np.asarray(s["torque_ratio"]), np.asarray(s["capacity_factor_nm_s2"]))
-        rules = CoreRules()
-        if "overrun" in s:
-            rules["overrun"] = str(s["overrun"])
-        if "interpolation" in s:
-            rules["interpolation"] = str(s["interpolation"])
-        warn_if_extended(self.source, table, rules, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"], what)
+        keys = (*TABLE_SPEC_KEYS, "overrun", "interpolation")
+        table: dict[str, Any] = {}
+        for k, v in self.spec.items():
+            if k in ("input_torque_nm", "table_rows"):
+                table[k] = [float(x) for x in v]
+            elif k in keys:
+                table[k] = v if isinstance(v, str) else np.asarray(v, dtype=float)
+        warn_if_extended(self.source, table, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"], what)
 
     def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:
         """The same model with other shape effects (eqs 2.16–2.18 sign convention)."""
@@ -72,15 +72,15 @@ def _require(conv: Converter, section: str, model: str) -> Any:
     return value
 
 
+#: The model specification's table keys (``input_torque_nm`` and ``table_rows`` for several tables).
+TABLE_SPEC_KEYS = ("speed_ratio", "torque_ratio", "capacity_factor_nm_s2", "input_torque_nm", "table_rows")
+
+
 def _table_spec(conv: Converter) -> dict[str, Any]:
+    """The table keys of the specification: :meth:`~.characteristic.Characteristic.core_table` as lists."""
     c = conv.characteristic
     assert c is not None  # the caller's conv.require(model) checked it
-    return {
-        "speed_ratio": c.speed_ratio.tolist(),
-        "torque_ratio": c.torque_ratio.tolist(),
-        "capacity_factor_nm_s2": c.capacity_factor_nm_s2.tolist(),
-        **c.core_rules(),
-    }
+    return {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in c.core_table().items()}
 
 
 def _inertia(conv: Converter, model: str) -> list[float]:

@@ -90,8 +90,8 @@ def _speed_error(e: Exception, pump_speed_rpm: float, converter_file: str, field
 def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
     """A sweep over the table's own range that contains every table point."""
     assert conv.characteristic is not None  # the callers' conv.require checked it
-    sr = conv.characteristic.speed_ratio
-    return np.unique(np.concatenate([np.linspace(sr[0], sr[-1], n), sr]))
+    sr = np.concatenate([t.speed_ratio for t in conv.characteristic.tables()])
+    return np.unique(np.concatenate([np.linspace(sr.min(), sr.max(), n), sr]))
 
 
 def characterise_table(
@@ -111,10 +111,11 @@ def characterise_table(
     sr = table_speed_ratios(conv) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
     pump = np.full(sr.shape, wp)
     assert conv.characteristic is not None  # conv.require("table") checked it
-    table_sr, table_tr, table_cf = conv.characteristic.arrays()
+    table = conv.characteristic.core_table()
     try:
-        rules = conv.characteristic.core_rules()
-        out = _core.table_steady_states(table_sr, table_tr, table_cf, pump, np.ascontiguousarray(sr * wp), **rules)
+        out = _core.table_steady_states(
+            **table, pump_speed_rad_s=pump, turbine_speed_rad_s=np.ascontiguousarray(sr * wp)
+        )
     except _core.CoreInputError as e:
         raise _speed_error(e, pump_speed_rpm, conv.path) from None
     conv.characteristic.warn_if_extended(pump, sr * wp, "the characteristic")
@@ -306,7 +307,7 @@ def sweep_speed_ratios(conv: Converter, model: str, text: str) -> np.ndarray:
         extra = np.array([] if cp is None else [cp])
     else:
         assert conv.characteristic is not None  # the caller's conv.require checked it
-        extra = conv.characteristic.speed_ratio
+        extra = np.unique(np.concatenate([t.speed_ratio for t in conv.characteristic.tables()]))
     inside = extra[(extra >= grid[0]) & (extra <= grid[-1])]
     step = float(grid[1] - grid[0]) if grid.size > 1 else 1.0
     # a grid point within round-off of an added one is that point (0.05·6 is the table's 0.3)
@@ -380,8 +381,8 @@ def steady_state(conv: Converter, model: str, pump_speed_rad_s, turbine_speed_ra
             df = _ht_frame(conv, wp, wt, wt / wp, strict=False)
         else:
             assert conv.characteristic is not None  # conv.require checked it
-            rules = conv.characteristic.core_rules()
-            out = _core.table_steady_states(*conv.characteristic.arrays(), wp, wt, **rules, lenient=True)
+            table = conv.characteristic.core_table()
+            out = _core.table_steady_states(**table, pump_speed_rad_s=wp, turbine_speed_rad_s=wt, lenient=True)
             conv.characteristic.warn_if_extended(wp, wt, "the steady states")
             df = _table_frame(out, out["speed_ratio"], wp, wt)
         return _order(_derived(df))
@@ -393,8 +394,54 @@ def characterise(
     pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
     speed_ratio: np.ndarray | None = None,
     allow_implausible: bool = False,
+    input_torque_nm: float | None = None,
 ) -> pd.DataFrame:
     """Steady-state characteristic of ``conv`` with ``model`` (``table``, ``hrovat-tobler``, ``quasi-dynamic``).
+
+    At the fixed pump speed ``pump_speed_rpm``, or with ``input_torque_nm`` (N·m) at that fixed pump
+    (input) torque, the pump speed solved at each speed ratio (:func:`characterise_at_input_torque`).
     A pump speed outside the plausible range (``speed_rad_s``) is refused unless ``allow_implausible``."""
     conv.require(model)
+    if input_torque_nm is not None:
+        return characterise_at_input_torque(conv, model, input_torque_nm, speed_ratio)
     return CHARACTERISE[model](conv, pump_speed_rpm, speed_ratio, allow_implausible)
+
+
+def characterise_at_input_torque(
+    conv: Converter, model: str, input_torque_nm: float, speed_ratio: np.ndarray | None = None
+) -> pd.DataFrame:
+    """Steady states at a fixed pump (input) torque ``input_torque_nm``, N·m, over ``speed_ratio``
+    (default: the sweep of :func:`characterise`), the positive pump speed solved in the core.
+
+    Table and quasi-dynamic: ``ω_p = √(T/CF(SR, T))``, the tables weighted at T
+    (docs/torque_capacity.md). Hrovat & Tobler: the pump speed at which its steady state carries T
+    (a 1-D iteration in the core). A speed ratio at which no positive pump speed carries T (T of the
+    other sign than the model's pump torque there, e.g. a drive torque in overrun) is a row of NaN
+    (``extrapolated`` false; Hrovat & Tobler: ``stator_mode`` ``no-steady-state``).
+
+    Raises
+    ------
+    InputError
+        ``--input-torque-nm`` not a finite, non-zero number.
+    """
+    conv.require(model)
+    if not (np.isfinite(input_torque_nm) and input_torque_nm != 0.0):
+        raise InputError("command line", "--input-torque-nm", input_torque_nm, "a finite, non-zero torque in N·m")
+    t = float(input_torque_nm)
+    if model == "hrovat-tobler":
+        sr = np.linspace(0.0, 1.0, 101) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
+        if speed_ratio is None and (cp := coupling_point(conv)) is not None:
+            sr = np.unique(np.append(sr, cp))
+        sr = np.ascontiguousarray(sr, dtype=float)
+        wp = _core.ht_pump_speeds_at_pump_torque(conv.core_geometry(), t, sr)
+        with np.errstate(invalid="ignore"):
+            return _order(_derived(_ht_frame(conv, wp, sr * wp, sr, strict=False)))
+    sr = np.ascontiguousarray(table_speed_ratios(conv) if speed_ratio is None else speed_ratio, dtype=float)
+    assert conv.characteristic is not None  # conv.require checked it
+    out = _core.table_steady_states_at_pump_torque(
+        **conv.characteristic.core_table(), pump_torque_nm=t, at_speed_ratio=sr
+    )
+    wp, wt = out["pump_speed_rad_s"], out["turbine_speed_rad_s"]
+    conv.characteristic.warn_if_extended(wp, wt, "the characteristic")
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return _order(_derived(_table_frame(out, sr, wp, wt)))

@@ -3,7 +3,9 @@
 CSV: a header with ``speed_ratio``, ``torque_ratio`` and exactly one capacity column
 (``capacity_factor_nm_s2``, ``k_factor_rpm_per_sqrt_nm``, ``k_factor_rad_s_per_sqrt_nm``,
 ``k_factor_rpm_per_sqrt_lbf_ft``, ``capacity_nm_per_rpm2`` or ``mp1000_nm``); lines starting
-with ``#`` are comments.
+with ``#`` are comments. An optional ``input_torque_nm`` column makes it the table-alone form of a
+torque-dependent converter (docs/torque_capacity.md): the rows with the same input torque form one
+table, in their order in the file.
 
 VECTO ``.vtcc`` (VECTO's torque-converter characteristic): a header such as
 ``Speed Ratio, Torque Ratio,MP1000`` and three columns, speed ratio, torque ratio and the input
@@ -76,13 +78,15 @@ def read_table_csv(path: Path) -> Characteristic:
         if required not in header:
             raise InputError(str(path), f"line {header_line} (header)", ",".join(header), f"a {required} column")
     capacity = [h for h in header if h in CAPACITY_KEYS]
-    unknown = [h for h in header if h not in CAPACITY_KEYS and h not in ("speed_ratio", "torque_ratio")]
+    known = ("speed_ratio", "torque_ratio", "input_torque_nm")
+    unknown = [h for h in header if h not in CAPACITY_KEYS and h not in known]
     if unknown:
         raise InputError(
             str(path),
             f"line {header_line} (header)",
             unknown[0],
-            f"only speed_ratio, torque_ratio and one capacity column of {', '.join(CAPACITY_KEYS)}",
+            f"only speed_ratio, torque_ratio, one capacity column of {', '.join(CAPACITY_KEYS)} "
+            "and optionally input_torque_nm",
         )
     if len(capacity) != 1:
         raise InputError(
@@ -92,11 +96,37 @@ def read_table_csv(path: Path) -> Characteristic:
             f"exactly one capacity column of {', '.join(CAPACITY_KEYS)}",
         )
     cols, lines = _columns(path, rows[1:], header)
-    table = Characteristic.from_columns(
-        cols["speed_ratio"], cols["torque_ratio"], cols[capacity[0]], capacity[0], str(path), rows=lines
-    )
-    table.warn_if_implausible()
+    if "input_torque_nm" in cols:
+        table = _torque_tables(path, cols, lines, capacity[0])
+    else:
+        table = Characteristic.from_columns(
+            cols["speed_ratio"], cols["torque_ratio"], cols[capacity[0]], capacity[0], str(path), rows=lines
+        )
+    for t in table.tables():
+        t.warn_if_implausible()
     return table
+
+
+def _torque_tables(path: Path, cols: dict[str, list[float]], lines: list[int], capacity: str) -> Characteristic:
+    """The tables of a CSV with an ``input_torque_nm`` column: the rows of each input torque, in
+    file order (each torque finite and positive)."""
+    torques: list[float] = []
+    for t, line in zip(cols["input_torque_nm"], lines, strict=True):
+        if not t > 0:
+            raise InputError(str(path), f"line {line}, input_torque_nm", t, "a positive input torque in N·m")
+        if t not in torques:
+            torques.append(t)
+    tables = []
+    for t in torques:
+        rows = [i for i, v in enumerate(cols["input_torque_nm"]) if v == t]
+        sr, tr, cap = ([c[i] for i in rows] for c in (cols["speed_ratio"], cols["torque_ratio"], cols[capacity]))
+        line_numbers = [lines[i] for i in rows]
+        tables.append(
+            Characteristic.from_columns(sr, tr, cap, capacity, str(path), rows=line_numbers, input_torque_nm=t)
+        )
+    if len(tables) == 1:
+        return tables[0]
+    return Characteristic.torque_dependent(tables, str(path), [f"rows with input_torque_nm {t:g}, " for t in torques])
 
 
 def read_vtcc(path: Path) -> Characteristic:

@@ -22,7 +22,7 @@
 //! and stator; the torque delivered to the transmission is `−T_ext[TURBINE]`.
 
 use super::hrovat_tobler::{steady_state, HtGeometry, HtParam};
-use super::table::Characteristic;
+use super::torque_capacity::TorqueCharacteristic;
 use crate::error::{CoreError, CoreResult};
 
 pub const PUMP: usize = 0;
@@ -126,12 +126,13 @@ pub use crate::error::sig;
 
 /// The steady-state table model with inertias (Li & Sundén 2016, eqs 2.8–2.11):
 /// `I_p ω̇_p = T_p − CF(SR) ω_p|ω_p|`, `I_t ω̇_t = TR(SR) CF(SR) ω_p|ω_p| + T_t` in drive, and
-/// the table's law in every other quadrant as [`Characteristic::torques`] defines it (passive,
+/// the table's law in every other quadrant as [`TorqueCharacteristic::torques`] defines it (passive,
 /// continuous; the overrun rule beyond the table's rows). With a [`TorqueLag`] the pump torque
 /// follows the table's with a first-order lag (docs/lag.md).
 #[derive(Debug, Clone)]
 pub struct TableDynamics {
-    pub characteristic: Characteristic,
+    /// One table, or several measured at different input torques ([`TorqueCharacteristic`]).
+    pub characteristic: TorqueCharacteristic,
     pub inertia: Inertias,
     /// The first-order lag of the transferred torques (`[characteristic] lag_time_constant_s`);
     /// None: the table's torques act at once, the model of eqs 2.8–2.11.
@@ -183,21 +184,21 @@ impl TorqueLag {
 }
 
 /// Table torques `(T_p,tr, T_t,tr)` and their gradients with respect to (ω_p, ω_t), in every
-/// quadrant ([`Characteristic::torques`]).
-pub(super) fn table_torques(c: &Characteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [f64; 2]) {
+/// quadrant ([`TorqueCharacteristic::torques`]).
+pub(super) fn table_torques(c: &TorqueCharacteristic, wp: f64, wt: f64) -> (f64, f64, [f64; 2], [f64; 2]) {
     let t = c.torques(wp, wt);
     (t.pump_nm, t.delivered_nm, t.d_pump, t.d_delivered)
 }
 
 /// Pump speed of a table steady state, and the table's pump torque there.
-pub(super) fn table_steady(c: &Characteristic, wp: f64, wt: f64) -> CoreResult<f64> {
+pub(super) fn table_steady(c: &TorqueCharacteristic, wp: f64, wt: f64) -> CoreResult<f64> {
     let op = c.operating_point(wp, wt)?;
     Ok(op.pump_torque_nm)
 }
 
 /// The lagged torques `(T_p,tr, T_t,tr)` at speeds (`wp`, `wt`) and lagged pump torque `z`, with
 /// their gradients with respect to (ω_p, ω_t, T_lag), after the passivity rule ([`TorqueLag`]).
-pub(super) fn lagged_torques(c: &Characteristic, wp: f64, wt: f64, z: f64) -> (f64, f64, [f64; 3], [f64; 3]) {
+pub(super) fn lagged_torques(c: &TorqueCharacteristic, wp: f64, wt: f64, z: f64) -> (f64, f64, [f64; 3], [f64; 3]) {
     let t = c.torques(wp, wt);
     let tr = t.torque_ratio;
     let (tp, td) = (z, tr * z);
@@ -747,6 +748,7 @@ impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
 mod tests {
     use super::*;
     use crate::converter::quasi_dynamic::QuasiDynamics;
+    use crate::converter::table::Characteristic;
 
     pub(crate) fn c1() -> Characteristic {
         Characteristic::new(
@@ -770,7 +772,7 @@ mod tests {
 
     fn qd() -> QuasiDynamics {
         QuasiDynamics {
-            characteristic: c1(),
+            characteristic: c1().into(),
             inertia: inertia(),
             fluid_density_kg_m3: 840.0,
             pump_radius_m: 0.12,
@@ -829,7 +831,7 @@ mod tests {
         }
         // points inside table segments (the table is piecewise linear)
         for u in [[200.0, 33.0, 0.0, 0.1], [210.0, 170.0, 0.0, 0.05], [150.0, 160.0, 0.0, 0.02]] {
-            check_jacobian(&TableDynamics { characteristic: c1(), inertia: inertia(), lag: None }, u, 1.0);
+            check_jacobian(&TableDynamics { characteristic: c1().into(), inertia: inertia(), lag: None }, u, 1.0);
             check_jacobian(&qd(), u, 1.0);
         }
     }
@@ -844,7 +846,17 @@ mod tests {
             vec![3.5e-3, 3.5e-3, 3.9e-3, 2.7e-3, 0.0, -1.5e-3, -2.4e-3],
         )
         .unwrap();
-        let tables = [c1(), c1().with_rules(None, Some("k_factor")).unwrap(), coast];
+        // and a torque-dependent pair (C.1 at 100 N·m, C.1 with CF +20 % and TR nearer 1 at 300 N·m):
+        // the solved input torque's gradient enters the Jacobian
+        let heavier = Characteristic::new(
+            c1().speed_ratio().to_vec(),
+            c1().torque_ratio().iter().map(|t| 1.0 + 0.8 * (t - 1.0)).collect(),
+            c1().capacity_factor_nm_s2().iter().map(|c| 1.2 * c).collect(),
+        )
+        .unwrap();
+        let pair = TorqueCharacteristic::new(vec![100.0, 300.0], vec![c1(), heavier]).unwrap();
+        let tables: [TorqueCharacteristic; 4] =
+            [c1().into(), c1().with_rules(None, Some("k_factor")).unwrap().into(), coast.into(), pair];
         let points = [
             [200.0, 90.0],   // drive
             [200.0, -60.0],  // roll-back, SR in [−1, 0]
@@ -868,7 +880,7 @@ mod tests {
     }
 
     fn lagged(t: Characteristic, tc: f64) -> TableDynamics {
-        TableDynamics { characteristic: t, inertia: inertia(), lag: Some(TorqueLag::new(tc).unwrap()) }
+        TableDynamics { characteristic: t.into(), inertia: inertia(), lag: Some(TorqueLag::new(tc).unwrap()) }
     }
 
     /// The lag's Jacobian, with the passivity rule inactive (drive) and active (a lagged torque of
@@ -930,7 +942,7 @@ mod tests {
     #[test]
     fn lagged_table_steady_state_is_the_table() {
         let m = lagged(c1(), 0.2);
-        let plain = TableDynamics { characteristic: c1(), inertia: inertia(), lag: None };
+        let plain = TableDynamics { characteristic: c1().into(), inertia: inertia(), lag: None };
         for (wp, wt) in [(200.0, 100.0), (200.0, 400.0), (0.0, 300.0), (-150.0, 40.0), (100.0, -350.0)] {
             let p = m.steady_point(wp, wt).unwrap();
             assert_eq!(p.u[FLOW], p.pump_torque_nm);

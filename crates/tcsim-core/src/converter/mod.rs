@@ -6,6 +6,7 @@
 //! * [`hrovat_tobler`]: the Hrovat & Tobler model's closed-form steady state and coupling point.
 //! * [`dynamics`]: the mass-matrix model trait and types, the table and Hrovat & Tobler models.
 //! * [`quasi_dynamic`]: tcsim's quasi-dynamic model (tables plus fluid inertia).
+//! * [`torque_capacity`]: several tables measured at different input torques (torque-dependent capacity).
 //! * [`spec`]: building a model from a specification, and the default flow time constant.
 
 pub mod capacity;
@@ -14,3 +15,4 @@ pub mod hrovat_tobler;
 pub mod quasi_dynamic;
 pub mod spec;
 pub mod table;
+pub mod torque_capacity;

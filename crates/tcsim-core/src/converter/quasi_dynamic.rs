@@ -3,7 +3,7 @@
 use super::dynamics::{
     table_steady, table_torques, ConverterDynamics, Inertias, Mat4, SteadyPoint, Vec4, FLOW, PUMP, TURBINE,
 };
-use super::table::Characteristic;
+use super::torque_capacity::TorqueCharacteristic;
 use crate::error::{CoreError, CoreResult};
 
 /// tcsim's quasi-dynamic model: the steady-state tables plus fluid inertia (physics notes §5;
@@ -15,7 +15,7 @@ use crate::error::{CoreError, CoreResult};
 ///     Q̇ = (Q_ss − Q)/τ_Q,    Q_ss = CF(SR) |ω_p| / (ρ R_p²)
 /// ```
 ///
-/// in drive; in every other quadrant the torques are the table's ([`Characteristic::torques`]) and
+/// in drive; in every other quadrant the torques are the table's ([`TorqueCharacteristic::torques`]) and
 /// the steady flow follows the same regions: `Q_ss = −C(x)·m(x)·|ω_t| / (ρ R_p²)` where the
 /// turbine-referred capacity C(x) applies (x = ω_p/ω_t), negative in overrun, continuous at the
 /// region boundaries.
@@ -25,7 +25,8 @@ use crate::error::{CoreError, CoreResult};
 /// table's whatever the shape effects; with S = 0 the flow does not act on the speeds at all.
 #[derive(Debug, Clone)]
 pub struct QuasiDynamics {
-    pub characteristic: Characteristic,
+    /// One table, or several measured at different input torques (the pump torque solved).
+    pub characteristic: TorqueCharacteristic,
     pub inertia: Inertias,
     pub fluid_density_kg_m3: f64,
     pub pump_radius_m: f64,

@@ -4,6 +4,7 @@ use super::dynamics::{ConverterDynamics, HtDynamics, Inertias, TableDynamics, To
 use super::hrovat_tobler::{steady_state, HtGeometry, HtParam, N_PARAMS};
 use super::quasi_dynamic::QuasiDynamics;
 use super::table::Characteristic;
+use super::torque_capacity::TorqueCharacteristic;
 use crate::error::{CoreError, CoreResult};
 use crate::units::REFERENCE_PUMP_SPEED_RAD_S;
 
@@ -95,14 +96,7 @@ fn build_unchecked(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics
     let kind = spec.kind()?;
     let i = numbers(spec, "inertia_kg_m2", Some(3))?;
     let inertia = Inertias::new(i[0], i[1], i[2])?;
-    let table = || -> CoreResult<Characteristic> {
-        Characteristic::new(
-            numbers(spec, "speed_ratio", None)?,
-            numbers(spec, "torque_ratio", None)?,
-            numbers(spec, "capacity_factor_nm_s2", None)?,
-        )?
-        .with_rules(spec.text("overrun").as_deref(), spec.text("interpolation").as_deref())
-    };
+    let table = || characteristic(spec);
     if kind != "table" && spec.numbers(LAG_KEY).is_some() {
         return Err(CoreError::new(
             "characteristic.lag_time_constant_s",
@@ -140,6 +134,35 @@ fn build_unchecked(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics
         }
         other => return Err(CoreError::new("kind", other, "table, quasi-dynamic or hrovat-tobler")),
     })
+}
+
+/// The table(s) of a specification: `speed_ratio`, `torque_ratio`, `capacity_factor_nm_s2` and the
+/// converter's `overrun` and `interpolation`; with `input_torque_nm` (one torque per table, N·m) the
+/// columns hold the tables one after the other, `table_rows` rows each (torque-dependent capacity,
+/// [`TorqueCharacteristic`]). Without `input_torque_nm`: one table, exactly as before.
+pub fn characteristic(spec: &dyn ModelSpec) -> CoreResult<TorqueCharacteristic> {
+    let columns = [
+        numbers(spec, "speed_ratio", None)?,
+        numbers(spec, "torque_ratio", None)?,
+        numbers(spec, "capacity_factor_nm_s2", None)?,
+    ];
+    let (overrun, interpolation) = (spec.text("overrun"), spec.text("interpolation"));
+    match spec.numbers("input_torque_nm") {
+        None => {
+            let [sr, tr, cf] = columns;
+            Ok(Characteristic::new(sr, tr, cf)?.with_rules(overrun.as_deref(), interpolation.as_deref())?.into())
+        }
+        Some(torques) => {
+            let rows = numbers(spec, "table_rows", Some(torques.len()))?;
+            TorqueCharacteristic::from_columns(
+                torques,
+                &rows,
+                [&columns[0], &columns[1], &columns[2]],
+                overrun.as_deref(),
+                interpolation.as_deref(),
+            )
+        }
+    }
 }
 
 /// The default flow time constant τ_Q of the quasi-dynamic model, s: the fluid's inertance over the

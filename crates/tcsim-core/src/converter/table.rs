@@ -529,34 +529,46 @@ impl Characteristic {
         if !turbine_speed_rad_s.is_finite() {
             return Err(CoreError::new("turbine_speed_rad_s", turbine_speed_rad_s, "a finite turbine speed"));
         }
-        let t = self.torques(pump_speed_rad_s, turbine_speed_rad_s);
-        let (tp, t_delivered) = (t.pump_nm, t.delivered_nm);
-        if !(tp.is_finite() && t_delivered.is_finite() && (t_delivered - tp).is_finite()) {
-            let (field, value) = if pump_speed_rad_s.abs() >= turbine_speed_rad_s.abs() {
-                ("pump_speed_rad_s", pump_speed_rad_s)
-            } else {
-                ("turbine_speed_rad_s", turbine_speed_rad_s)
-            };
-            return Err(CoreError::of(
-                InputSource::Drive,
-                field,
-                value,
-                "a speed at which the steady torques are finite (they grow as the speed squared and overflow)",
-            ));
-        }
-        let capacity =
-            if pump_speed_rad_s == 0.0 { f64::NAN } else { tp / (pump_speed_rad_s * pump_speed_rad_s.abs()) };
-        Ok(TableOperatingPoint {
-            speed_ratio: turbine_speed_rad_s / pump_speed_rad_s,
-            torque_ratio: t.torque_ratio,
-            capacity_factor_nm_s2: capacity,
-            pump_torque_nm: tp,
-            turbine_torque_nm: t_delivered,
-            stator_torque_nm: t_delivered - tp,
-            extrapolated: t.extrapolated,
-            extension: t.extension,
-        })
+        operating_point_from(
+            pump_speed_rad_s,
+            turbine_speed_rad_s,
+            &self.torques(pump_speed_rad_s, turbine_speed_rad_s),
+        )
     }
+}
+
+/// The steady state at finite speeds `pump_speed_rad_s`, `turbine_speed_rad_s` (rad/s) whose
+/// torques are `t` (an error where they overflow).
+pub(crate) fn operating_point_from(
+    pump_speed_rad_s: f64,
+    turbine_speed_rad_s: f64,
+    t: &TableTorques,
+) -> CoreResult<TableOperatingPoint> {
+    let (tp, t_delivered) = (t.pump_nm, t.delivered_nm);
+    if !(tp.is_finite() && t_delivered.is_finite() && (t_delivered - tp).is_finite()) {
+        let (field, value) = if pump_speed_rad_s.abs() >= turbine_speed_rad_s.abs() {
+            ("pump_speed_rad_s", pump_speed_rad_s)
+        } else {
+            ("turbine_speed_rad_s", turbine_speed_rad_s)
+        };
+        return Err(CoreError::of(
+            InputSource::Drive,
+            field,
+            value,
+            "a speed at which the steady torques are finite (they grow as the speed squared and overflow)",
+        ));
+    }
+    let capacity = if pump_speed_rad_s == 0.0 { f64::NAN } else { tp / (pump_speed_rad_s * pump_speed_rad_s.abs()) };
+    Ok(TableOperatingPoint {
+        speed_ratio: turbine_speed_rad_s / pump_speed_rad_s,
+        torque_ratio: t.torque_ratio,
+        capacity_factor_nm_s2: capacity,
+        pump_torque_nm: tp,
+        turbine_torque_nm: t_delivered,
+        stator_torque_nm: t_delivered - tp,
+        extrapolated: t.extrapolated,
+        extension: t.extension,
+    })
 }
 
 /// C, TR_m and m of the turbine-referred region and their derivatives in x.

@@ -34,12 +34,12 @@ pub fn ht(shape: [f64; 3]) -> HtDynamics {
 }
 
 pub fn table() -> TableDynamics {
-    TableDynamics { characteristic: c1(), inertia: inertia(), lag: None }
+    TableDynamics { characteristic: c1().into(), inertia: inertia(), lag: None }
 }
 
 pub fn qd(sp: f64, st: f64) -> QuasiDynamics {
     QuasiDynamics {
-        characteristic: c1(),
+        characteristic: c1().into(),
         inertia: inertia(),
         fluid_density_kg_m3: 840.0,
         pump_radius_m: 0.12,
