@@ -59,5 +59,5 @@ def operating_point(
     msg = f"{model}: {len(df)} operating points written to {out}/operating_points.csv"
     if flagged:
         counts = df.loc[~df["valid"], "reason"].value_counts()
-        msg += f"; {flagged} flagged (" + ", ".join(f"{n} {r}" for r, n in counts.items()) + ")"
+        msg += f"; {flagged} flagged (" + ", ".join(f"{n} {r}" for r, n in counts.items() if n) + ")"
     say(msg)

@@ -109,7 +109,7 @@ def operating_point(
         One row per point: ``turbine_speed_rad_s``, ``turbine_torque_nm`` (given, or P/ω_t),
         ``pump_speed_rad_s`` (rad/s), ``pump_torque_nm`` (N·m, positive in drive), ``speed_ratio``
         (ω_t/ω_p), ``torque_ratio`` (the forward model's TR), ``efficiency`` (SR·TR), ``valid`` and
-        ``reason`` (``ok``, ``at-rest``, ``non-finite-input``, ``above-pump-speed-limit``,
+        ``reason`` (categorical: ``ok``, ``at-rest``, ``non-finite-input``, ``above-pump-speed-limit``,
         ``pump-against-turbine``, ``no-steady-state``, ``overflow``, ``power-at-standstill``;
         docs/operating_point.md). Where several pump speeds give the torque: the lowest one turning
         with the turbine. A NaN value always comes with a reason other than ``ok`` (or ``at-rest``,
@@ -142,8 +142,8 @@ def operating_point(
         rules = conv.characteristic.core_rules()
         arrays = conv.characteristic.arrays()
         out = _core.table_operating_points(*arrays, wt, torque, limit, **rules, turbine_power_w=power)
-        found = np.isfinite(out["pump_speed_rad_s"])
-        conv.characteristic.warn_if_extended(out["pump_speed_rad_s"][found], wt[found], "the operating points")
-    names = np.array([REASONS[code][0] for code in sorted(REASONS)], dtype=object)
-    out["reason"] = names[np.asarray(out["reason"], dtype=np.intp)]
+        overrun = out["speed_ratio"] > 1.0  # only overrun can reach the mirror extension (NaN: false)
+        conv.characteristic.warn_if_extended(out["pump_speed_rad_s"][overrun], wt[overrun], "the operating points")
+    names = [REASONS[code][0] for code in sorted(REASONS)]
+    out["reason"] = pd.Categorical.from_codes(np.asarray(out["reason"], dtype=np.intp), categories=names)
     return pd.DataFrame({"turbine_speed_rad_s": wt, **out}, columns=list(COLUMNS))
