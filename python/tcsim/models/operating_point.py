@@ -144,6 +144,6 @@ def operating_point(
         out = _core.table_operating_points(*arrays, wt, torque, limit, **rules, turbine_power_w=power)
         overrun = out["speed_ratio"] > 1.0  # only overrun can reach the mirror extension (NaN: false)
         conv.characteristic.warn_if_extended(out["pump_speed_rad_s"][overrun], wt[overrun], "the operating points")
-    names = [REASONS[code][0] for code in sorted(REASONS)]
+    names = pd.Index([REASONS[code][0] for code in sorted(REASONS)])
     out["reason"] = pd.Categorical.from_codes(np.asarray(out["reason"], dtype=np.intp), categories=names)
     return pd.DataFrame({"turbine_speed_rad_s": wt, **out}, columns=list(COLUMNS))
