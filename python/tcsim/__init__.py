@@ -7,7 +7,9 @@ and Hrovat & Tobler (1985). Units are SI and carried in every name (``convention
 Tiers:
 
 * one-liners: :func:`characterise` (a converter name or file and a model → DataFrame),
-  :func:`steady_state` (steady states at any pump and turbine speeds → DataFrame) and
+  :func:`steady_state` (steady states at any pump and turbine speeds → DataFrame),
+  :func:`operating_point` (the backward operating point: pump speed and torque from turbine speed
+  and torque → DataFrame) and
   :func:`simulate` (a converter, a drive and a model → :class:`~tcsim.transient.TransientResult`);
 * objects: :func:`load_converter` → :class:`Converter`, then :mod:`tcsim.steady` per model;
   :func:`dynamic_model` → :class:`~tcsim.transient.DynamicModel` and the drives of
@@ -18,6 +20,7 @@ Tiers:
 from __future__ import annotations
 
 from .errors import InputError, TcsimWarning
+from .models import operating_point as _operating_point
 from .models import steady as _steady
 from .models.characteristic import Characteristic
 from .models.converter import Converter, bundled_names, load_converter
@@ -37,6 +40,7 @@ __all__ = [
     "dynamic_model",
     "hrovat_tobler_steady_state",
     "load_converter",
+    "operating_point",
     "simulate",
     "simulate_batch",
     "steady_state",
@@ -63,3 +67,23 @@ def steady_state(converter, model: str, pump_speed_rad_s, turbine_speed_rad_s):
     :func:`tcsim.steady.steady_state`. ``converter`` is a bundled name, a path or a :class:`Converter`."""
     conv = converter if isinstance(converter, Converter) else load_converter(converter)
     return _steady.steady_state(conv, model, pump_speed_rad_s, turbine_speed_rad_s)
+
+
+def operating_point(
+    converter,
+    turbine_speed_rad_s,
+    turbine_torque_nm=None,
+    model: str = "table",
+    pump_speed_limit_rad_s: float | None = None,
+    *,
+    turbine_power_w=None,
+):
+    """Backward operating points: pump speed and torque of ``model``'s steady state at turbine speeds,
+    rad/s, delivering torques, N·m (or powers ``turbine_power_w``, W), with an optional pump speed
+    limit, rad/s; one row per point with ``valid`` and ``reason``. See
+    :func:`tcsim.models.operating_point.operating_point`. ``converter`` is a bundled name, a path or a
+    :class:`Converter`."""
+    conv = converter if isinstance(converter, Converter) else load_converter(converter)
+    return _operating_point.operating_point(
+        conv, turbine_speed_rad_s, turbine_torque_nm, model, pump_speed_limit_rad_s, turbine_power_w=turbine_power_w
+    )

@@ -131,6 +131,27 @@ def table_steady_states_at_pump_torque(
     table_rows: list[float] | None = None,
 ) -> dict[str, Any]: ...
 def ht_pump_speeds_at_pump_torque(geometry: _ArrayLike, pump_torque_nm: float, speed_ratio: _ArrayLike) -> _Array: ...
+def table_operating_points(
+    speed_ratio: _ArrayLike,
+    torque_ratio: _ArrayLike,
+    capacity_factor_nm_s2: _ArrayLike,
+    turbine_speed_rad_s: _ArrayLike,
+    turbine_torque_nm: _ArrayLike | None = None,
+    pump_speed_limit_rad_s: float | None = None,
+    overrun: str | None = None,
+    interpolation: str | None = None,
+    threads: int = 0,
+    turbine_power_w: _ArrayLike | None = None,
+) -> dict[str, Any]: ...
+def ht_operating_points(
+    geometry: _ArrayLike,
+    turbine_speed_rad_s: _ArrayLike,
+    turbine_torque_nm: _ArrayLike | None = None,
+    pump_speed_limit_rad_s: float | None = None,
+    threads: int = 0,
+    turbine_power_w: _ArrayLike | None = None,
+) -> dict[str, Any]: ...
+def operating_point_reasons() -> dict[int, tuple[str, bool]]: ...
 def smoothed_rate(time_s: _ArrayLike, values: _ArrayLike, window_s: float) -> _Array: ...
 def transient_columns() -> list[str]: ...
 def transient_runs(

@@ -24,6 +24,7 @@ use tcsim_core::batch::{
     ht_ratio_gradients as core_ratio_gradients, ht_steady_states_cancellable as core_steady_states,
     run_transient_jobs_cancellable, TransientJob,
 };
+use tcsim_core::converter::backward::{backward_points, Backward, Load, Reason};
 use tcsim_core::converter::capacity::CapacityConvention;
 use tcsim_core::converter::dynamics::ConverterDynamics;
 use tcsim_core::converter::dynamics::{Inertias, MassMatrixBound};
@@ -464,6 +465,104 @@ fn ht_pump_speeds_at_pump_torque<'py>(
                 .collect()
         });
         Ok(w.into_pyarray(py))
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Backward operating points
+
+/// The reason codes of the backward operating points: code → (name, valid).
+#[pyfunction]
+fn operating_point_reasons() -> BTreeMap<u8, (&'static str, bool)> {
+    Reason::ALL.iter().map(|r| (r.code(), (r.key(), r.valid()))).collect()
+}
+
+/// The columns of a batch of backward operating points as a dict of arrays.
+fn backward_dict<'py>(
+    py: Python<'py>,
+    b: &Backward,
+    wt: &PyReadonlyArray1<'py, f64>,
+    t: Option<PyReadonlyArray1<'py, f64>>,
+    power: Option<PyReadonlyArray1<'py, f64>>,
+    limit: Option<f64>,
+    threads: usize,
+) -> PyResult<Bound<'py, PyDict>> {
+    let wt = slice(wt, "turbine_speed_rad_s")?;
+    let (values, load) = match (&t, &power) {
+        (Some(t), None) => (slice(t, "turbine_torque_nm")?, Load::TorqueNm),
+        (None, Some(p)) => (slice(p, "turbine_power_w")?, Load::PowerW),
+        _ => return Err(PyValueError::new_err("give either turbine_torque_nm or turbine_power_w")),
+    };
+    let limit = limit.unwrap_or(f64::INFINITY);
+    let cols = cancellable(py, |cancel| match backward_points(b, wt, values, load, limit, threads, cancel) {
+        Ok(cols) => cols.map(Ok),
+        Err(e) => Some(Err(e)),
+    })?
+    .map_err(input_error)?;
+    let valid: Vec<bool> = cols.reason.iter().map(|&r| Reason::ALL[usize::from(r)].valid()).collect();
+    let d = PyDict::new(py);
+    d.set_item("turbine_torque_nm", cols.turbine_torque_nm.into_pyarray(py))?;
+    d.set_item("pump_speed_rad_s", cols.pump_speed_rad_s.into_pyarray(py))?;
+    d.set_item("pump_torque_nm", cols.pump_torque_nm.into_pyarray(py))?;
+    d.set_item("speed_ratio", cols.speed_ratio.into_pyarray(py))?;
+    d.set_item("torque_ratio", cols.torque_ratio.into_pyarray(py))?;
+    d.set_item("efficiency", cols.efficiency.into_pyarray(py))?;
+    d.set_item("valid", valid.into_pyarray(py))?;
+    d.set_item("reason", cols.reason.into_pyarray(py))?;
+    Ok(d)
+}
+
+/// Backward operating points of the table model (closed form per table segment): the pump speed and
+/// torque at turbine speed `turbine_speed_rad_s[i]` (rad/s) delivering `turbine_torque_nm[i]` (N·m,
+/// positive in drive; or `turbine_power_w[i]`, W, instead: T = P/ω_t), the pump speed at most
+/// `pump_speed_limit_rad_s` (None: no limit). Returns a
+/// dict of arrays with `valid` and the `reason` code of every point ([`operating_point_reasons`]).
+#[pyfunction]
+#[pyo3(signature = (speed_ratio, torque_ratio, capacity_factor_nm_s2, turbine_speed_rad_s, turbine_torque_nm=None, pump_speed_limit_rad_s=None, overrun=None, interpolation=None, threads=0, turbine_power_w=None))]
+#[allow(clippy::too_many_arguments)]
+fn table_operating_points<'py>(
+    py: Python<'py>,
+    speed_ratio: PyReadonlyArray1<'py, f64>,
+    torque_ratio: PyReadonlyArray1<'py, f64>,
+    capacity_factor_nm_s2: PyReadonlyArray1<'py, f64>,
+    turbine_speed_rad_s: PyReadonlyArray1<'py, f64>,
+    turbine_torque_nm: Option<PyReadonlyArray1<'py, f64>>,
+    pump_speed_limit_rad_s: Option<f64>,
+    overrun: Option<String>,
+    interpolation: Option<String>,
+    threads: usize,
+    turbine_power_w: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let c = characteristic(
+            &speed_ratio,
+            &torque_ratio,
+            &capacity_factor_nm_s2,
+            overrun.as_deref(),
+            interpolation.as_deref(),
+        )?;
+        let b = py.detach(|| Backward::table(&c));
+        backward_dict(py, &b, &turbine_speed_rad_s, turbine_torque_nm, turbine_power_w, pump_speed_limit_rad_s, threads)
+    })
+}
+
+/// Backward operating points of the Hrovat & Tobler model at steady state (one geometry row), as
+/// [`table_operating_points`].
+#[pyfunction]
+#[pyo3(signature = (geometry, turbine_speed_rad_s, turbine_torque_nm=None, pump_speed_limit_rad_s=None, threads=0, turbine_power_w=None))]
+fn ht_operating_points<'py>(
+    py: Python<'py>,
+    geometry: PyReadonlyArray2<'py, f64>,
+    turbine_speed_rad_s: PyReadonlyArray1<'py, f64>,
+    turbine_torque_nm: Option<PyReadonlyArray1<'py, f64>>,
+    pump_speed_limit_rad_s: Option<f64>,
+    threads: usize,
+    turbine_power_w: Option<PyReadonlyArray1<'py, f64>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let g = one_geometry(&geometry)?;
+        let b = py.detach(|| Backward::hrovat_tobler(&g));
+        backward_dict(py, &b, &turbine_speed_rad_s, turbine_torque_nm, turbine_power_w, pump_speed_limit_rad_s, threads)
     })
 }
 
@@ -1243,6 +1342,9 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(table_steady_states, m)?)?;
     m.add_function(wrap_pyfunction!(table_steady_states_at_pump_torque, m)?)?;
     m.add_function(wrap_pyfunction!(ht_pump_speeds_at_pump_torque, m)?)?;
+    m.add_function(wrap_pyfunction!(table_operating_points, m)?)?;
+    m.add_function(wrap_pyfunction!(ht_operating_points, m)?)?;
+    m.add_function(wrap_pyfunction!(operating_point_reasons, m)?)?;
     m.add_function(wrap_pyfunction!(transient_columns, m)?)?;
     m.add_function(wrap_pyfunction!(smoothed_rate, m)?)?;
     m.add_function(wrap_pyfunction!(launch_columns, m)?)?;

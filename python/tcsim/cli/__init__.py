@@ -6,12 +6,13 @@ they use when they run, so that ``tcsim --help`` starts fast.
 
 from __future__ import annotations
 
-from . import characterise, converters, export_fmu, fit, fit_shapes, launch, replay, study
+from . import characterise, converters, export_fmu, fit, fit_shapes, launch, operating_point, replay, study
 from .app import app, main
 
 # registered in the order ``tcsim --help`` lists them
 app.command()(converters.converters)
 app.command()(characterise.characterise)
+app.command("operating-point", help=operating_point.HELP)(operating_point.operating_point)
 app.command()(fit.fit)
 app.command()(study.study)
 app.command()(replay.replay)

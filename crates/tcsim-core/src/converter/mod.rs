@@ -1,6 +1,8 @@
 //! The converter models: characteristic tables, the Hrovat & Tobler closed form, and the three
 //! models in mass-matrix form for the transient engines. Depends on nothing above it.
 //!
+//! * [`backward`]: the backward (quasi-static) operating point: pump speed and torque from the
+//!   turbine speed and torque.
 //! * [`capacity`]: the six capacity conventions of characteristic tables.
 //! * [`table`]: the steady-state look-up-table model (Li & Sundén 2016, eqs 2.8–2.11).
 //! * [`hrovat_tobler`]: the Hrovat & Tobler model's closed-form steady state and coupling point.
@@ -9,6 +11,7 @@
 //! * [`torque_capacity`]: several tables measured at different input torques (torque-dependent capacity).
 //! * [`spec`]: building a model from a specification, and the default flow time constant.
 
+pub mod backward;
 pub mod capacity;
 pub mod dynamics;
 pub mod hrovat_tobler;
