@@ -5,6 +5,7 @@ bundled data."""
 from __future__ import annotations
 
 import importlib
+import re
 from pathlib import Path
 
 import pytest
@@ -85,7 +86,20 @@ def test_every_name_of_all_imports(name):
     exec(f"from tcsim import {name}", {})  # noqa: S102 - the import statement itself
 
 
-@pytest.mark.parametrize("dotted", DOCUMENTED)
+def names_in_docs() -> set[str]:
+    """Every dotted ``tcsim.…`` name written in README.md and docs/*.md (so that a page added or
+    edited cannot name what does not exist)."""
+    pattern = re.compile(r"(?<![\w/.-])tcsim(?:\.[A-Za-z_]\w*)+")
+    pages = [REPO / "README.md", *sorted((REPO / "docs").glob("*.md"))]
+    return {m.group(0) for page in pages for m in pattern.finditer(page.read_text(encoding="utf-8"))}
+
+
+def test_the_docs_name_the_api_they_describe():
+    found = names_in_docs()
+    assert {"tcsim.operating_point", "tcsim.characterise", "tcsim.transient"} <= found, sorted(found)
+
+
+@pytest.mark.parametrize("dotted", sorted(set(DOCUMENTED) | names_in_docs()))
 def test_documented_names_resolve(dotted):
     assert resolve(dotted) is not None
 

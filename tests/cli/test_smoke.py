@@ -15,7 +15,8 @@ pytestmark = pytest.mark.subprocess
 def test_help_lists_every_command():
     r = run_cli("--help")
     assert r.code == 0, r.stderr
-    for command in ("launch", "converters", "characterise", "fit", "study", "replay", "fit-shapes", "export-fmu"):
+    commands = ("launch", "converters", "characterise", "fit", "study", "replay", "fit-shapes", "export-fmu")
+    for command in (*commands, "operating-point"):
         assert command in r.stdout
 
 

@@ -19,6 +19,7 @@ import pytest
 
 import tcsim
 from tcsim.errors import InputError, TcsimWarning
+from tcsim.io.results import non_finite_columns
 from tcsim.models.converter import bundled_names, load_converter
 from tcsim.models.operating_point import COLUMNS
 
@@ -170,6 +171,20 @@ def test_cli_writes_the_operating_points(cli, tmp_path):
     np.testing.assert_allclose(df["pump_speed_rad_s"], api["pump_speed_rad_s"], rtol=1e-15)
     assert df["reason"].tolist() == api["reason"].tolist()
     assert "3 operating points written" in r.stdout + r.stderr
+
+
+def test_flagged_points_are_written_without_an_overflow_warning(cli, tmp_path):
+    """A flagged point's empty values are explained by its reason; a valid point with a non-finite
+    value would still be warned about (the writer's check, io.results.non_finite_columns)."""
+    points = _points(tmp_path, "turbine_speed_rad_s,turbine_torque_nm\n100,50\n1e200,1e300\n")
+    r = cli("operating-point", "li-sunden-2016", points, "--out", tmp_path / "o")
+    assert r.code == 0, r.stderr
+    df = pd.read_csv(tmp_path / "o" / "operating_points.csv")
+    assert df["reason"].tolist() == ["ok", "overflow"] and df["pump_speed_rad_s"].isna().tolist() == [False, True]
+    assert "non-finite" not in r.stdout + r.stderr, r.stderr
+    assert non_finite_columns(df) == {}
+    df.loc[1, "valid"] = True  # the same NaN in a point called valid is reported
+    assert non_finite_columns(df) == {"pump_speed_rad_s": 1, "pump_torque_nm": 1}
 
 
 def test_cli_reads_powers_from_parquet_and_other_models(cli, tmp_path):

@@ -540,8 +540,11 @@ fn table_operating_points<'py>(
             &capacity_factor_nm_s2,
             overrun.as_deref(),
             interpolation.as_deref(),
+            None,
+            None,
         )?;
-        let b = py.detach(|| Backward::table(&c));
+        let c = c.single().ok_or_else(|| PyValueError::new_err("one table"))?;
+        let b = py.detach(|| Backward::table(c));
         backward_dict(py, &b, &turbine_speed_rad_s, turbine_torque_nm, turbine_power_w, pump_speed_limit_rad_s, threads)
     })
 }

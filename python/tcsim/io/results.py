@@ -37,9 +37,14 @@ def _partly_nan(df: pd.DataFrame, name: str) -> np.ndarray:
 def non_finite_columns(df: pd.DataFrame) -> dict[str, int]:
     """Columns of ``df`` that hold a value a result file must not hold silently, with their count:
     ±inf anywhere but in :data:`INFINITE_ALLOWED`; NaN in a physical quantity
-    (:data:`NAN_NOT_EXPECTED`) of a run that has it at other samples."""
+    (:data:`NAN_NOT_EXPECTED`) of a run that has it at other samples. Rows that a boolean ``valid``
+    column flags as invalid are explained by their ``reason`` (the backward operating points) and
+    not counted."""
     out = {}
     df = df.reset_index(drop=True)
+    explained = np.zeros(len(df), dtype=bool)
+    if "valid" in df.columns and "reason" in df.columns and pd.api.types.is_bool_dtype(df["valid"]):
+        explained = ~df["valid"].to_numpy()
     for name in df.columns:
         col = df[name]
         if name == "model" or not pd.api.types.is_numeric_dtype(col) or pd.api.types.is_bool_dtype(col):
@@ -49,6 +54,7 @@ def non_finite_columns(df: pd.DataFrame) -> dict[str, int]:
             bad |= _partly_nan(df, name)
         if name not in INFINITE_ALLOWED:
             bad |= np.isinf(col.to_numpy(dtype=float))
+        bad &= ~explained
         if bad.any():
             out[str(name)] = int(bad.sum())
     return out

@@ -267,6 +267,13 @@ def _rule(sections: list[CharacteristicSection], key: str) -> str | None:
     return next((getattr(t, key) for t in sections if getattr(t, key) is not None), None)
 
 
+def _lag(doc: ConverterFile, tables: list[CharacteristicSection] | None) -> float | None:
+    """``lag_time_constant_s`` of ``[characteristic]`` or of any ``[[characteristic]]`` table (the same
+    in each table that gives it: :data:`CONVERTER_WIDE_KEYS`)."""
+    sections = tables if tables is not None else [doc.characteristic] if doc.characteristic is not None else []
+    return next((t.lag_time_constant_s for t in sections if t.lag_time_constant_s is not None), None)
+
+
 def _characteristic(doc: ConverterFile, tables: list[CharacteristicSection] | None, path: str) -> Characteristic | None:
     """The validated characteristic of ``[characteristic]``, or of the ``[[characteristic]]`` ``tables``."""
     sections = tables if tables is not None else ([doc.characteristic] if doc.characteristic is not None else [])
@@ -380,9 +387,7 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
         doc.quasi_dynamic,
         doc.description,
         dict(doc.sources),
-        _rule(tables if tables is not None else [doc.characteristic], "lag_time_constant_s")
-        if tables is not None or doc.characteristic is not None
-        else None,
+        _lag(doc, tables),
     )
 
 

@@ -73,6 +73,25 @@ def _load(source: str, wt, torque, power) -> tuple[np.ndarray, np.ndarray, str]:
     return flat[0], flat[1], name
 
 
+def _table_points(conv: Converter, wt: np.ndarray, torque, limit, power) -> dict:
+    """The core's backward points of the converter's single table (the table and quasi-dynamic
+    models); a torque-dependent characteristic is refused."""
+    c = conv.characteristic
+    assert c is not None  # conv.require checked it
+    if c.by_torque:
+        raise InputError(
+            conv.path,
+            "[characteristic]",
+            f"{len(c.by_torque)} tables by input torque",
+            "a single table: the backward operating point of a torque-dependent capacity is not built"
+            " (docs/operating_point.md)",
+        )
+    out = _core.table_operating_points(*c.arrays(), wt, torque, limit, **c.core_rules(), turbine_power_w=power)
+    overrun = out["speed_ratio"] > 1.0  # only overrun can reach the mirror extension (NaN: false)
+    c.warn_if_extended(out["pump_speed_rad_s"][overrun], wt[overrun], "the operating points")
+    return out
+
+
 def operating_point(
     conv: Converter,
     turbine_speed_rad_s,
@@ -120,7 +139,8 @@ def operating_point(
     InputError
         An unknown model, a converter without the model's sections, both or neither of torque and
         power, arguments that are not numbers or do not broadcast, a pump speed limit that is not
-        positive.
+        positive; for the table and quasi-dynamic models, a converter with several tables by input
+        torque (``[[characteristic]]``; not built).
 
     References
     ----------
@@ -138,12 +158,7 @@ def operating_point(
     if model == "hrovat-tobler":
         out = _core.ht_operating_points(conv.core_geometry(), wt, torque, limit, turbine_power_w=power)
     else:
-        assert conv.characteristic is not None  # conv.require checked it
-        rules = conv.characteristic.core_rules()
-        arrays = conv.characteristic.arrays()
-        out = _core.table_operating_points(*arrays, wt, torque, limit, **rules, turbine_power_w=power)
-        overrun = out["speed_ratio"] > 1.0  # only overrun can reach the mirror extension (NaN: false)
-        conv.characteristic.warn_if_extended(out["pump_speed_rad_s"][overrun], wt[overrun], "the operating points")
+        out = _table_points(conv, wt, torque, limit, power)
     names = pd.Index([REASONS[code][0] for code in sorted(REASONS)])
     out["reason"] = pd.Categorical.from_codes(np.asarray(out["reason"], dtype=np.intp), categories=names)
     return pd.DataFrame({"turbine_speed_rad_s": wt, **out}, columns=list(COLUMNS))

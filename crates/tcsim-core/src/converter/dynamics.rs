@@ -896,6 +896,34 @@ mod tests {
         }
     }
 
+    /// The lag on a torque-dependent characteristic (two tables, the input torque solved): the
+    /// mixed tables' torque-ratio gradient carries into the lag's Jacobian, and where the lag state
+    /// is the steady pump torque the lagged torques are the mixed table's.
+    #[test]
+    fn lagged_torque_dependent_table_jacobian_matches_finite_differences() {
+        let heavier = Characteristic::new(
+            c1().speed_ratio().to_vec(),
+            c1().torque_ratio().iter().map(|t| 1.0 + 0.8 * (t - 1.0)).collect(),
+            c1().capacity_factor_nm_s2().iter().map(|c| 1.2 * c).collect(),
+        )
+        .unwrap();
+        let pair = TorqueCharacteristic::new(vec![100.0, 300.0], vec![c1(), heavier]).unwrap();
+        let m = TableDynamics { characteristic: pair.clone(), inertia: inertia(), lag: TorqueLag::new(0.05).ok() };
+        let mut mixed = 0;
+        let points = [[250.0, 90.0], [200.0, 150.0], [300.0, 57.0], [180.0, 100.0], [-200.0, -70.0], [150.0, 410.0]];
+        for [wp, wt] in points {
+            let t = pair.torques(wp, wt);
+            let (a, b) = (c1().torques(wp, wt).torque_ratio, pair.tables()[1].torques(wp, wt).torque_ratio);
+            mixed += usize::from((t.torque_ratio - a).abs() > 1e-9 && (t.torque_ratio - b).abs() > 1e-9);
+            let f = m.forces(&[wp, wt, 0.0, t.pump_nm], 1.0);
+            assert_eq!((-f[PUMP], f[TURBINE], f[FLOW]), (t.pump_nm, t.torque_ratio * t.pump_nm, 0.0));
+            for z in [t.pump_nm, 0.5 * t.pump_nm, -t.pump_nm - 30.0] {
+                check_jacobian(&m, [wp, wt, 0.0, z], 1.0);
+            }
+        }
+        assert!(mixed >= 2, "only {mixed} points between the tables");
+    }
+
     /// Passivity of the lag: for random speeds and lagged torques the absorbed power is ≥ 0, the
     /// loss power is that absorbed power, and where the candidate pair is passive it is unchanged
     /// (the Simscape form `T_t = TR·T_lag`).
