@@ -13,6 +13,7 @@ import pandas as pd
 import pytest
 
 from tcsim import transient
+from tcsim.errors import InputError
 from tcsim.models import drives
 
 T_END_S = 6.0
@@ -238,3 +239,31 @@ def test_launch_lockup_events_as_before(cli, tmp_path):
         got = events[(events["model"] == model) & events["kind"].str.startswith("lockup")]
         assert list(got["kind"]) == [k for k, _ in expected], model
         assert np.allclose(got["time_s"], [t for _, t in expected], rtol=0, atol=1e-3), model
+
+
+# ---------------------------------------------------------------------------------------------
+# the capacity's range: 0 to 1e6 N·m (tcsim_core::engine::lockup::MAX_CAPACITY_NM)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_the_largest_capacity_locks_at_once_from_a_large_slip(model):
+    """1e6 N·m engaged at t = 0 against 600 N·m on the pump and a load driving the turbine backwards
+    (hundreds of rad/s of slip): the clutch locks within a millisecond and the run completes. (At
+    1e8 N·m this run's integrator failed: measured, the reason for the limit.)"""
+    t = np.linspace(0.0, 0.5, 51)
+    d = drives.PumpTorqueLoad(t, np.full_like(t, 600.0), 0.05, load_torque_nm=-500.0, lockup_capacity_nm=1e6)
+    run = transient.simulate("li-sunden-2016", d, model, times_s=t)
+    lock = next(e.time_s for e in run.events if e.kind == "lockup-lock")
+    assert lock < 1e-3
+    f = run.frame()
+    after = f[f["time_s"] > lock]
+    assert (after["lockup_state"] == 2).all() and (after["pump_speed_rad_s"] == after["turbine_speed_rad_s"]).all()
+
+
+@pytest.mark.parametrize("value", [1.0000001e6, 1e10, -1e-300])
+def test_a_capacity_outside_0_to_1e6_is_refused_by_the_drive(value):
+    t = np.linspace(0.0, 1.0, 11)
+    cap = np.where(t < 0.5, 0.0, value)
+    d = drives.PumpTorqueLoad(t, np.full_like(t, 200.0), 1.2, lockup_capacity_nm=cap)
+    with pytest.raises(InputError, match=r"lockup_capacity_nm\[5\] = .*from 0 to 1e6 N·m"):
+        transient.simulate("li-sunden-2016", d, "table")
