@@ -428,6 +428,9 @@ def test_call_order_and_non_finite_values_in_model_exchange(fmus, instance):
     assert inst("fmi2EnterEventMode") == OK and inst("fmi2NewDiscreteStates", ctypes.byref(info)) == OK
     assert inst("fmi2Terminate") == OK
     assert inst("fmi2EnterEventMode") == ERROR
+    assert inst("fmi2Reset") == OK  # still a Model Exchange instance after a reset
+    inst.start(_inputs(fmu, "pump-torque"))
+    assert inst.array("fmi2GetDerivatives", fmu.states)[0] == OK and inst.step(0.0, 0.01) == ERROR
 
 
 def test_guid_is_checked(fmus, instance):
