@@ -440,9 +440,15 @@ impl Instance {
         let at = |tau: f64| {
             [0, 1].map(|k| start[k] + ramp[k].0 * if ramp[k].1 >= h * (1.0 - 1e-9) { tau } else { tau.min(ramp[k].1) })
         };
-        let (mut tau, mut sample) = (0.0, None);
+        let (mut tau, mut sample, saved) = (0.0, None, stepper.state());
         for c in corners {
-            sample = Some(stepper.do_step(c - tau, at(tau), at(c)).map_err(|e| e.to_string())?);
+            match stepper.do_step(c - tau, at(tau), at(c)) {
+                Ok(s) => sample = Some(s),
+                Err(e) => {
+                    stepper.set_state(&saved); // a failed step leaves the instance at t
+                    return Err(e.to_string());
+                }
+            }
             tau = c;
         }
         self.previous = Some((t, start));
