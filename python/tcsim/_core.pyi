@@ -212,6 +212,7 @@ def steady_torque_ratio(
 
 #: ``modelIdentifier`` of the FMU.
 FMU_MODEL_IDENTIFIER: str
+FMU_LOG_CATEGORIES: list[tuple[str, str]]
 #: Value reference of the first tunable parameter.
 FMU_FIRST_PARAMETER_VR: int
 
