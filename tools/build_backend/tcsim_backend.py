@@ -35,6 +35,7 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import time
 import zipfile
 from collections.abc import Mapping
 from pathlib import Path
@@ -77,7 +78,9 @@ def build_fmu_library() -> Path:
         raise RuntimeError("cargo is not on PATH: building tcsim needs Rust 1.89 or newer (https://rustup.rs)")
     command = [cargo, "build", "--release", "-p", FMU_PACKAGE, "--message-format=json-render-diagnostics"]
     print(f"tcsim: building the FMU library: cargo build --release -p {FMU_PACKAGE}", file=sys.stderr, flush=True)
+    start = time.monotonic()
     p = subprocess.run(command, cwd=ROOT, stdout=subprocess.PIPE, text=True, check=False)
+    print(f"tcsim: cargo build of {FMU_PACKAGE}: {time.monotonic() - start:.1f} s", file=sys.stderr, flush=True)
     if p.returncode != 0:
         raise RuntimeError(
             f"'cargo build --release -p {FMU_PACKAGE}' failed (exit {p.returncode}); cargo's messages are above"
