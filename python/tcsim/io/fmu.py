@@ -453,52 +453,64 @@ SOURCES_README = """\
 This FMU was exported by `tcsim export-fmu` (tcsim {version}). Its binary, `binaries/linux64/{mi}.so`,
 is the Rust library `crates/tcsim-fmu` of tcsim, built from the sources in this directory. The
 model itself (the converter's parameters and the causality) is data, in `resources/model.json`, so
-one binary serves every converter, model and causality.
+one binary serves every converter, model and causality of this tcsim version.
 
 ## Rebuilding the binary for another platform
 
-The library has no dependency but Rust crates (diffsol, nalgebra, serde_json); no Python, no
-FMI SDK. With a Rust toolchain (https://rustup.rs, Rust 1.89 or newer) on the target platform:
+The library needs Rust 1.89 or newer (https://rustup.rs) and nothing else: no Python, no FMI SDK.
+Build it for the target: cargo writes `target/<target>/release/tcsim_fmu.dll` (Windows) or
+`target/<target>/release/libtcsim_fmu.dylib` (macOS). Copy it into the FMU under the
+`modelIdentifier`, `{mi}`:
 
-    cd sources            # this directory, extracted from the .fmu (a zip archive)
-    cargo build --release -p tcsim-fmu
-
-(or the same command in a checkout of the tcsim source tree). Then put the library into the FMU
-under the name the `modelIdentifier` requires, `{mi}`:
-
-| platform | cargo makes | copy it into the FMU as |
+| target | FMI 2.0 | FMI 3.0 |
 |---|---|---|
-| Linux x86-64 | `target/release/libtcsim_fmu.so` | `binaries/linux64/{mi}.so` |
-| Windows x86-64 (MSVC) | `target\\release\\tcsim_fmu.dll` | `binaries/win64/{mi}.dll` |
-| macOS (x86-64 or arm64) | `target/release/libtcsim_fmu.dylib` | `binaries/darwin64/{mi}.dylib` |
+| `x86_64-pc-windows-msvc` or `-gnu` | `binaries/win64/{mi}.dll` | `binaries/x86_64-windows/{mi}.dll` |
+| `x86_64-apple-darwin` | `binaries/darwin64/{mi}.dylib` (universal) | `binaries/x86_64-darwin/{mi}.dylib` |
+| `aarch64-apple-darwin` | `binaries/darwin64/{mi}.dylib` (universal) | `binaries/aarch64-darwin/{mi}.dylib` |
+| `x86_64-unknown-linux-gnu` | `binaries/linux64/{mi}.so` | `binaries/x86_64-linux/{mi}.so` |
 
-For example on Windows (PowerShell):
+Windows, MSVC (PowerShell, with the Visual Studio C++ build tools), in the folder of `converter.fmu`:
 
-    Expand-Archive converter.fmu fmu; cd fmu\\sources
-    cargo build --release -p tcsim-fmu
-    mkdir ..\\binaries\\win64; copy target\\release\\tcsim_fmu.dll ..\\binaries\\win64\\{mi}.dll
-    cd ..; Remove-Item -Recurse sources\\target
-    Compress-Archive -Path * -DestinationPath ..\\converter.fmu -Force
+    rustup target add x86_64-pc-windows-msvc
+    python -m zipfile -e converter.fmu fmu
+    cd fmu\\sources
+    $env:RUSTFLAGS = "-C target-feature=+crt-static"
+    cargo build --release -p tcsim-fmu --target x86_64-pc-windows-msvc
+    mkdir ..\\binaries\\win64
+    copy target\\x86_64-pc-windows-msvc\\release\\tcsim_fmu.dll ..\\binaries\\win64\\{mi}.dll
+    Remove-Item -Recurse target; cd ..
+    python -m zipfile -c ..\\converter-win.fmu modelDescription.xml binaries resources sources
 
-and on macOS:
+Windows, GNU, cross-compiled on Linux (`apt-get install gcc-mingw-w64-x86-64`):
 
-    mkdir fmu && cd fmu && unzip ../converter.fmu && cd sources
-    cargo build --release -p tcsim-fmu
-    mkdir -p ../binaries/darwin64 && cp target/release/libtcsim_fmu.dylib ../binaries/darwin64/{mi}.dylib
-    rm -rf target && cd .. && zip -r ../converter.fmu . -x 'sources/target/*'
+    rustup target add x86_64-pc-windows-gnu
+    python3 -m zipfile -e converter.fmu fmu && cd fmu/sources
+    cargo build --release -p tcsim-fmu --target x86_64-pc-windows-gnu
+    mkdir -p ../binaries/win64 && cp target/x86_64-pc-windows-gnu/release/tcsim_fmu.dll ../binaries/win64/{mi}.dll
+    rm -rf target && cd .. && python3 -m zipfile -c ../converter-win.fmu modelDescription.xml binaries resources sources
 
-A universal macOS library: build both `--target x86_64-apple-darwin` and `--target aarch64-apple-darwin`
-and join them with `lipo -create -output {mi}.dylib <x86_64 lib> <arm64 lib>`.
+macOS, one universal library for Intel and Apple silicon (Xcode command-line tools):
 
-Keep `modelDescription.xml` and `resources/` as they are: they do not depend on the platform.
-Do not add `<SourceFiles>`: the sources are Rust, not the C an importing tool would compile.
+    rustup target add x86_64-apple-darwin aarch64-apple-darwin
+    python3 -m zipfile -e converter.fmu fmu && cd fmu/sources
+    cargo build --release -p tcsim-fmu --target x86_64-apple-darwin
+    cargo build --release -p tcsim-fmu --target aarch64-apple-darwin
+    mkdir -p ../binaries/darwin64
+    lipo -create -output ../binaries/darwin64/{mi}.dylib target/x86_64-apple-darwin/release/libtcsim_fmu.dylib \\
+        target/aarch64-apple-darwin/release/libtcsim_fmu.dylib
+    rm -rf target && cd .. && python3 -m zipfile -c ../converter-mac.fmu modelDescription.xml binaries resources sources
+
+An FMI 3.0 FMU takes the FMI 3.0 folders (one library per architecture, no `lipo`). Keep
+`modelDescription.xml` and `resources/` as they are: they do not depend on the platform. Zip with
+Python's `zipfile` (paths with `/`, files at the root). Do not add `<SourceFiles>`: the sources are
+Rust, not the C an importing tool would compile.
 
 ## Contents
 
 * `Cargo.toml`, `Cargo.lock`: the workspace (members `tcsim-core` and `tcsim-fmu` only) and the
   exact dependency versions tcsim was built with;
 * `crates/tcsim-core/`: the converter models and the transient engine (pure Rust);
-* `crates/tcsim-fmu/`: the FMI 2.0 C API (Model Exchange and Co-Simulation).
+* `crates/tcsim-fmu/`: the FMI C API (Model Exchange and Co-Simulation).
 {missing}
 License: MIT (`LICENSE`).
 """
