@@ -2,9 +2,10 @@
 
 ``pip install .``, ``pip wheel .`` and ``python -m build`` call :func:`build_wheel`. It lets maturin
 build the wheel of the Python package and its extension ``tcsim._core`` (``crates/tcsim-py``), then
-runs ``cargo build --release -p tcsim-fmu`` in the same target directory (the dependencies are
-compiled already; only the FMU crate and its link remain) and adds to the wheel, as package data of
-``tcsim``:
+runs ``cargo build --release -p tcsim-fmu`` in the same target directory (the third-party crates
+are compiled already; ``tcsim-core`` and ``tcsim-fmu`` are compiled in the FMU library's feature set,
+which a later ``cargo build --release --workspace`` reuses for ``tcsim-core``) and adds to the wheel,
+as package data of ``tcsim``:
 
 * ``tcsim/_fmu/<library>``: the FMU library as cargo names it (``libtcsim_fmu.so`` on Linux,
   ``libtcsim_fmu.dylib`` on macOS, ``tcsim_fmu.dll`` on Windows), a ``cdylib`` that links no Python;
