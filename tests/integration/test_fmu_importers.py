@@ -86,7 +86,8 @@ def fmi_sim() -> Path:
     how = f"run `bash {INSTALL.relative_to(REPO)}` (CI does)"
     if not binary.is_file():
         pytest.fail(f"the FMU importer fmi-sim {_pinned_version()} is not installed ({binary}): {how}", pytrace=False)
-    version = subprocess.run([binary, "--version"], capture_output=True, text=True, timeout=60).stdout.strip()
+    said = subprocess.run([binary, "--version"], capture_output=True, text=True, timeout=60)
+    version = (said.stdout + said.stderr).strip().removeprefix("Error: ").splitlines()[0]  # 0.7.0 says it on stderr
     if version != f"fmi-sim {_pinned_version()}":
         pytest.fail(f"{binary}: {version!r}, expected fmi-sim {_pinned_version()}: {how}", pytrace=False)
     return binary
@@ -195,30 +196,71 @@ def _deviation(t, y, t_ref, y_ref, window_s: float) -> float:
 # every FMU in both interfaces
 
 
-@pytest.mark.parametrize("interface", INTERFACES)
-@pytest.mark.parametrize("version", FMI_VERSIONS)
-@pytest.mark.parametrize("causality", list(tfmu.CAUSALITIES))
-@pytest.mark.parametrize("model", MODELS)
-def test_importer_matches_replay(fmi_sim, fmus, measurement, tmp_path, model, causality, version, interface):
-    fmu = fmus[(model, causality, version)]
+#: Outputs that leave the acceptance band because of a defect of the FMU, by (causality, interface):
+#: the columns and the reason (test_importer_known_defects shows each; strict, so a fix is noticed).
+KNOWN_DEFECTS: dict[tuple[str, str], tuple[frozenset[str], str]] = {
+    ("speeds", "co-simulation"): (
+        frozenset({"pump_torque_nm", "torque_ratio"}),
+        "issue 13 item 10: in Co-Simulation the FMU takes an input's rate from the previous communication "
+        "interval, so the pump inertia torque I_p*dw_p/dt in pump_torque_nm (and torque_ratio) of the speeds "
+        "causality is one interval late: 7-8 % (16 %) of the range outside the tube at 10 ms",
+    ),
+}
+
+
+def _deviations(fmi_sim, fmus, measurement, tmp_path, case: tuple[str, str, str], interface: str) -> dict[str, float]:
+    """Run one FMU in fmi-sim; each output's distance from the replay in units of its range (Model
+    Exchange: pointwise; Co-Simulation: from the ±1 interval tube, after the first interval)."""
+    model, causality, version = case
+    fmu = fmus[case]
     ref = _replay(measurement, model, causality)
     stop_s = float(measurement["time_s"].iloc[-1])
     step_s = ME_STEP_S if interface == "model-exchange" else CS_STEP_S
     inputs = _importer_inputs(fmu, interface, causality, ref, measurement)
     res = _run_importer(fmi_sim, fmu, interface, inputs, step_s, stop_s, tmp_path)
 
-    assert res["time"].iloc[-1] == pytest.approx(stop_s) and len(res) == round(stop_s / step_s) + 1
+    t = res["time"].to_numpy()
+    grid = np.round(np.arange(0.0, stop_s + step_s / 2, step_s), 9)
+    # every output point, and in Model Exchange each event's time once more (fmi-sim records before the event)
+    assert t[-1] == pytest.approx(stop_s) and np.all(np.diff(t) >= 0.0) and set(grid) <= set(np.round(t, 9))
     outputs = _variables(fmu, "output")
     assert set(outputs) == set(res.columns) - {"time"}, "fmi-sim records every output"
     compared = [name for name in outputs if not np.isnan(ref[name]).all()]
     assert set(tfmu.CAUSALITIES[causality]).isdisjoint(compared) and len(compared) >= 4, compared
-    later = res["time"].to_numpy() > (0.0 if interface == "model-exchange" else 1.5 * CS_STEP_S)
+    later = t > (0.0 if interface == "model-exchange" else 1.5 * CS_STEP_S)
     window_s = 0.0 if interface == "model-exchange" else CS_STEP_S
-    deviations = {
-        name: _deviation(res["time"].to_numpy()[later], res[name].to_numpy()[later], ref["time_s"], ref[name], window_s)
-        for name in compared
+    return {
+        name: _deviation(t[later], res[name].to_numpy()[later], ref["time_s"], ref[name], window_s) for name in compared
     }
-    assert max(deviations.values()) <= TOLERANCE, {k: f"{100 * v:.3f} %" for k, v in deviations.items()}
+
+
+def _percent(deviations: dict[str, float]) -> dict[str, str]:
+    return {k: f"{100 * v:.3f} % of range" for k, v in deviations.items()}
+
+
+@pytest.mark.parametrize("interface", INTERFACES)
+@pytest.mark.parametrize("version", FMI_VERSIONS)
+@pytest.mark.parametrize("causality", list(tfmu.CAUSALITIES))
+@pytest.mark.parametrize("model", MODELS)
+def test_importer_matches_replay(fmi_sim, fmus, measurement, tmp_path, model, causality, version, interface):
+    """Every output but the known defects' within the band."""
+    deviations = _deviations(fmi_sim, fmus, measurement, tmp_path, (model, causality, version), interface)
+    known = KNOWN_DEFECTS.get((causality, interface), (frozenset(), ""))[0]
+    checked = {k: v for k, v in deviations.items() if k not in known}
+    assert max(checked.values()) <= TOLERANCE, _percent(checked)
+
+
+@pytest.mark.parametrize("version", FMI_VERSIONS)
+@pytest.mark.parametrize("model", MODELS)
+@pytest.mark.parametrize(
+    "causality, interface",
+    [pytest.param(*key, marks=pytest.mark.xfail(strict=True, reason=why)) for key, (_, why) in KNOWN_DEFECTS.items()],
+)
+def test_importer_known_defects(fmi_sim, fmus, measurement, tmp_path, model, causality, version, interface):
+    """The outputs of :data:`KNOWN_DEFECTS` within the band (they are not, today)."""
+    deviations = _deviations(fmi_sim, fmus, measurement, tmp_path, (model, causality, version), interface)
+    known = {k: v for k, v in deviations.items() if k in KNOWN_DEFECTS[(causality, interface)][0]}
+    assert known and max(known.values()) <= TOLERANCE, _percent(known)
 
 
 # ---------------------------------------------------------------------------------------------
