@@ -113,6 +113,7 @@ def _run_importer(
     inputs.to_csv(inp, index=False, float_format="%.17e")
     args = [fmi_sim, "--model", fmu, "-i", inp, "-o", out, interface]
     args += ["--output-interval", repr(step_s), "-s", "0", "-f", repr(stop_s)]
+    env = dict(os.environ if env is None else env, RUST_BACKTRACE="0")  # its error in one line
     p = subprocess.run(list(map(str, args)), capture_output=True, text=True, env=env, timeout=RUN_TIMEOUT_S)
     if p.returncode != 0 or not out.is_file():
         raise AssertionError(f"fmi-sim {interface} of {fmu.name} failed (exit {p.returncode}): {p.stderr.strip()}")
