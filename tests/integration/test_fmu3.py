@@ -21,6 +21,8 @@ fmpy = pytest.importorskip("fmpy")
 from fmpy.fmi3 import FMU3Model, FMU3Slave  # noqa: E402
 from fmpy.validation import validate_fmu  # noqa: E402
 
+import tcsim.fmu  # noqa: E402
+from tcsim.errors import InputError  # noqa: E402
 from tcsim.io import fmu as tfmu  # noqa: E402
 from tcsim.io import fmu3  # noqa: E402
 from tcsim.transient import PumpTorqueTurbineSpeed, Speeds, dynamic_model, isolated_takeoff, simulate  # noqa: E402
@@ -389,6 +391,15 @@ def test_cli_export_fmu_fmi_version(cli, library_env, tmp_path):
     lines = [ln for ln in r.stderr.splitlines() if ln.strip()]
     assert r.code == 2 and lines == ["error: command line: --fmi-version = '2.1': expected 2 or 3"], r.stderr
     assert not bad.exists()
+
+
+def test_api_fmi_versions(library_env, tmp_path):
+    """``tcsim.fmu.export_fmu(..., fmi=tcsim.fmu.FMI3)``; ``fmi_version`` knows 2 and 3 only."""
+    assert tcsim.fmu.fmi_version(3) is tcsim.fmu.FMI3 and tcsim.fmu.fmi_version("2") is tcsim.fmu.FMI2
+    with pytest.raises(InputError, match="--fmi-version"):
+        tcsim.fmu.fmi_version(4)
+    path = tcsim.fmu.export_fmu(CONVERTER, "table", tmp_path / "t.fmu", "speeds", fmi=tcsim.fmu.FMI3)
+    assert _root(path).get("fmiVersion") == "3.0"
 
 
 def test_macos_libraries_go_to_their_architectures(tmp_path):

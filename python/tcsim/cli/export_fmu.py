@@ -15,8 +15,6 @@ HELP = (
     "Export one model as an FMI 2.0 or 3.0 FMU, Model Exchange and Co-Simulation (linux binary, sources to "
     "rebuild elsewhere; no Python inside)."
 )
-#: ``--fmi-version`` choices.
-FMI_VERSIONS = ("2", "3")
 
 
 def export_fmu_command(converter: str, model: str, out: Path, causality: str, fmi_version: str = "2") -> str:
@@ -24,14 +22,11 @@ def export_fmu_command(converter: str, model: str, out: Path, causality: str, fm
     import json
     import zipfile
 
-    from ..errors import InputError
-    from ..io.fmu import CAUSALITIES, FMI2
+    from ..io.fmu import CAUSALITIES
     from ..io.fmu import export_fmu as write_fmu
-    from ..io.fmu3 import FMI3
+    from ..io.fmu3 import fmi_version as version_of
 
-    if fmi_version not in FMI_VERSIONS:
-        raise InputError("command line", "--fmi-version", fmi_version, "2 or 3")
-    fmi = FMI3 if fmi_version == "3" else FMI2
+    fmi = version_of(fmi_version)
     path = write_fmu(converter, model, out, causality, fmi=fmi)
     with zipfile.ZipFile(path) as zf:
         params = json.loads(zf.read("resources/model.json"))["parameters"]

@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from .. import _core
+from ..errors import InputError
 from ..models.converter import Converter
 from ..models.dynamic import DynamicModel
 from . import fmu
@@ -163,6 +164,18 @@ FMI3 = FmiVersion(
 )
 
 
+#: The FMI versions by their ``--fmi-version`` name.
+FMI_VERSIONS: dict[str, FmiVersion] = {"2": fmu.FMI2, "3": FMI3}
+
+
+def fmi_version(value: int | str) -> FmiVersion:
+    """The FMI version of a ``--fmi-version`` value (``2`` or ``3``); anything else is an
+    :class:`~tcsim.errors.InputError`."""
+    if str(value) not in FMI_VERSIONS:
+        raise InputError("command line", "--fmi-version", value, " or ".join(FMI_VERSIONS))
+    return FMI_VERSIONS[str(value)]
+
+
 def export_fmu(
     converter: Converter | str | Path | DynamicModel | None,
     model: str | DynamicModel,
@@ -174,4 +187,4 @@ def export_fmu(
     return fmu.export_fmu(converter, model, out_path, causality, fmi=FMI3)
 
 
-__all__: Sequence[str] = ("export_fmu", "model_description_xml", "platforms", "FMI3", "TIME_VR")
+__all__: Sequence[str] = ("export_fmu", "model_description_xml", "platforms", "fmi_version", "FMI3", "TIME_VR")
