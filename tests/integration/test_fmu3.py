@@ -138,7 +138,7 @@ def test_fmi3_variables_are_the_fmi2_variables(fmus, model):
 def test_fmi3_cosimulation_matches_replay_and_fmi2(fmus, takeoff, model):
     """FMPy's co-simulation of the take-off: within the 0.5 % tube of ±1 communication step around
     the replay run (after the start, as FMI 2.0: the first interval has no input rate yet), and
-    the same numbers as the FMI 2.0 FMU."""
+    the same numbers as the FMI 2.0 FMU (measured: bit for bit)."""
     t, tp, wt = takeoff["time"], takeoff["pump_torque_nm"], takeoff["turbine_speed_rad_s"]
     ref = simulate(dynamic_model(CONVERTER, model), PumpTorqueTurbineSpeed(t, tp, wt))
     runs = {
@@ -166,7 +166,8 @@ def test_fmi3_cosimulation_matches_replay_and_fmi2(fmus, takeoff, model):
 def test_fmi3_model_exchange_matches_replay_and_fmi2(fmus, model):
     """FMPy's CVode drives the FMI 3.0 Model Exchange interface (states, derivatives, event
     indicators, the stator's release past the coupling point): within the 0.5 % tube of ±1 output
-    interval around the engine run, and within 0.5 % of the range of the FMI 2.0 FMU's run."""
+    interval around the engine run, and the FMI 2.0 FMU's run (to 1e-9 of the range: the same
+    library and instance; measured: 9e-12)."""
     stop = 4.0
     t = np.round(np.arange(0.0, stop + 1e-9, 0.01), 6)
     tp = np.interp(t, [0.0, 0.1, 0.3, stop], [40.0, 40.0, 250.0, 250.0])
@@ -198,8 +199,8 @@ def test_fmi3_model_exchange_matches_replay_and_fmi2(fmus, model):
     for col in ("pump_speed_rad_s", "turbine_torque_nm"):
         excess = _tube_excess(res["time"], res[col], ref["time_s"], ref[col], 1e-3)
         assert excess.max() == 0.0, (col, excess.max())
-        fmi2 = np.interp(res["time"], runs[2]["time"], runs[2][col])
-        assert np.max(np.abs(res[col] - fmi2)) <= TUBE * np.ptp(ref[col]), col
+        np.testing.assert_array_equal(res["time"], runs[2]["time"])
+        np.testing.assert_allclose(res[col], runs[2][col], rtol=0.0, atol=1e-9 * np.ptp(ref[col]), err_msg=col)
     if model == "hrovat-tobler":
         stator = res["stator_speed_rad_s"]
         assert stator[0] == 0.0 and stator[-1] > 0.0  # locked at stall, released past the coupling point

@@ -4,7 +4,7 @@ no Python inside.
 ::
 
     tcsim export-fmu CONVERTER --model table|hrovat-tobler|quasi-dynamic -o FILE.fmu
-                     [--causality pump-torque|speeds]
+                     [--causality pump-torque|speeds] [--fmi-version 2|3]
 
 The FMU is a zip archive:
 
