@@ -18,7 +18,7 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::instance::{Configuration, Instance};
-use crate::variables::{event_indicator, is_derivative, states, Model, FIRST_DERIVATIVE, TIME};
+use crate::variables::{event_indicator, is_derivative, states, Model, FIRST_DERIVATIVE, RATES, TIME};
 
 type Status = i32;
 const OK: Status = 0;
@@ -444,6 +444,11 @@ pub unsafe extern "C" fn fmi3SetFloat64(
                     return Err(format!("value reference {r} is calculated and cannot be set"));
                 }
                 inst.instance.set(*r, *v)?;
+                if let Some(rate) = RATES.iter().find(|rate| rate.vr == *r).filter(|_| !inst.instance.model_exchange) {
+                    // Co-Simulation: the rate of a speed input over the coming step (FMI 3.0 has no
+                    // fmi2SetRealInputDerivatives); unset, the last interval's
+                    inst.instance.set_rate(rate.of, 1, *v)?;
+                }
             }
             Ok(())
         })
