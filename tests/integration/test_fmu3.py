@@ -97,6 +97,8 @@ def test_fmi3_fmu_validates(fmus, model, causality):
         names = set(zf.namelist())
         config = json.loads(zf.read("resources/model.json"))
     assert "binaries/x86_64-linux/tcsim_converter.so" in names
+    with zipfile.ZipFile(path) as zf:
+        assert "binaries/x86_64-windows/tcsim_converter.dll" in zf.read("sources/README.md").decode()
     assert config[fmu3.TOKEN_KEY] == md.guid  # FMPy reads the instantiationToken as guid
     assert md.numberOfEventIndicators == (3 if model == "hrovat-tobler" else 0)
 

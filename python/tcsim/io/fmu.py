@@ -562,6 +562,8 @@ class FmiVersion:
     platforms: Callable[[Path], list[str]]
     #: Functions the library must export.
     functions: tuple[str, ...]
+    #: What ``sources/README.md`` adds for the version (markdown; none for FMI 2.0).
+    sources_note: str = ""
 
 
 #: FMI 2.0: ``binaries/linux64``, ``win64``, ``darwin64``; the GUID is not in ``model.json``.
@@ -610,6 +612,9 @@ def export_fmu(
                 (stage / "binaries" / platform).mkdir(parents=True)
                 shutil.copyfile(lib, stage / "binaries" / platform / f"{MODEL_IDENTIFIER}{lib.suffix.lower()}")
         _write_sources(root, stage / "sources")
+        if fmi.sources_note:
+            with (stage / "sources" / "README.md").open("a") as readme:
+                readme.write(fmi.sources_note)
         with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
             for item in sorted(stage.rglob("*")):
                 if item.is_file():

@@ -154,6 +154,18 @@ def model_description_xml(
     )
 
 
+#: What ``sources/README.md`` of an FMI 3.0 FMU adds: its platform directories.
+SOURCES_NOTE = f"""
+## This is an FMI 3.0 FMU
+
+FMI 3.0 names the binary directories by platform tuple: put the library into
+`binaries/x86_64-windows/{MODEL_IDENTIFIER}.dll` (Windows x86-64),
+`binaries/x86_64-darwin/{MODEL_IDENTIFIER}.dylib` (macOS Intel) or
+`binaries/aarch64-darwin/{MODEL_IDENTIFIER}.dylib` (macOS Apple silicon; a universal library goes into
+both), and on Linux x86-64 `binaries/x86_64-linux/{MODEL_IDENTIFIER}.so`, instead of `win64`, `darwin64`
+and `linux64` above. The library is the same for FMI 2.0 and 3.0.
+"""
+
 #: FMI 3.0: ``binaries/x86_64-linux`` (...), the ``instantiationToken`` in ``model.json``.
 FMI3 = FmiVersion(
     "3.0",
@@ -161,6 +173,7 @@ FMI3 = FmiVersion(
     lambda token: {TOKEN_KEY: token},
     platforms,
     FUNCTIONS,
+    SOURCES_NOTE,
 )
 
 
