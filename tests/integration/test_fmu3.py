@@ -366,6 +366,7 @@ def test_fmi3_calling_sequence_and_unsupported_functions_are_errors(fmus):
         calls = [
             ("fmi3DoStep", lambda: inst.doStep(0.0, 0.01)),
             ("fmi3GetFloat64", lambda: inst.getFloat64([20])),  # calculated: no value yet
+            ("fmi3GetFloat64", lambda: inst.getFloat64([1])),  # an output: the same
             ("fmi3SetFloat64", lambda: inst.setFloat64([fmu3.TIME_VR], [1.0])),
             ("fmi3SetFloat64", lambda: inst.setFloat64([3], [1.0])),  # an output
             ("fmi3GetInt32", lambda: inst.getInt32([0])),

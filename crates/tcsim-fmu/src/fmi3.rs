@@ -18,7 +18,9 @@ use std::path::Path;
 use serde_json::Value;
 
 use crate::instance::{Configuration, Instance};
-use crate::variables::{event_indicator, is_derivative, states, Model, FIRST_DERIVATIVE, RATES, TIME};
+use crate::variables::{
+    event_indicator, is_derivative, is_input, states, Model, FIRST_DERIVATIVE, RATES, SIGNAL_SLOTS, TIME,
+};
 
 type Status = i32;
 const OK: Status = 0;
@@ -54,10 +56,10 @@ pub struct Instance3 {
 impl Instance3 {
     fn log(&self, status: Status, message: &str) {
         let Some(logger) = self.logger else { return };
-        let msg = CString::new(message.replace('\0', " ")).unwrap_or_default();
-        let text = format!("{}: ", self.name.to_string_lossy());
-        let full = CString::new(format!("{text}{}", msg.to_string_lossy())).unwrap_or_default();
-        unsafe { logger(self.environment, status, c"logStatusError".as_ptr(), full.as_ptr()) };
+        // the instance name first: FMI 3.0's callback has no argument for it
+        let text = format!("{}: {}", self.name.to_string_lossy(), message).replace('\0', " ");
+        let msg = CString::new(text).unwrap_or_default();
+        unsafe { logger(self.environment, status, c"logStatusError".as_ptr(), msg.as_ptr()) };
     }
 
     /// An error unless the instance is in one of `states`.
@@ -87,11 +89,13 @@ impl Instance3 {
         if vr == TIME {
             return Ok(self.instance.time_now());
         }
-        let calculated = event_indicator(vr).is_some() || is_derivative(vr);
-        if calculated && self.state == State::Instantiated {
+        let output = (vr as usize) < SIGNAL_SLOTS && !is_input(self.instance.config.causality, vr);
+        let indicator_or_derivative = event_indicator(vr).is_some() || is_derivative(vr);
+        if (output || indicator_or_derivative) && self.state == State::Instantiated {
             return Err(format!("value reference {vr} is calculated: it has no value before initialisation"));
         }
-        if calculated && self.state == State::Initialization {
+        if indicator_or_derivative && self.state == State::Initialization {
+            // (an output read in initialisation mode brings the instance up to date itself)
             self.instance.refresh_in_initialization();
         }
         if let Some(i) = event_indicator(vr) {
@@ -929,7 +933,7 @@ pub unsafe extern "C" fn fmi3DoStep(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::variables::{self, COORDINATES, FIRST_EVENT_INDICATOR, FIRST_PARAMETER, SIGNAL_SLOTS, START_PARAMETERS};
+    use crate::variables::{self, COORDINATES, FIRST_EVENT_INDICATOR, FIRST_PARAMETER, START_PARAMETERS};
     use tcsim_core::engine::mode_view::EVENT_INDICATORS;
 
     /// The value references FMI 3.0 adds are free in the FMI 2.0 table.
