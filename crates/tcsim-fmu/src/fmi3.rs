@@ -96,7 +96,7 @@ impl Instance3 {
         }
         if indicator_or_derivative && self.state == State::Initialization {
             // (an output read in initialisation mode brings the instance up to date itself)
-            self.instance.refresh_in_initialization();
+            self.instance.provisional()?;
         }
         if let Some(i) = event_indicator(vr) {
             if i >= self.sizes().1 {
@@ -112,20 +112,17 @@ impl Instance3 {
             if !declared {
                 return Err(format!("no variable with value reference {vr}"));
             }
-            return self.instance.derivative_now(c).ok_or(format!("der {vr}: not initialised"));
         }
-        self.instance.get(vr).ok_or(format!("no variable with value reference {vr}"))
+        self.instance.read(vr)
     }
 
     /// In initialisation mode the Model Exchange state follows the inputs set so far.
     fn me_current(&mut self) -> Result<(), String> {
-        if self.state == State::Initialization {
-            self.instance.refresh_in_initialization();
-        }
+        self.instance.provisional()?;
         if self.instance.me_ready() {
             Ok(())
         } else {
-            self.instance.initialize()
+            Err("Model Exchange call before initialisation".into())
         }
     }
 }
@@ -344,7 +341,7 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
                 inst.instance.options.rtol = tolerance.min(1e-4);
             }
             inst.instance.start_time = start;
-            inst.instance.initializing = true;
+            inst.instance.enter_initialization()?;
             inst.state = State::Initialization;
             Ok(())
         })
@@ -356,8 +353,7 @@ pub unsafe extern "C" fn fmi3ExitInitializationMode(c: *mut c_void) -> Status {
     unsafe {
         with(c, |inst| {
             inst.expect("fmi3ExitInitializationMode", &[State::Initialization])?;
-            inst.instance.initializing = false;
-            inst.instance.initialize()?;
+            inst.instance.exit_initialization()?;
             inst.state = if inst.instance.model_exchange { State::Event } else { State::Step };
             Ok(())
         })
@@ -383,6 +379,7 @@ pub unsafe extern "C" fn fmi3Terminate(c: *mut c_void) -> Status {
     unsafe {
         with(c, |inst| {
             inst.expect("fmi3Terminate", &[State::Event, State::ContinuousTime, State::Step])?;
+            inst.instance.terminate()?;
             inst.state = State::Terminated;
             Ok(())
         })
@@ -443,11 +440,13 @@ pub unsafe extern "C" fn fmi3SetFloat64(
             if n_values != n_vr {
                 return Err(format!("{n_values} values for {n_vr} value references: every variable is a scalar"));
             }
-            for (r, v) in slice(vr, n_vr)?.iter().zip(slice(values, n_values)?) {
-                if *r == TIME || event_indicator(*r).is_some() || is_derivative(*r) {
-                    return Err(format!("value reference {r} is calculated and cannot be set"));
-                }
-                inst.instance.set(*r, *v)?;
+            let (vr, values) = (slice(vr, n_vr)?, slice(values, n_values)?);
+            if let Some(r) = vr.iter().find(|&&r| r == TIME || event_indicator(r).is_some() || is_derivative(r)) {
+                return Err(format!("value reference {r} is calculated and cannot be set"));
+            }
+            // all or nothing, as fmi2SetReal
+            inst.instance.set_all(vr, values)?;
+            for (r, v) in vr.iter().zip(values) {
                 if let Some(rate) = RATES.iter().find(|rate| rate.vr == *r).filter(|_| !inst.instance.model_exchange) {
                     // Co-Simulation: the rate of a speed input over the coming step (FMI 3.0 has no
                     // fmi2SetRealInputDerivatives); unset, the last interval's
@@ -863,7 +862,7 @@ pub unsafe extern "C" fn fmi3GetNominalsOfContinuousStates(c: *mut c_void, x: *m
     unsafe {
         with(c, |inst| {
             sized(n, inst.sizes().0, "continuous states")?;
-            inst.instance.me_nominals_any(slice_mut(x, n)?)
+            inst.instance.me_nominals(slice_mut(x, n)?)
         })
     }
 }

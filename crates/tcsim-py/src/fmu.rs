@@ -141,6 +141,7 @@ pub fn fmu_event_indicator_variables<'py>(py: Python<'py>, model: &str) -> PyRes
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FMU_MODEL_IDENTIFIER", variables::MODEL_IDENTIFIER)?;
+    m.add("FMU_LOG_CATEGORIES", tcsim_fmu::LOG_CATEGORIES.to_vec())?;
     m.add("FMU_FIRST_PARAMETER_VR", variables::FIRST_PARAMETER)?;
     m.add_function(wrap_pyfunction!(fmu_variables, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_signals, m)?)?;

@@ -202,11 +202,18 @@ def _header(
         f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
         f'  variableNamingConvention="flat" numberOfEventIndicators="{_core.fmu_event_indicators(model.name)}">',
         f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
-        ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+        ' canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="false"/>',
         f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
-        ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="false"'
-        ' canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+        ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true"'
+        ' canSerializeFMUstate="true" providesDirectionalDerivative="false"/>',
     ]
+
+
+def _log_categories() -> list[str]:
+    """``<LogCategories>``: the categories the library logs with (:data:`tcsim._core.FMU_LOG_CATEGORIES`)."""
+    lines = ["  <LogCategories>"]
+    lines += [f"    <Category name={xml_attr(n)} description={xml_attr(d)}/>" for n, d in _core.FMU_LOG_CATEGORIES]
+    return [*lines, "  </LogCategories>"]
 
 
 def _unit_definitions() -> list[str]:
@@ -277,6 +284,7 @@ def model_description_xml(
         [
             *_header(model, causality, variables, name, guid, stamp),
             *_unit_definitions(),
+            *_log_categories(),
             '  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>',
             *_model_variables(variables, index),
             *_model_structure(variables, index),
@@ -566,11 +574,11 @@ class FmiVersion:
     sources_note: str = ""
 
 
-#: FMI 2.0: ``binaries/linux64``, ``win64``, ``darwin64``; the GUID is not in ``model.json``.
+#: FMI 2.0: ``binaries/linux64``, ``win64``, ``darwin64``; the GUID in ``model.json``.
 FMI2 = FmiVersion(
     "2.0",
     lambda model, causality, token: model_description_xml(model, causality, guid=token),
-    lambda token: {},
+    lambda token: {"guid": token},  # checked by fmi2Instantiate
     lambda lib: [PLATFORM_OF_SUFFIX[lib.suffix.lower()]],
     ("fmi2GetVersion", "fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance"),
 )
