@@ -356,9 +356,9 @@ def test_fmi3_wrong_instantiation_token_is_refused(fmus):
 
 
 def test_fmi3_calling_sequence_and_unsupported_functions_are_errors(fmus):
-    """DoStep before initialisation, SetFloat64 of an output or of time, other types, FMU state,
-    clocks, directional derivatives and a second ExitInitializationMode return fmi3Error with a
-    message; the instance goes on afterwards."""
+    """DoStep before initialisation, SetFloat64 of an output or of time, other types, clocks,
+    directional derivatives and a second ExitInitializationMode return fmi3Error with a message;
+    the instance goes on afterwards."""
     log = _Log()
     _, unzip, inst = _instance(fmus[("table", "pump-torque", 3)], FMU3Slave, log)
     try:
@@ -370,7 +370,6 @@ def test_fmi3_calling_sequence_and_unsupported_functions_are_errors(fmus):
             ("fmi3SetFloat64", lambda: inst.setFloat64([fmu3.TIME_VR], [1.0])),
             ("fmi3SetFloat64", lambda: inst.setFloat64([3], [1.0])),  # an output
             ("fmi3GetInt32", lambda: inst.getInt32([0])),
-            ("fmi3GetFMUState", lambda: inst.getFMUState()),
             ("fmi3GetClock", lambda: inst.getClock([0])),
             ("fmi3GetDirectionalDerivative", lambda: inst.getDirectionalDerivative([1], [0], [1.0])),
             ("fmi3ExitInitializationMode", lambda: inst.exitInitializationMode()),
@@ -394,6 +393,76 @@ def test_fmi3_calling_sequence_and_unsupported_functions_are_errors(fmus):
         inst.enterInitializationMode(startTime=0.0)
         inst.exitInitializationMode()
         assert np.isfinite(inst.getFloat64([1])[0])
+    finally:
+        inst.freeInstance()
+        shutil.rmtree(unzip, ignore_errors=True)
+
+
+def _steps(inst, first: int, last: int) -> list[list[float]]:
+    """Co-simulation steps ``first``..``last`` (10 ms) of a torque ramp at a rising turbine speed;
+    the outputs after each."""
+    rows = []
+    for k in range(first, last):
+        inst.setFloat64([0, 2], [100.0 + 20.0 * k, 4.0 * k])
+        inst.doStep(0.01 * k, 0.01)
+        rows.append(inst.getFloat64([1, 3, 6, 7, 20, 23]))
+    return rows
+
+
+def test_fmi3_fmu_state_continues_bit_for_bit(fmus):
+    """fmi3GetFMUState at 0.2 s, on to 0.5 s; fmi3SetFMUState and the same inputs give the same
+    numbers bit for bit, also in a fresh instance from the serialised state; a damaged serialised
+    state is refused."""
+    log = _Log()
+    path = fmus[("hrovat-tobler", "pump-torque", 3)]
+    _, unzip, inst = _instance(path, FMU3Slave, log)
+    _, unzip2, fresh = _instance(path, FMU3Slave, log)
+    try:
+        inst.instantiate(logMessage=log)
+        inst.enterInitializationMode(startTime=0.0)
+        inst.setFloat64([0, 2], [100.0, 0.0])
+        inst.exitInitializationMode()
+        _steps(inst, 0, 20)
+        state = inst.getFMUState()
+        first = _steps(inst, 20, 50)
+        inst.setFMUState(state)
+        assert _steps(inst, 20, 50) == first
+        data = inst.serializeFMUState(state)
+        inst.freeFMUState(state)
+        fresh.instantiate(logMessage=log)
+        restored = fresh.deserializeFMUState(data)
+        fresh.setFMUState(restored)
+        assert _steps(fresh, 20, 50) == first
+        with pytest.raises(Exception, match="fmi3DeserializeFMUState"):
+            fresh.deserializeFMUState(data[:-1])
+        fresh.freeFMUState(restored)
+    finally:
+        inst.freeInstance()
+        fresh.freeInstance()
+        shutil.rmtree(unzip, ignore_errors=True)
+        shutil.rmtree(unzip2, ignore_errors=True)
+
+
+def test_fmi3_fmu_state_in_model_exchange(fmus):
+    """Model Exchange: a state taken in continuous-time mode restores the states, the time and the
+    mode (fmi3CompletedIntegratorStep is allowed again)."""
+    log = _Log()
+    _, unzip, inst = _instance(fmus[("hrovat-tobler", "pump-torque", 3)], FMU3Model, log)
+    try:
+        inst.instantiate(logMessage=log)
+        inst.enterInitializationMode(startTime=0.0)
+        inst.setFloat64([0, 2], [150.0, 20.0])
+        inst.exitInitializationMode()
+        inst.updateDiscreteStates()
+        inst.enterContinuousTimeMode()
+        saved_x, state = _array(inst.getContinuousStates, 3), inst.getFMUState()
+        inst.setTime(0.3)
+        inst.setContinuousStates((ctypes.c_double * 3)(*[1.1 * x for x in saved_x]), 3)
+        inst.enterEventMode()
+        inst.setFMUState(state)
+        assert _array(inst.getContinuousStates, 3) == saved_x and inst.getFloat64([fmu3.TIME_VR]) == [0.0]
+        inst.completedIntegratorStep()
+        inst.freeFMUState(state)
     finally:
         inst.freeInstance()
         shutil.rmtree(unzip, ignore_errors=True)

@@ -7,9 +7,10 @@
 //!
 //! The instance checks the calling sequence (the FMI 3.0 state machine, [`State`]) and the
 //! `instantiationToken` against `resources/model.json`. What the FMU does not have (other variable
-//! types, clocks, scheduled execution, FMU state, directional and adjoint derivatives,
+//! types, clocks, scheduled execution, directional and adjoint derivatives,
 //! configuration mode, Co-Simulation's event mode and intermediate update) returns `fmi3Error` with
-//! a message through the logger. Every entry point catches panics: none crosses the C boundary.
+//! a message through the logger. The FMU state is the FMI 2.0 one (`snapshot.rs`) with the
+//! state-machine state. Every entry point catches panics: none crosses the C boundary.
 
 use std::ffi::{c_char, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
@@ -17,7 +18,8 @@ use std::path::Path;
 
 use serde_json::Value;
 
-use crate::instance::{Configuration, Instance};
+use crate::instance::{Configuration, Instance, Phase};
+use crate::snapshot::Snapshot;
 use crate::variables::{
     event_indicator, is_derivative, is_input, states, Model, FIRST_DERIVATIVE, RATES, SIGNAL_SLOTS, TIME,
 };
@@ -550,39 +552,129 @@ pub unsafe extern "C" fn fmi3GetVariableDependencies(
     unsafe { unsupported(c, "fmi3GetVariableDependencies (see <ModelStructure>)") }
 }
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi3GetFMUState(c: *mut c_void, _s: *mut *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi3GetFMUState") }
+// ---------------------------------------------------------------------------------------------
+// FMU state: the FMI 2.0 snapshot of the instance (`snapshot.rs`) and the FMI 3.0 state
+
+/// An FMU state of FMI 3.0: the instance's snapshot and the state-machine state.
+struct State3 {
+    snapshot: Snapshot,
+    state: State,
+}
+
+/// Store a new FMU state in `*s`, or overwrite the one there.
+unsafe fn store(s: *mut *mut c_void, saved: State3) -> Result<(), String> {
+    if s.is_null() {
+        return Err("null fmi3FMUState pointer".into());
+    }
+    let existing = unsafe { *s } as *mut State3;
+    if existing.is_null() {
+        unsafe { *s = Box::into_raw(Box::new(saved)) as *mut c_void };
+    } else {
+        let existing = unsafe { &mut *existing };
+        existing.snapshot.check_live()?;
+        *existing = saved;
+    }
+    Ok(())
+}
+
+/// The FMU state behind `s`.
+unsafe fn stored<'a>(s: *mut c_void) -> Result<&'a State3, String> {
+    if s.is_null() {
+        return Err("null fmi3FMUState".into());
+    }
+    let saved = unsafe { &*(s as *const State3) };
+    saved.snapshot.check_live()?;
+    Ok(saved)
+}
+
+/// The state-machine state of a restored instance phase (serialised states keep the phase only:
+/// Model Exchange resumes in Event Mode, Co-Simulation in Step Mode).
+fn state_of(phase: Phase, model_exchange: bool) -> State {
+    match phase {
+        Phase::Instantiated => State::Instantiated,
+        Phase::Initialization => State::Initialization,
+        Phase::Running if model_exchange => State::Event,
+        Phase::Running => State::Step,
+        Phase::Terminated => State::Terminated,
+    }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SetFMUState(c: *mut c_void, _s: *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi3SetFMUState") }
+pub unsafe extern "C" fn fmi3GetFMUState(c: *mut c_void, s: *mut *mut c_void) -> Status {
+    unsafe { with(c, |inst| store(s, State3 { snapshot: inst.instance.snapshot(), state: inst.state })) }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3FreeFMUState(c: *mut c_void, _s: *mut *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi3FreeFMUState") }
+pub unsafe extern "C" fn fmi3SetFMUState(c: *mut c_void, s: *mut c_void) -> Status {
+    unsafe {
+        with(c, |inst| {
+            let saved = stored(s)?;
+            inst.instance.restore(&saved.snapshot)?;
+            inst.state = saved.state;
+            Ok(())
+        })
+    }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SerializedFMUStateSize(c: *mut c_void, _s: *mut c_void, _n: *mut usize) -> Status {
-    unsafe { unsupported(c, "fmi3SerializedFMUStateSize") }
+pub unsafe extern "C" fn fmi3FreeFMUState(c: *mut c_void, s: *mut *mut c_void) -> Status {
+    unsafe {
+        with(c, |_| {
+            if s.is_null() || (*s).is_null() {
+                return Ok(());
+            }
+            stored(*s)?;
+            let mut saved = Box::from_raw(*s as *mut State3);
+            saved.snapshot.kill();
+            drop(saved);
+            *s = std::ptr::null_mut();
+            Ok(())
+        })
+    }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3SerializeFMUState(c: *mut c_void, _s: *mut c_void, _b: *mut u8, _n: usize) -> Status {
-    unsafe { unsupported(c, "fmi3SerializeFMUState") }
+pub unsafe extern "C" fn fmi3SerializedFMUStateSize(c: *mut c_void, s: *mut c_void, n: *mut usize) -> Status {
+    unsafe {
+        with(c, |_| {
+            let size = stored(s)?.snapshot.to_bytes().len();
+            if n.is_null() {
+                return Err("null size pointer".into());
+            }
+            *n = size;
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi3SerializeFMUState(c: *mut c_void, s: *mut c_void, b: *mut u8, n: usize) -> Status {
+    unsafe {
+        with(c, |_| {
+            let bytes = stored(s)?.snapshot.to_bytes();
+            if n < bytes.len() {
+                return Err(format!("serialised FMU state of {} bytes: the buffer has {n}", bytes.len()));
+            }
+            slice_mut(b, bytes.len())?.copy_from_slice(&bytes);
+            Ok(())
+        })
+    }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3DeserializeFMUState(
     c: *mut c_void,
-    _b: *const u8,
-    _n: usize,
-    _s: *mut *mut c_void,
+    b: *const u8,
+    n: usize,
+    s: *mut *mut c_void,
 ) -> Status {
-    unsafe { unsupported(c, "fmi3DeserializeFMUState") }
+    unsafe {
+        with(c, |inst| {
+            let snapshot = Snapshot::from_bytes(slice(b, n)?, &inst.instance)?;
+            let state = state_of(snapshot.phase(), inst.instance.model_exchange);
+            store(s, State3 { snapshot, state })
+        })
+    }
 }
 
 #[no_mangle]

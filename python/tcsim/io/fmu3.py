@@ -85,16 +85,16 @@ def _header(model: DynamicModel, causality: str, name: str, token: str, stamp: s
         f"Torque converter {stem}, {model.name} model (tcsim {version}), FMI 3.0. Inputs "
         f"{', '.join(CAUSALITIES[causality])}. Starts from the steady state consistent with the inputs."
     )
-    no_state = 'canGetAndSetFMUState="false" canSerializeFMUState="false" providesDirectionalDerivatives="false"'
+    caps = 'canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="false"'
     return [
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<fmiModelDescription fmiVersion="3.0" modelName={a(name)} instantiationToken={a(token)}',
         f"  description={a(description)}",
         f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
         '  variableNamingConvention="flat">',
-        f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" needsCompletedIntegratorStep="false" {no_state}/>',
+        f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" needsCompletedIntegratorStep="false" {caps}/>',
         f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
-        f' maxOutputDerivativeOrder="0" providesIntermediateUpdate="false" hasEventMode="false" {no_state}/>',
+        f' maxOutputDerivativeOrder="0" providesIntermediateUpdate="false" hasEventMode="false" {caps}/>',
     ]
 
 
