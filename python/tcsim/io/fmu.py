@@ -60,6 +60,7 @@ from ..models.converter import MODELS, Converter
 from ..models.drives import Drive, PumpTorqueTurbineSpeed, Speeds
 from ..models.dynamic import DynamicModel, resolve_model
 from ..simulation.transient import SolverError, simulate
+from .fmu_sources import PACKAGED_DIR, SOURCES_DIR, copy_rust_sources, is_source_tree
 from .outputs import output_file
 
 #: ``modelIdentifier`` of the FMU: the binary is ``binaries/<platform>/tcsim_converter.<ext>``
@@ -316,10 +317,20 @@ def source_root() -> Path | None:
             candidates.append(Path(unquote(urlparse(url).path)))
     except Exception:
         pass
-    for root in candidates:
-        if (root / "Cargo.toml").is_file() and (root / "crates" / "tcsim-fmu" / "Cargo.toml").is_file():
-            return root
-    return None
+    return next((root for root in candidates if is_source_tree(root)), None)
+
+
+def packaged_dir() -> Path:
+    """``tcsim/_fmu/`` of this copy of tcsim: where an installed wheel carries the FMU library it was
+    built with and that library's Rust sources (``sources/``); absent in a source checkout."""
+    return Path(__file__).resolve().parents[1] / PACKAGED_DIR
+
+
+def packaged_library() -> Path | None:
+    """The FMU library installed with this copy of tcsim (``tcsim/_fmu/libtcsim_fmu.so`` on Linux),
+    or None in a source checkout (``maturin develop``) or a copy built without it."""
+    lib = packaged_dir() / _local_library_file()
+    return lib if lib.is_file() else None
 
 
 def _newest_source_mtime(root: Path) -> float:
@@ -367,23 +378,23 @@ def build_library(root: Path, timeout_s: float = 1800.0) -> Path:
 
 
 def find_libraries(build: bool = True) -> list[Path]:
-    """The FMU libraries to package: ``$TCSIM_FMU_LIBRARY`` (one file, or several separated by
-    ``os.pathsep``, one per platform: ``.so`` linux64, ``.dll`` win64, ``.dylib`` darwin64), else
-    ``target/release/``, else ``target/debug/`` of the source tree (``libtcsim_fmu.so`` on Linux);
-    else, with ``build`` and a source tree, the library is built with cargo. Raises
-    :class:`FmuLibraryError` when there is none."""
+    """The FMU libraries to package, the first found of:
+
+    1. ``$TCSIM_FMU_LIBRARY`` (one file, or several separated by ``os.pathsep``, one per platform:
+       ``.so`` linux64, ``.dll`` win64, ``.dylib`` darwin64);
+    2. the library installed with the package (:func:`packaged_library`): built by ``pip install``
+       together with ``tcsim._core``, so it matches the variable table the XML is written from;
+    3. ``target/release/``, then ``target/debug/`` of the source tree (``libtcsim_fmu.so`` on
+       Linux), with a :class:`~tcsim.errors.TcsimWarning` when it is older than the Rust sources;
+    4. with ``build`` and a source tree, the library built now with cargo (a warning says so first).
+
+    Raises :class:`FmuLibraryError` when there is none."""
     env = os.environ.get(LIBRARY_ENV)
     if env:
-        libs = [Path(part).expanduser() for part in env.split(os.pathsep) if part.strip()]
-        for lib in libs:
-            if not lib.is_file():
-                raise FmuLibraryError(f"{LIBRARY_ENV}={env}: {lib}: no such file")
-            if lib.suffix.lower() not in PLATFORM_OF_SUFFIX:
-                raise FmuLibraryError(f"{LIBRARY_ENV}={env}: {lib}: expected a .so, .dll or .dylib library")
-        platforms = [PLATFORM_OF_SUFFIX[lib.suffix.lower()] for lib in libs]
-        if len(set(platforms)) != len(platforms):
-            raise FmuLibraryError(f"{LIBRARY_ENV}={env}: one library per platform")
-        return libs
+        return _env_libraries(env)
+    installed = packaged_library()
+    if installed is not None:
+        return [installed]
     root = source_root()
     name = _local_library_file()
     if root is not None:
@@ -399,14 +410,37 @@ def find_libraries(build: bool = True) -> list[Path]:
                     )
                 return [lib]
         if build:
+            warnings.warn(
+                f"the FMU library {name} is not built: running 'cargo build --release -p tcsim-fmu' in {root} "
+                "(minutes the first time)",
+                TcsimWarning,
+                stacklevel=2,
+            )
             return [build_library(root)]
     raise FmuLibraryError(
-        f"the FMU library {name} was not found: set {LIBRARY_ENV} to it, or run "
-        "'cargo build --release -p tcsim-fmu' in the tcsim source tree" + ("" if root is None else f" ({root})")
+        f"the FMU library {name} was not found: set {LIBRARY_ENV} to it, reinstall tcsim with "
+        "'pip install' (which builds it into the package), or run 'cargo build --release -p tcsim-fmu' in the "
+        "tcsim source tree" + ("" if root is None else f" ({root})")
     )
 
 
-def _check_library(lib: Path, needed: Sequence[str] = ("fmi2GetVersion", "fmi2Instantiate", "fmi2DoStep")) -> None:
+def _env_libraries(env: str) -> list[Path]:
+    """The libraries ``$TCSIM_FMU_LIBRARY`` lists: files, ``.so``/``.dll``/``.dylib``, one a platform."""
+    libs = [Path(part).expanduser() for part in env.split(os.pathsep) if part.strip()]
+    for lib in libs:
+        if not lib.is_file():
+            raise FmuLibraryError(f"{LIBRARY_ENV}={env}: {lib}: no such file")
+        if lib.suffix.lower() not in PLATFORM_OF_SUFFIX:
+            raise FmuLibraryError(f"{LIBRARY_ENV}={env}: {lib}: expected a .so, .dll or .dylib library")
+    platforms = [PLATFORM_OF_SUFFIX[lib.suffix.lower()] for lib in libs]
+    if len(set(platforms)) != len(platforms):
+        raise FmuLibraryError(f"{LIBRARY_ENV}={env}: one library per platform")
+    return libs
+
+
+def _check_library(
+    lib: Path, needed: Sequence[str] = ("fmi2GetVersion", "fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance")
+) -> None:
     """The library exports the ``needed`` functions (by default FMI 2.0's; and, if it is for this
     platform, it loads)."""
     if lib.suffix.lower() != Path(_local_library_file()).suffix:
@@ -428,65 +462,81 @@ SOURCES_README = """\
 This FMU was exported by `tcsim export-fmu` (tcsim {version}). Its binary, `binaries/linux64/{mi}.so`,
 is the Rust library `crates/tcsim-fmu` of tcsim, built from the sources in this directory. The
 model itself (the converter's parameters and the causality) is data, in `resources/model.json`, so
-one binary serves every converter, model and causality.
+one binary serves every converter, model and causality of this tcsim version.
 
 ## Rebuilding the binary for another platform
 
-The library has no dependency but Rust crates (diffsol, nalgebra, serde_json); no Python, no
-FMI SDK. With a Rust toolchain (https://rustup.rs, Rust 1.89 or newer) on the target platform:
+The library needs Rust 1.89 or newer (https://rustup.rs) and nothing else: no Python, no FMI SDK.
+Build it for the target: cargo writes `target/<target>/release/tcsim_fmu.dll` (Windows) or
+`target/<target>/release/libtcsim_fmu.dylib` (macOS). Copy it into the FMU under the
+`modelIdentifier`, `{mi}`:
 
-    cd sources            # this directory, extracted from the .fmu (a zip archive)
-    cargo build --release -p tcsim-fmu
-
-(or the same command in a checkout of the tcsim source tree). Then put the library into the FMU
-under the name the `modelIdentifier` requires, `{mi}`:
-
-| platform | cargo makes | copy it into the FMU as |
+| target | FMI 2.0 | FMI 3.0 |
 |---|---|---|
-| Linux x86-64 | `target/release/libtcsim_fmu.so` | `binaries/linux64/{mi}.so` |
-| Windows x86-64 (MSVC) | `target\\release\\tcsim_fmu.dll` | `binaries/win64/{mi}.dll` |
-| macOS (x86-64 or arm64) | `target/release/libtcsim_fmu.dylib` | `binaries/darwin64/{mi}.dylib` |
+| `x86_64-pc-windows-msvc` or `-gnu` | `binaries/win64/{mi}.dll` | `binaries/x86_64-windows/{mi}.dll` |
+| `x86_64-apple-darwin` | `binaries/darwin64/{mi}.dylib` (universal) | `binaries/x86_64-darwin/{mi}.dylib` |
+| `aarch64-apple-darwin` | `binaries/darwin64/{mi}.dylib` (universal) | `binaries/aarch64-darwin/{mi}.dylib` |
+| `x86_64-unknown-linux-gnu` | `binaries/linux64/{mi}.so` | `binaries/x86_64-linux/{mi}.so` |
 
-For example on Windows (PowerShell):
+Windows, MSVC (PowerShell, with the Visual Studio C++ build tools), in the folder of `converter.fmu`:
 
-    Expand-Archive converter.fmu fmu; cd fmu\\sources
-    cargo build --release -p tcsim-fmu
-    mkdir ..\\binaries\\win64; copy target\\release\\tcsim_fmu.dll ..\\binaries\\win64\\{mi}.dll
-    cd ..; Remove-Item -Recurse sources\\target
-    Compress-Archive -Path * -DestinationPath ..\\converter.fmu -Force
+    rustup target add x86_64-pc-windows-msvc
+    python -m zipfile -e converter.fmu fmu
+    cd fmu\\sources
+    $env:RUSTFLAGS = "-C target-feature=+crt-static"
+    cargo build --release -p tcsim-fmu --target x86_64-pc-windows-msvc
+    mkdir ..\\binaries\\win64
+    copy target\\x86_64-pc-windows-msvc\\release\\tcsim_fmu.dll ..\\binaries\\win64\\{mi}.dll
+    Remove-Item -Recurse target; cd ..
+    python -m zipfile -c ..\\converter-win.fmu modelDescription.xml binaries resources sources
 
-and on macOS:
+Windows, GNU, cross-compiled on Linux (`apt-get install gcc-mingw-w64-x86-64`):
 
-    mkdir fmu && cd fmu && unzip ../converter.fmu && cd sources
-    cargo build --release -p tcsim-fmu
-    mkdir -p ../binaries/darwin64 && cp target/release/libtcsim_fmu.dylib ../binaries/darwin64/{mi}.dylib
-    rm -rf target && cd .. && zip -r ../converter.fmu . -x 'sources/target/*'
+    rustup target add x86_64-pc-windows-gnu
+    python3 -m zipfile -e converter.fmu fmu && cd fmu/sources
+    cargo build --release -p tcsim-fmu --target x86_64-pc-windows-gnu
+    mkdir -p ../binaries/win64 && cp target/x86_64-pc-windows-gnu/release/tcsim_fmu.dll ../binaries/win64/{mi}.dll
+    rm -rf target && cd .. && python3 -m zipfile -c ../converter-win.fmu modelDescription.xml binaries resources sources
 
-A universal macOS library: build both `--target x86_64-apple-darwin` and `--target aarch64-apple-darwin`
-and join them with `lipo -create -output {mi}.dylib <x86_64 lib> <arm64 lib>`.
+macOS, one universal library for Intel and Apple silicon (Xcode command-line tools):
 
-Keep `modelDescription.xml` and `resources/` as they are: they do not depend on the platform.
-Do not add `<SourceFiles>`: the sources are Rust, not the C an importing tool would compile.
+    rustup target add x86_64-apple-darwin aarch64-apple-darwin
+    python3 -m zipfile -e converter.fmu fmu && cd fmu/sources
+    cargo build --release -p tcsim-fmu --target x86_64-apple-darwin
+    cargo build --release -p tcsim-fmu --target aarch64-apple-darwin
+    mkdir -p ../binaries/darwin64
+    lipo -create -output ../binaries/darwin64/{mi}.dylib target/x86_64-apple-darwin/release/libtcsim_fmu.dylib \\
+        target/aarch64-apple-darwin/release/libtcsim_fmu.dylib
+    rm -rf target && cd .. && python3 -m zipfile -c ../converter-mac.fmu modelDescription.xml binaries resources sources
+
+An FMI 3.0 FMU takes the FMI 3.0 folders (one library per architecture, no `lipo`). Keep
+`modelDescription.xml` and `resources/` as they are: they do not depend on the platform. Zip with
+Python's `zipfile` (paths with `/`, files at the root). Do not add `<SourceFiles>`: the sources are
+Rust, not the C an importing tool would compile.
 
 ## Contents
 
 * `Cargo.toml`, `Cargo.lock`: the workspace (members `tcsim-core` and `tcsim-fmu` only) and the
   exact dependency versions tcsim was built with;
 * `crates/tcsim-core/`: the converter models and the transient engine (pure Rust);
-* `crates/tcsim-fmu/`: the FMI 2.0 C API (Model Exchange and Co-Simulation).
+* `crates/tcsim-fmu/`: the FMI C API (Model Exchange and Co-Simulation).
 {missing}
 License: MIT (`LICENSE`).
 """
 
-_CRATE_FILES = ("Cargo.toml", "build.rs", "README.md", "LICENSE")
-_CRATE_DIRS = ("src", "include")
-
 
 def _write_sources(root: Path | None, dest: Path) -> None:
-    """``sources/``: the README and, when the source tree is known, the Rust sources."""
+    """``sources/``: the README and the Rust sources, those installed with the package
+    (``tcsim/_fmu/sources/``, the sources of :func:`packaged_library`) else those of the source tree
+    ``root``; with neither, the README alone and a warning."""
     dest.mkdir(parents=True, exist_ok=True)
     missing = ""
-    if root is None:
+    installed = packaged_dir() / SOURCES_DIR
+    if installed.is_dir():
+        shutil.copytree(installed, dest, dirs_exist_ok=True)
+    elif root is not None:
+        copy_rust_sources(root, dest)
+    else:
         missing = (
             "\n**This FMU carries no Rust sources**: it was exported without the tcsim source tree. "
             "Get them from the tcsim repository (the same version) and build there.\n"
@@ -496,22 +546,6 @@ def _write_sources(root: Path | None, dest: Path) -> None:
             TcsimWarning,
             stacklevel=3,
         )
-    else:
-        ws = (root / "Cargo.toml").read_text()
-        ws = re.sub(r"(?ms)^members\s*=\s*\[.*?\]", 'members = ["crates/tcsim-core", "crates/tcsim-fmu"]', ws, count=1)
-        (dest / "Cargo.toml").write_text(ws)
-        for name in ("Cargo.lock", "LICENSE"):
-            if (root / name).is_file():
-                shutil.copy2(root / name, dest / name)
-        for crate in ("tcsim-core", "tcsim-fmu"):
-            src, out = root / "crates" / crate, dest / "crates" / crate
-            out.mkdir(parents=True)
-            for name in _CRATE_FILES:
-                if (src / name).is_file():
-                    shutil.copy2(src / name, out / name)
-            for d in _CRATE_DIRS:
-                if (src / d).is_dir():
-                    shutil.copytree(src / d, out / d, ignore=shutil.ignore_patterns("target", "*.orig", "*.rej", ".*"))
     (dest / "README.md").write_text(SOURCES_README.format(version=_version(), mi=MODEL_IDENTIFIER, missing=missing))
 
 
