@@ -234,4 +234,12 @@ def fmu_event_indicators(model: str) -> int:
 def fmu_units() -> list[tuple[str, list[tuple[str, int]], list[tuple[str, str]]]]:
     """``<UnitDefinitions>``: name, SI base-unit exponents, display units with their factors as text."""
 
+#: FMI 3.0: value reference of ``time``, the independent variable.
+FMU_TIME_VR: int
+#: FMI 3.0: the key of ``resources/model.json`` holding the ``instantiationToken``.
+FMU_INSTANTIATION_TOKEN_KEY: str
+
+def fmu_event_indicator_variables(model: str) -> list[dict[str, Any]]:
+    """FMI 3.0: the event indicators of a model kind as variables (as :func:`fmu_variables`)."""
+
 def time_resolution_s(t: float) -> float: ...

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from .io.fmu import (
     CAUSALITIES,
+    FMI2,
     SIGNALS,
     FmuLibraryError,
     export_fmu,
@@ -12,13 +13,17 @@ from .io.fmu import (
     model_description_xml,
     model_json,
 )
+from .io.fmu3 import FMI3, fmi_version
 
 __all__ = [
     "CAUSALITIES",
+    "FMI2",
+    "FMI3",
     "SIGNALS",
     "FmuLibraryError",
     "export_fmu",
     "find_libraries",
+    "fmi_version",
     "fmu_parameters",
     "model_description_xml",
     "model_json",

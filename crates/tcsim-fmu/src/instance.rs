@@ -713,6 +713,38 @@ impl Instance {
     }
 }
 
+/// What the FMI 3.0 layer (`fmi3.rs`) asks beyond the FMI 2.0 calls.
+impl Instance {
+    /// Whether the Model Exchange state exists (after initialisation, or an output read in it).
+    pub fn me_ready(&self) -> bool {
+        self.me.is_some()
+    }
+
+    /// The current time: the model's (Model Exchange), the last communication point
+    /// (Co-Simulation), else the start time.
+    pub fn time_now(&self) -> f64 {
+        match (&self.me, &self.stepper) {
+            (Some(me), _) => me.time_s,
+            (None, Some(stepper)) => stepper.time_s(),
+            (None, None) => self.start_time,
+        }
+    }
+
+    /// Event indicator `i` now: Model Exchange's, or in Co-Simulation that of the state at the
+    /// last communication point; none before initialisation.
+    pub fn event_indicator_now(&self, i: usize) -> Option<f64> {
+        let h = self.options.hysteresis;
+        if let Some(me) = &self.me {
+            let drive = self.me_drive(me.time_s).ok()?;
+            return ModeView::new(&me.model, &drive, me.mode).indicators(&me.u, me.time_s, &h).get(i).copied();
+        }
+        let stepper = self.stepper.as_ref()?;
+        let sample = stepper.sample()?;
+        let drive = self.me_drive(sample.time_s).ok()?;
+        ModeView::new(&stepper.model, &drive, sample.mode).indicators(&sample.u, sample.time_s, &h).get(i).copied()
+    }
+}
+
 #[cfg(test)]
 mod me_tests {
     use super::*;

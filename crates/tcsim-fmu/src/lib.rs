@@ -15,6 +15,7 @@
 // `# Safety` section.
 #![allow(clippy::missing_safety_doc)]
 
+pub mod fmi3;
 mod instance;
 mod snapshot;
 pub mod uri;

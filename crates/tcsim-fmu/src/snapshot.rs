@@ -145,6 +145,11 @@ impl Instance {
 }
 
 impl Snapshot {
+    /// The instance's phase when the state was taken (for FMI 3.0's finer state machine).
+    pub fn phase(&self) -> Phase {
+        self.phase
+    }
+
     /// An error unless this is a live snapshot (not freed, not a foreign pointer's memory).
     pub fn check_live(&self) -> Result<(), String> {
         if self.live == LIVE {

@@ -639,6 +639,42 @@ pub fn variables(model: Model, causality: Causality, parameters: &[Parameter]) -
     out
 }
 
+// ---------------------------------------------------------------------------------------------
+// FMI 3.0 only: the independent variable and the event indicators as variables
+
+/// Value reference of `time`, the independent variable FMI 3.0 declares.
+pub const TIME: u32 = 50;
+/// Value reference of event indicator 0 (FMI 3.0 declares each as a variable); indicator i has
+/// `FIRST_EVENT_INDICATOR + i`.
+pub const FIRST_EVENT_INDICATOR: u32 = 40;
+/// Name and description of each event indicator, in the engine's order
+/// (`tcsim_core::engine::mode_view::ModeView::indicators`).
+pub const EVENT_INDICATOR_NAMES: [(&str, &str); EVENT_INDICATORS] = [
+    ("stator_clutch_indicator", "Event indicator of the stator one-way clutch (positive while its state holds)"),
+    ("flow_indicator", "Event indicator of the flow direction (positive while it holds)"),
+    ("reverse_flow_indicator", "Event indicator of flow starting in reverse (positive while it does not)"),
+];
+
+/// The event indicator of value reference `vr`: its index.
+pub fn event_indicator(vr: u32) -> Option<usize> {
+    vr.checked_sub(FIRST_EVENT_INDICATOR).map(|i| i as usize).filter(|&i| i < EVENT_INDICATORS)
+}
+
+/// The event indicators of a model as FMI 3.0 variables (`local`, `continuous`, `calculated`, no
+/// unit: each is a torque, a speed or a flow, by the mode); none for a model without them.
+pub fn event_indicator_variables(model: Model) -> Vec<Variable> {
+    EVENT_INDICATOR_NAMES[..model.event_indicators()]
+        .iter()
+        .enumerate()
+        .map(|(i, (name, description))| {
+            let mut v =
+                Variable::new(FIRST_EVENT_INDICATOR + i as u32, name, "local", "continuous", "").describe(*description);
+            v.initial = Some("calculated");
+            v
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -132,6 +132,13 @@ pub fn fmu_units() -> Vec<(&'static str, Vec<(&'static str, i32)>, Vec<(&'static
         .collect()
 }
 
+/// FMI 3.0: the event indicators of a model kind as variables (dicts as [`fmu_variables`]), in
+/// the order of `<EventIndicator>`.
+#[pyfunction]
+pub fn fmu_event_indicator_variables<'py>(py: Python<'py>, model: &str) -> PyResult<Vec<Bound<'py, PyDict>>> {
+    variables::event_indicator_variables(model_of(model)?).iter().map(|v| variable_dict(py, v)).collect()
+}
+
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FMU_MODEL_IDENTIFIER", variables::MODEL_IDENTIFIER)?;
     m.add("FMU_LOG_CATEGORIES", tcsim_fmu::LOG_CATEGORIES.to_vec())?;
@@ -141,5 +148,8 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fmu_causalities, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_event_indicators, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_units, m)?)?;
+    m.add("FMU_TIME_VR", variables::TIME)?;
+    m.add("FMU_INSTANTIATION_TOKEN_KEY", tcsim_fmu::fmi3::TOKEN_KEY)?;
+    m.add_function(wrap_pyfunction!(fmu_event_indicator_variables, m)?)?;
     Ok(())
 }

@@ -1,4 +1,5 @@
-"""``tcsim export-fmu``: one converter model as an FMI 2.0 FMU (see :mod:`tcsim.io.fmu`)."""
+"""``tcsim export-fmu``: one converter model as an FMI 2.0 or 3.0 FMU (see :mod:`tcsim.io.fmu` and
+:mod:`tcsim.io.fmu3`)."""
 
 from __future__ import annotations
 
@@ -11,26 +12,28 @@ from .app import say
 
 #: The command's ``--help`` text.
 HELP = (
-    "Export one model as an FMI 2.0 FMU, Model Exchange and Co-Simulation (linux64 binary, sources to "
+    "Export one model as an FMI 2.0 or 3.0 FMU, Model Exchange and Co-Simulation (linux binary, sources to "
     "rebuild elsewhere; no Python inside)."
 )
 
 
-def export_fmu_command(converter: str, model: str, out: Path, causality: str) -> str:
+def export_fmu_command(converter: str, model: str, out: Path, causality: str, fmi_version: str = "2") -> str:
     """Write the FMU; the line to print."""
     import json
     import zipfile
 
     from ..io.fmu import CAUSALITIES
     from ..io.fmu import export_fmu as write_fmu
+    from ..io.fmu3 import fmi_version as version_of
 
-    path = write_fmu(converter, model, out, causality)
+    fmi = version_of(fmi_version)
+    path = write_fmu(converter, model, out, causality, fmi=fmi)
     with zipfile.ZipFile(path) as zf:
         params = json.loads(zf.read("resources/model.json"))["parameters"]
         platforms = sorted({n.split("/")[1] for n in zf.namelist() if n.startswith("binaries/")})
     inputs = CAUSALITIES[causality]
     return (
-        f"{model} model of {converter} written to {path} (FMI 2.0 Model Exchange and Co-Simulation, "
+        f"{model} model of {converter} written to {path} (FMI {fmi.name} Model Exchange and Co-Simulation, "
         f"{', '.join(platforms)}; inputs {' and '.join(inputs)}; {len(params)} tunable parameters)"
     )
 
@@ -43,6 +46,9 @@ def export_fmu(
         str,
         typer.Option("--causality", help="pump-torque (pump torque and turbine speed in) | speeds (both speeds in)"),
     ] = "pump-torque",
+    fmi_version: Annotated[
+        str, typer.Option("--fmi-version", help="2 (FMI 2.0, the default) | 3 (FMI 3.0)", metavar="2|3")
+    ] = "2",
 ) -> None:
     """The command; its help is :data:`HELP`."""
-    say(export_fmu_command(converter, model, out, causality))
+    say(export_fmu_command(converter, model, out, causality, fmi_version))

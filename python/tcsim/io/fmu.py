@@ -4,7 +4,7 @@ no Python inside.
 ::
 
     tcsim export-fmu CONVERTER --model table|hrovat-tobler|quasi-dynamic -o FILE.fmu
-                     [--causality pump-torque|speeds]
+                     [--causality pump-torque|speeds] [--fmi-version 2|3]
 
 The FMU is a zip archive:
 
@@ -45,7 +45,7 @@ import tempfile
 import uuid
 import warnings
 import zipfile
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from importlib import metadata
@@ -438,10 +438,11 @@ def _env_libraries(env: str) -> list[Path]:
     return libs
 
 
-def _check_library(lib: Path) -> None:
-    """The library exports the FMI 2.0 Co-Simulation functions (and, if it is for this platform,
-    it loads)."""
-    needed = ("fmi2GetVersion", "fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance")
+def _check_library(
+    lib: Path, needed: Sequence[str] = ("fmi2GetVersion", "fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance")
+) -> None:
+    """The library exports the ``needed`` functions (by default FMI 2.0's; and, if it is for this
+    platform, it loads)."""
     if lib.suffix.lower() != Path(_local_library_file()).suffix:
         data = lib.read_bytes()
         missing = [f for f in needed if f.encode() not in data]
@@ -588,27 +589,58 @@ def _is_fmu(path: Path) -> bool:
         return False
 
 
+@dataclass(frozen=True)
+class FmiVersion:
+    """What differs between the FMI versions an FMU is written for (the library, the model and the
+    variables are the same)."""
+
+    #: ``fmiVersion`` of the model description (``2.0``).
+    name: str
+    #: ``modelDescription.xml`` of a model under a causality with a GUID/instantiation token.
+    model_description: Callable[[DynamicModel, str, str], str]
+    #: Entries ``resources/model.json`` adds for the version, given the token.
+    resources: Callable[[str], dict[str, Any]]
+    #: The ``binaries/`` directories of a library file.
+    platforms: Callable[[Path], list[str]]
+    #: Functions the library must export.
+    functions: tuple[str, ...]
+    #: What ``sources/README.md`` adds for the version (markdown; none for FMI 2.0).
+    sources_note: str = ""
+
+
+#: FMI 2.0: ``binaries/linux64``, ``win64``, ``darwin64``; the GUID in ``model.json``.
+FMI2 = FmiVersion(
+    "2.0",
+    lambda model, causality, token: model_description_xml(model, causality, guid=token),
+    lambda token: {"guid": token},  # checked by fmi2Instantiate
+    lambda lib: [PLATFORM_OF_SUFFIX[lib.suffix.lower()]],
+    ("fmi2GetVersion", "fmi2Instantiate", "fmi2DoStep", "fmi2FreeInstance"),
+)
+
+
 def export_fmu(
     converter: Converter | str | Path | DynamicModel | None,
     model: str | DynamicModel,
     out_path: str | Path,
     causality: str = "pump-torque",
+    fmi: FmiVersion = FMI2,
 ) -> Path:
     """Write the FMU of ``model`` (a name of :data:`tcsim.models.converter.MODELS`, or a
     :class:`~tcsim.transient.DynamicModel`, with ``converter`` then ignored) of ``converter`` (a
     :class:`~tcsim.models.converter.Converter`, bundled name or file) to ``out_path`` (``*.fmu``), written
     atomically by the rule of :func:`tcsim.io.outputs.output_file` (an input of the run or a
-    directory of that name is refused, an existing file replaced). Returns the path."""
+    directory of that name is refused, an existing file replaced), for FMI 2.0 or, with
+    ``fmi=tcsim.io.fmu3.FMI3``, 3.0. Returns the path."""
     _check_causality(causality)
     out = _output_path(out_path)
     dyn = resolve_model(converter if isinstance(converter, (Converter, DynamicModel)) else str(converter), model)
     _check_model(dyn, causality)
-    guid = "{" + str(uuid.uuid4()) + "}"
-    xml = model_description_xml(dyn, causality, guid=guid)
-    config = {**model_json(dyn, causality), "guid": guid}  # checked by fmi2Instantiate
+    token = "{" + str(uuid.uuid4()) + "}"
+    xml = fmi.model_description(dyn, causality, token)
+    config = {**model_json(dyn, causality), **fmi.resources(token)}
     libs = find_libraries()
     for lib in libs:
-        _check_library(lib)
+        _check_library(lib, fmi.functions)
     root = source_root()
 
     inputs = [str(p) for p in (converter, dyn.source) if isinstance(p, (str, Path))]
@@ -618,10 +650,13 @@ def export_fmu(
         (stage / "resources").mkdir()
         (stage / "resources" / "model.json").write_text(json.dumps(config, indent=1) + "\n")
         for lib in libs:
-            platform = PLATFORM_OF_SUFFIX[lib.suffix.lower()]
-            (stage / "binaries" / platform).mkdir(parents=True)
-            shutil.copyfile(lib, stage / "binaries" / platform / f"{MODEL_IDENTIFIER}{lib.suffix.lower()}")
+            for platform in fmi.platforms(lib):
+                (stage / "binaries" / platform).mkdir(parents=True)
+                shutil.copyfile(lib, stage / "binaries" / platform / f"{MODEL_IDENTIFIER}{lib.suffix.lower()}")
         _write_sources(root, stage / "sources")
+        if fmi.sources_note:
+            with (stage / "sources" / "README.md").open("a") as readme:
+                readme.write(fmi.sources_note)
         with zipfile.ZipFile(tmp, "w", compression=zipfile.ZIP_DEFLATED) as zf:
             for item in sorted(stage.rglob("*")):
                 if item.is_file():
