@@ -50,7 +50,7 @@ CONVERTER = "li-sunden-2016"
 MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
 #: ``tcsim export-fmu --fmi-version`` values to test (FMI 3.0 joins as "3"); "2" is the default
 #: and is exported without the flag.
-FMI_VERSIONS = ("2",)
+FMI_VERSIONS = ("2", "3")
 #: The replay drive of each ``--causality``, made from the measurement's columns (SI, conventions.md).
 REPLAY_DRIVES: dict[str, Callable[[pd.DataFrame], PumpTorqueTurbineSpeed | Speeds]] = {
     "pump-torque": lambda m: PumpTorqueTurbineSpeed(m["time_s"], m["pump_torque_nm"], m["turbine_speed_rad_s"]),
@@ -269,25 +269,10 @@ def test_importer_known_defects(fmi_sim, fmus, measurement, tmp_path, model, cau
 # ---------------------------------------------------------------------------------------------
 # unpacked into folders with awkward names (the resource URI, issue 13 item 2)
 
-ITEM_2 = "issue 13 item 2: the FMU decodes %20 only in the resource URI, so it does not find resources/model.json"
-#: Folder names, and the characters each importer percent-encodes in the resource URI it passes:
-#: fmi-sim (the url crate's path set) encodes the space and ö, FMPy (pathlib's as_uri) all but
-#: letters, digits and ``-_.~/``.
+#: Folder names. fmi-sim (the url crate's path set) percent-encodes the space and ö in the resource
+#: URI it passes, FMPy (pathlib's as_uri) all but letters, digits and ``-_.~/``; the FMU decodes
+#: them all (issue 13 item 2; these cases failed before, shown by strict xfails until the fix).
 FOLDERS = ("plain", "with space", "with+plus", "with(paren", "with-ö", "unpack dir +(ö)")
-ENCODED = {"fmi-sim": {"ö"}, "fmpy": {"+", "(", "ö"}}
-
-
-def _folder_cases(importer: str) -> list:
-    return [
-        pytest.param(
-            name,
-            marks=[pytest.mark.xfail(strict=True, raises=AssertionError, reason=ITEM_2)]
-            if ENCODED[importer] & set(name)
-            else [],
-            id=name,
-        )
-        for name in FOLDERS
-    ]
 
 
 SHORT_STOP_S = 0.1
@@ -302,7 +287,7 @@ def plain_run(fmi_sim, fmus, measurement, tmp_path_factory) -> pd.DataFrame:
     return _run_importer(fmi_sim, fmu, "co-simulation", inputs, CS_STEP_S, SHORT_STOP_S, workdir)
 
 
-@pytest.mark.parametrize("folder", _folder_cases("fmi-sim"))
+@pytest.mark.parametrize("folder", FOLDERS)
 def test_importer_unpacks_into_an_awkward_folder(fmi_sim, fmus, measurement, plain_run, tmp_path, folder):
     """fmi-sim unpacks the FMU into a temporary folder under $TMPDIR: named ``folder`` here, with
     the FMU file in it too. The run is the run from the plain temporary folder."""
@@ -316,7 +301,7 @@ def test_importer_unpacks_into_an_awkward_folder(fmi_sim, fmus, measurement, pla
     assert [p.name for p in where.iterdir() if p.name.startswith("fmi-rs")] == [], "fmi-sim removed what it unpacked"
 
 
-@pytest.mark.parametrize("folder", _folder_cases("fmpy"))
+@pytest.mark.parametrize("folder", FOLDERS)
 def test_fmpy_runs_from_an_awkward_folder(fmus, tmp_path, folder):
     """FMPy, from the FMU unpacked into a folder named ``folder``: the same run as from the archive."""
     fmpy = pytest.importorskip("fmpy")

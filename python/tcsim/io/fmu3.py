@@ -64,6 +64,25 @@ def platforms(lib: Path) -> list[str]:
     return ["x86_64-darwin"]
 
 
+def _type_name(v: dict[str, Any]) -> str:
+    """The ``<Float64Type>`` of a variable's unit and display unit (the variables carry their units
+    through ``declaredType``, as the Modelica Association's Reference FMUs do: importers that read
+    only type definitions, such as fmi-sim 0.7.0, accept no ``unit`` on a variable)."""
+    return v["unit"] + (f" in {v['display_unit']}" if v["display_unit"] else "")
+
+
+def _type_definitions(variables: list[dict[str, Any]]) -> list[str]:
+    """``<TypeDefinitions>``: one ``<Float64Type>`` per unit and display unit used (``time``: s)."""
+    a, seen, lines = xml_attr, {"s": ("s", None)}, []
+    for v in variables:
+        if v["unit"]:
+            seen[_type_name(v)] = (v["unit"], v["display_unit"])
+    for name, (unit, display) in seen.items():
+        shown = f" displayUnit={a(display)}" if display else ""
+        lines.append(f"    <Float64Type name={a(name)} unit={a(unit)}{shown}/>")
+    return ["  <TypeDefinitions>", *lines, "  </TypeDefinitions>"]
+
+
 def _float64(v: dict[str, Any]) -> str:
     """One ``<Float64>`` of a row of the variable table."""
     a = xml_attr
@@ -71,8 +90,7 @@ def _float64(v: dict[str, Any]) -> str:
     attrs += f" description={a(v['description'])}" if v["description"] else ""
     attrs += f' causality="{v["causality"]}" variability="{v["variability"]}"'
     attrs += f' initial="{v["initial"]}"' if v["initial"] else ""
-    attrs += f" unit={a(v['unit'])}" if v["unit"] else ""
-    attrs += f" displayUnit={a(v['display_unit'])}" if v["display_unit"] else ""
+    attrs += f" declaredType={a(_type_name(v))}" if v["unit"] else ""
     attrs += f' start="{v["start_text"]}"' if v["start_text"] is not None else ""
     attrs += f' derivative="{v["derivative_of"]}"' if v["derivative_of"] is not None else ""
     return f"    <Float64 {attrs}/>"
@@ -133,12 +151,13 @@ def model_description_xml(
     stamp = (generation_time or datetime.now(UTC)).strftime("%Y-%m-%dT%H:%M:%SZ")
     time = (
         f'    <Float64 name="time" valueReference="{TIME_VR}" description="Simulation time"'
-        ' causality="independent" variability="continuous" unit="s"/>'
+        ' causality="independent" variability="continuous" declaredType="s"/>'
     )
     return "\n".join(
         [
             *_header(model, causality, name, token, stamp),
             *fmu._unit_definitions(),
+            *_type_definitions(variables + indicators),
             "  <LogCategories>",
             '    <Category name="logStatusError" description="Errors, with the reason (always logged)"/>',
             "  </LogCategories>",
