@@ -6,17 +6,18 @@ use tcsim_core::converter::dynamics::ConverterDynamics;
 use tcsim_core::converter::dynamics::FLOW;
 use tcsim_core::converter::spec::{build_model, ModelSpec};
 use tcsim_core::engine::converter_events::{Mode, Sample};
-use tcsim_core::engine::isolated::{initial_mode, initial_state, Drive, InitialState};
-use tcsim_core::engine::mode_view::ModeView;
+use tcsim_core::engine::isolated::{initial_mode, initial_state, Drive, InitialState, TurbineLoad};
+use tcsim_core::engine::lockup::{ClutchMode, LockupCommand};
+use tcsim_core::engine::mode_view::{ModeView, LOCKUP_INDICATOR};
 use tcsim_core::engine::options::SolverOptions;
 use tcsim_core::engine::outputs::{row, COLUMNS};
 use tcsim_core::engine::signal::Signal;
-use tcsim_core::engine::stepper::{Causality, Stepper};
+use tcsim_core::engine::stepper::{Causality, Stepper, StepperDrive};
 use tcsim_core::CoreResult;
 
 use crate::variables::{
-    self, causality_of, is_derivative, is_input, signal_name, start_parameter, vr, Model, FIRST_DERIVATIVE,
-    FIRST_PARAMETER, RATES, SIGNALS, SIGNAL_SLOTS, START_PARAMETERS,
+    self, causality_of, drive_parameter, has_signal, is_derivative, is_input, signal_name, start_parameter, vr, Model,
+    DRIVE_PARAMETERS, FIRST_DERIVATIVE, FIRST_PARAMETER, RATES, SIGNALS, SIGNAL_SLOTS, START_PARAMETERS,
 };
 
 /// A parameter: the spec entry `model[key]` (scalar) or `model[key][index]`.
@@ -50,9 +51,10 @@ impl Configuration {
         let doc: Value = serde_json::from_str(text).map_err(|e| format!("model.json: {e}"))?;
         let causality = match doc.get("causality").and_then(Value::as_str) {
             None => Causality::PumpTorqueTurbineSpeed,
-            Some(name) => {
-                causality_of(name).ok_or(format!("model.json: causality {name:?}: expected pump-torque or speeds"))?
-            }
+            Some(name) => causality_of(name).ok_or_else(|| {
+                let names: Vec<&str> = variables::CAUSALITIES.iter().map(|c| c.0).collect();
+                format!("model.json: causality {name:?}: expected one of {}", names.join(", "))
+            })?,
         };
         let model = doc.get("model").and_then(Value::as_object).cloned().ok_or("model.json: no \"model\" object")?;
         let mut parameters = Vec::new();
@@ -114,8 +116,10 @@ pub struct Instance {
     rates: [Option<f64>; SIGNAL_SLOTS],
     /// Model Exchange: the model, all coordinates, the mode and the time.
     me: Option<ModelExchange>,
-    /// Values of the start-value parameters ([`START_PARAMETERS`], value references 30–33).
+    /// Values of the start-value parameters ([`START_PARAMETERS`], value references 30–34).
     start: [f64; START_PARAMETERS.len()],
+    /// Values of the drive's fixed parameters ([`DRIVE_PARAMETERS`], value references 35–37).
+    drive: [f64; DRIVE_PARAMETERS.len()],
     /// Inputs at the previous communication point, for the rate estimate.
     previous: Option<(f64, [f64; 2])>,
     stepper: Option<Stepper<Box<dyn ConverterDynamics + Send>>>,
@@ -146,6 +150,7 @@ impl Instance {
             rates: [None; SIGNAL_SLOTS],
             me: None,
             start: START_PARAMETERS.map(|s| s.start),
+            drive: DRIVE_PARAMETERS.map(|d| d.start),
             previous: None,
             stepper: None,
             rebuild: false,
@@ -177,6 +182,9 @@ impl Instance {
         if let Some(i) = start_parameter(vr) {
             return Some(self.start[i]);
         }
+        if let Some(i) = drive_parameter(vr) {
+            return Some(self.drive[i]);
+        }
         let output = is_derivative(vr) || ((vr as usize) < SIGNAL_SLOTS && !self.settable(vr as usize));
         if self.initializing && output {
             // in initialisation mode the outputs are the steady state for the inputs set so far
@@ -205,12 +213,21 @@ impl Instance {
             self.start[i] = value;
             return Ok(());
         }
+        if let Some(i) = drive_parameter(vr) {
+            return self.set_drive_parameter(i, value);
+        }
         if let Some(name) = signal_name(vr) {
+            if !has_signal(self.config.causality, vr) && variables::signal_def(vr).is_some() {
+                return Err(format!("no variable with value reference {vr} under this causality"));
+            }
             if !self.settable(vr as usize) {
                 return Err(format!("{name} is an output and cannot be set"));
             }
             if !value.is_finite() {
                 return Err(format!("{name} = {value}: expected a finite value"));
+            }
+            if vr == vr::LOCKUP_CAPACITY && value < 0.0 {
+                return Err(format!("{name} = {value}: expected a capacity of zero or more (N.m)"));
             }
             self.signals[vr as usize] = value;
             return Ok(());
@@ -234,7 +251,8 @@ impl Instance {
     }
 
     pub fn set_rate(&mut self, vr: u32, order: i32, value: f64) -> Result<(), String> {
-        if order != 1 || !self.input_refs().contains(&(vr as usize)) {
+        let input = self.input_refs().contains(&(vr as usize)) || variables::COMMON_INPUTS.contains(&vr);
+        if order != 1 || !input {
             return Err(format!(
                 "input derivatives of order 1 of the inputs only (value reference {vr}, order {order})"
             ));
@@ -264,6 +282,8 @@ impl Instance {
         }
         let model = self.model().map_err(|e| e.to_string())?;
         let mut stepper = Stepper::new(model, self.config.causality, self.options);
+        let capacity = self.signals[vr::LOCKUP_CAPACITY as usize];
+        stepper.extra = self.stepper_drive([capacity, capacity]);
         let refs = self.input_refs();
         let rates = [self.rates[refs[0]].unwrap_or(0.0), self.rates[refs[1]].unwrap_or(0.0)];
         let sample =
@@ -291,7 +311,12 @@ impl Instance {
             _ => [0.0, 0.0],
         };
         let end = [0, 1].map(|k| start[k] + h * self.rates[refs[k]].unwrap_or(estimated[k]));
+        // the capacity: held over the interval, unless its rate is given (then linear, not below 0)
+        let capacity = self.signals[vr::LOCKUP_CAPACITY as usize];
+        let capacity_end = (capacity + h * self.rates[vr::LOCKUP_CAPACITY as usize].unwrap_or(0.0)).max(0.0);
+        let extra = self.stepper_drive([capacity, capacity_end]);
         let stepper = self.stepper.as_mut().ok_or("fmi2DoStep before initialisation")?;
+        stepper.extra = extra;
         if (stepper.time_s() - t).abs() > 1e-9 * t.abs().max(1.0) {
             return Err(format!(
                 "communication point {t} s: expected the end of the last step, {} s",
@@ -302,6 +327,30 @@ impl Instance {
         self.previous = Some((t, start));
         self.rates = [None; SIGNAL_SLOTS];
         self.publish(&sample);
+        Ok(())
+    }
+
+    /// The clutch and the load of the stepper, with the capacity at the start and end of an interval.
+    fn stepper_drive(&self, capacity_nm: [f64; 2]) -> StepperDrive {
+        let d = |vr: u32| drive_parameter(vr).map_or(f64::NAN, |i| self.drive[i]);
+        StepperDrive {
+            lockup_capacity_nm: Some(capacity_nm),
+            lockup_static_to_kinetic: d(vr::LOCKUP_STATIC_TO_KINETIC),
+            load_inertia_kg_m2: d(vr::LOAD_INERTIA),
+            load_drag_nm_s2: d(vr::LOAD_DRAG),
+        }
+    }
+
+    /// Set a drive parameter: before initialisation only, finite and at least its minimum.
+    fn set_drive_parameter(&mut self, i: usize, value: f64) -> Result<(), String> {
+        let d = &DRIVE_PARAMETERS[i];
+        if self.stepper.is_some() || (self.me.is_some() && !self.initializing) {
+            return Err(format!("{} is fixed after initialisation", d.name));
+        }
+        if !(value.is_finite() && value >= d.min) {
+            return Err(format!("{} = {value}: expected a finite value of {} or more", d.name, d.min));
+        }
+        self.drive[i] = value;
         Ok(())
     }
 
@@ -386,13 +435,16 @@ impl Instance {
     /// The initial state the start-value parameters ask for (none: the steady state).
     fn initial(&self) -> InitialState {
         let start = |vr: u32| start_parameter(vr).map_or(f64::NAN, |i| self.start[i]);
+        // drive (c): the turbine speed is a state; the steady start is at its initial value
+        let turbine_speed_rad_s =
+            (self.config.causality == Causality::Torques).then(|| start(vr::INITIAL_TURBINE_SPEED));
         if start(vr::START_FROM_STEADY_STATE) != 0.0 {
-            return InitialState::default();
+            return InitialState { turbine_speed_rad_s, ..InitialState::default() };
         }
         let pump_given = variables::inputs(self.config.causality).contains(&vr::PUMP_SPEED);
         InitialState {
             pump_speed_rad_s: (!pump_given).then(|| start(vr::INITIAL_PUMP_SPEED)),
-            turbine_speed_rad_s: None,
+            turbine_speed_rad_s,
             stator_speed_rad_s: Some(start(vr::INITIAL_STATOR_SPEED)),
             flow_m3_s: Some(start(vr::INITIAL_FLOW)),
         }
@@ -405,16 +457,30 @@ impl Instance {
         };
         let s = |vr: u32| self.signals[vr as usize];
         let turbine = line("turbine_speed_rad_s", s(vr::TURBINE_SPEED), s(vr::TURBINE_ACCEL))?;
+        let extra = self.stepper_drive([s(vr::LOCKUP_CAPACITY); 2]);
+        let lockup = Some(LockupCommand {
+            capacity_nm: Signal::constant(s(vr::LOCKUP_CAPACITY)),
+            static_to_kinetic: extra.lockup_static_to_kinetic,
+        });
         Ok(match self.config.causality {
             Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
                 pump_torque_nm: Signal::constant(s(vr::PUMP_TORQUE)),
                 turbine_speed_rad_s: turbine,
-                lockup: None,
+                lockup,
             },
             Causality::Speeds => Drive::Speeds {
                 pump_speed_rad_s: line("pump_speed_rad_s", s(vr::PUMP_SPEED), s(vr::PUMP_ACCEL))?,
                 turbine_speed_rad_s: turbine,
-                lockup: None,
+                lockup,
+            },
+            Causality::Torques => Drive::PumpTorqueLoad {
+                pump_torque_nm: Signal::constant(s(vr::PUMP_TORQUE)),
+                load: TurbineLoad {
+                    torque_nm: Signal::constant(s(vr::LOAD_TORQUE)),
+                    inertia_kg_m2: extra.load_inertia_kg_m2,
+                    drag_nm_s2: extra.load_drag_nm_s2,
+                },
+                lockup,
             },
         })
     }
@@ -498,11 +564,21 @@ impl Instance {
     pub fn me_indicators(&self, g: &mut [f64]) -> Result<(), String> {
         let me = self.me_state()?;
         let drive = self.me_drive(me.time_s)?;
-        let values = ModeView::new(&me.model, &drive, me.mode).indicators(&me.u, me.time_s, &self.options.hysteresis);
-        for (v, x) in g.iter_mut().zip(values) {
-            *v = x;
+        let mut values =
+            ModeView::new(&me.model, &drive, me.mode).indicators(&me.u, me.time_s, &self.options.hysteresis);
+        if self.locked_without_capacity(me.mode) {
+            values[LOCKUP_INDICATOR] = -1.0; // the command fell to zero: the clutch opens
+        }
+        let slots = self.model_kind().map_or_else(Vec::new, Model::indicator_slots);
+        for (v, &slot) in g.iter_mut().zip(&slots) {
+            *v = values[slot];
         }
         Ok(())
+    }
+
+    /// A locked clutch whose command is zero (it has no roots: the host's zero opens it at once).
+    fn locked_without_capacity(&self, mode: Mode) -> bool {
+        mode.lockup.is_locked() && self.signals[vr::LOCKUP_CAPACITY as usize] <= 0.0
     }
 
     /// `fmi2NewDiscreteStates`: apply every due switch; whether the states changed.
@@ -512,6 +588,10 @@ impl Instance {
         let drive = self.me_drive(me.time_s)?;
         let (mut u, mut mode, t) = (me.u, me.mode, me.time_s);
         let mut changed = false;
+        if self.locked_without_capacity(mode) {
+            mode.lockup = ClutchMode::Unarmed { since_s: t };
+            changed = true;
+        }
         for _ in 0..8 {
             match ModeView::new(&me.model, &drive, mode).event(&mut u, t, &h) {
                 Some((_, next)) => {
@@ -587,7 +667,7 @@ mod me_tests {
                 let me = inst.me.as_ref().unwrap();
                 let table: Vec<usize> = variables::states(model, causality).iter().map(|&(_, c)| c).collect();
                 assert_eq!(me.coordinates, table, "{model:?} {name}");
-                assert_eq!(me.model.has_stator_clutch(), model.event_indicators() > 0, "{model:?}");
+                assert_eq!(me.model.has_stator_clutch(), model.event_indicators() > 1, "{model:?}");
                 assert_eq!(inst.me_sizes(), (table.len(), model.event_indicators()));
                 for (s, c) in variables::states(model, causality) {
                     let der = inst.get(FIRST_DERIVATIVE + c as u32).unwrap();
@@ -617,12 +697,12 @@ mod me_tests {
         inst.set(0, 150.0).unwrap();
         inst.set(2, 0.0).unwrap();
         inst.initialize().unwrap();
-        assert_eq!(inst.me_sizes(), (3, 3));
+        assert_eq!(inst.me_sizes(), (3, 4));
         // at the steady state the derivatives vanish and no event is due
         let mut dx = [1.0; 3];
         inst.me_derivatives(&mut dx).unwrap();
         assert!(dx.iter().all(|d| d.abs() < 1e-6), "{dx:?}");
-        let mut g = [0.0; 3];
+        let mut g = [0.0; 4];
         inst.me_indicators(&mut g).unwrap();
         assert!(g.iter().all(|v| *v > 0.0));
         assert!(!inst.me_new_discrete_states().unwrap());
