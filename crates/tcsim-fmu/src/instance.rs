@@ -684,6 +684,38 @@ mod me_tests {
         }
     }
 
+    /// Drive (c) in Model Exchange: both speeds are states; a locked clutch links the turbine to the
+    /// pump (the momentum-conserving projection makes the two states equal, and their derivatives
+    /// are equal while it holds); a command set to zero opens it at the next event.
+    #[test]
+    fn a_locked_clutch_in_drive_c_joins_the_speed_states() {
+        let text = format!(r#"{{"causality": "torques", "model": {}, "parameters": []}}"#, spec(Model::Table));
+        let mut inst = Instance::new(Configuration::parse(&text).unwrap());
+        inst.model_exchange = true;
+        inst.set(vr::PUMP_TORQUE, 100.0).unwrap();
+        inst.set(vr::LOCKUP_CAPACITY, 500.0).unwrap();
+        assert!(inst.set(vr::LOCKUP_CAPACITY, -1.0).unwrap_err().contains("lockup_capacity_nm = -1"));
+        inst.initialize().unwrap();
+        assert_eq!(inst.me_sizes(), (2, 1));
+        assert_eq!(inst.get(vr::LOCKUP_STATE), Some(1.0)); // slipping from the stall
+        inst.me_set_states(&[100.0, 99.8]).unwrap();
+        let mut g = [0.0];
+        inst.me_indicators(&mut g).unwrap();
+        assert!(g[0] < 0.0, "the slip is below the sync threshold: {g:?}");
+        assert!(inst.me_new_discrete_states().unwrap());
+        let (mut x, mut dx) = ([0.0; 2], [0.0; 2]);
+        inst.me_get_states(&mut x).unwrap();
+        inst.me_derivatives(&mut dx).unwrap();
+        assert!(x[0] == x[1] && dx[0] == dx[1] && x[0] > 99.8 && x[0] < 100.0, "{x:?} {dx:?}");
+        assert_eq!(inst.get(vr::LOCKUP_STATE), Some(2.0));
+        assert_eq!(inst.get(vr::LOCKUP_SLIP), Some(0.0));
+        inst.set(vr::LOCKUP_CAPACITY, 0.0).unwrap();
+        inst.me_indicators(&mut g).unwrap();
+        assert!(g[0] < 0.0);
+        assert!(inst.me_new_discrete_states().unwrap());
+        assert_eq!(inst.get(vr::LOCKUP_STATE), Some(0.0));
+    }
+
     #[test]
     fn model_exchange_states_derivatives_and_events() {
         let config = Configuration::parse(&format!(
