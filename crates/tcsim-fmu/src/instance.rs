@@ -273,6 +273,9 @@ impl Instance {
                 }
             }
         }
+        if stepper.model.lag_state() {
+            self.signals[vr::LAG_TORQUE as usize] = sample.u[FLOW]; // the lag state is no output column
+        }
     }
 
     /// `fmi2ExitInitializationMode`: the steady state consistent with the inputs.
@@ -487,12 +490,6 @@ impl Instance {
 
     fn me_initialize(&mut self) -> Result<(), String> {
         let model = self.model().map_err(|e| e.to_string())?;
-        if model.lag_state() {
-            // the modelDescription declares the table model's states without the lag's
-            return Err("Model Exchange of the table model with lag_time_constant_s is not supported (its lag state \
-                        is not among the FMU's declared states): use Co-Simulation (docs/lag.md)"
-                .to_string());
-        }
         let t = self.start_time;
         let drive = self.me_drive(t)?;
         let u = initial_state(&model, &drive, t, &self.initial()).map_err(|e| e.to_string())?;
@@ -546,7 +543,8 @@ impl Instance {
     pub fn me_nominals(&self, x: &mut [f64]) -> Result<(), String> {
         let me = self.me_state()?;
         for (&c, v) in me.coordinates.iter().zip(x.iter_mut()) {
-            *v = if c == FLOW { 0.05 } else { 100.0 };
+            // the flow's scale, or (the table model's lag state, in the same slot) a torque's
+            *v = if c == FLOW && !me.model.lag_state() { 0.05 } else { 100.0 };
         }
         Ok(())
     }
@@ -622,6 +620,9 @@ impl Instance {
             }
             let drive = self.me_drive(me.time_s).ok()?;
             let sample = ModeView::new(&me.model, &drive, me.mode).sample(&me.u, me.time_s);
+            if vr == vr::LAG_TORQUE {
+                return me.model.lag_state().then_some(sample.u[FLOW]);
+            }
             let r = row(&me.model, &sample);
             return COLUMNS.iter().position(|c| *c == name).map(|c| r[c]);
         }
@@ -633,6 +634,7 @@ impl Instance {
 #[cfg(test)]
 mod me_tests {
     use super::*;
+    use crate::variables::SpecValue;
 
     /// A model specification of each kind (JSON).
     fn spec(model: Model) -> String {
@@ -657,25 +659,32 @@ mod me_tests {
     /// Exchange, the derivatives' value references and the stator clutch.
     #[test]
     fn the_variable_table_agrees_with_the_engine() {
-        for model in Model::ALL {
+        // each model, and the table model with its first-order lag (a fourth state)
+        let lagged = spec(Model::Table).replacen('{', r#"{"lag_time_constant_s": 0.05, "#, 1);
+        let cases = Model::ALL.map(|m| (m, spec(m), false)).into_iter().chain([(Model::Table, lagged, true)]);
+        for (model, model_spec, lag) in cases {
+            let params = if lag { vec![("lag_time_constant_s".to_string(), SpecValue::Scalar(0.05))] } else { vec![] };
+            let params = variables::parameters(&params).unwrap();
+            let entries = if lag { r#"[{"key": "lag_time_constant_s"}]"# } else { "[]" };
             for (name, causality, _) in variables::CAUSALITIES {
-                let text = format!(r#"{{"causality": "{name}", "model": {}, "parameters": []}}"#, spec(model));
+                let text = format!(r#"{{"causality": "{name}", "model": {model_spec}, "parameters": {entries}}}"#);
                 let mut inst = Instance::new(Configuration::parse(&text).unwrap());
                 assert_eq!(inst.config.causality, causality);
                 inst.model_exchange = true;
                 inst.initialize().unwrap();
                 let me = inst.me.as_ref().unwrap();
-                let table: Vec<usize> = variables::states(model, causality).iter().map(|&(_, c)| c).collect();
+                assert_eq!(me.model.lag_state(), lag);
+                let table: Vec<usize> = variables::states(model, causality, lag).iter().map(|&(_, c)| c).collect();
                 assert_eq!(me.coordinates, table, "{model:?} {name}");
                 assert_eq!(me.model.has_stator_clutch(), model.event_indicators() > 1, "{model:?}");
                 assert_eq!(inst.me_sizes(), (table.len(), model.event_indicators()));
-                for (s, c) in variables::states(model, causality) {
+                for (s, c) in variables::states(model, causality, lag) {
                     let der = inst.get(FIRST_DERIVATIVE + c as u32).unwrap();
                     assert!(der.is_finite(), "der({}) = {der}", s.name);
                 }
                 // every declared variable can be read, every input set
-                for v in variables::variables(model, causality, &[]) {
-                    assert!(inst.get(v.vr).is_some(), "{model:?} {name}: {}", v.name);
+                for v in variables::variables(model, causality, &params) {
+                    assert!(inst.get(v.vr).is_some_and(f64::is_finite), "{model:?} {name}: {}", v.name);
                     if v.causality == "input" {
                         inst.set(v.vr, v.start.unwrap()).unwrap();
                     }

@@ -9,6 +9,7 @@
 //! value reference whatever the model and the causality; a model lists the signals it has.
 
 use tcsim_core::converter::hrovat_tobler::HtParam;
+use tcsim_core::converter::spec::LAG_KEY;
 use tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC;
 use tcsim_core::engine::mode_view::{EVENT_INDICATORS, LOCKUP_INDICATOR};
 use tcsim_core::engine::stepper::Causality;
@@ -23,7 +24,7 @@ pub const FIRST_DERIVATIVE: u32 = 20;
 /// Number of coordinates of a converter model (pump, turbine, stator speed, flow).
 pub const COORDINATES: u32 = 4;
 /// Value references of the signals and the input rates: `0..SIGNAL_SLOTS`.
-pub const SIGNAL_SLOTS: usize = 19;
+pub const SIGNAL_SLOTS: usize = 20;
 
 /// Value references of the signals.
 pub mod vr {
@@ -46,6 +47,7 @@ pub mod vr {
     pub const LOCKUP_TORQUE: u32 = 16;
     pub const LOCKUP_STATE: u32 = 17;
     pub const LOCKUP_SLIP: u32 = 18;
+    pub const LAG_TORQUE: u32 = 19;
     pub const START_FROM_STEADY_STATE: u32 = 30;
     pub const INITIAL_PUMP_SPEED: u32 = 31;
     pub const INITIAL_STATOR_SPEED: u32 = 32;
@@ -138,17 +140,19 @@ pub struct SignalDef {
     pub start: Option<f64>,
     /// The causality the signal belongs to, if only one has it (the load torque).
     pub only: Option<Causality>,
+    /// Only in an FMU of the table model with the lag ([`has_lag`]): the lag state.
+    pub lag: bool,
 }
 
 const ALL: &[Model] = &Model::ALL;
 
 const fn signal(vr: u32, name: &'static str, unit: &'static str, description: &'static str) -> SignalDef {
-    SignalDef { vr, name, unit, description, models: ALL, state: None, start: None, only: None }
+    SignalDef { vr, name, unit, description, models: ALL, state: None, start: None, only: None, lag: false }
 }
 
 /// The signals in value-reference order (a part-load stall as the inputs' start: 50 N·m at the
 /// pump, or the pump at 150 rad/s; no load torque, an open lock-up clutch).
-pub const SIGNALS: [SignalDef; 17] = [
+pub const SIGNALS: [SignalDef; 18] = [
     SignalDef {
         start: Some(50.0),
         ..signal(vr::PUMP_TORQUE, "pump_torque_nm", "N.m", "Torque on the pump (engine torque at the converter input)")
@@ -233,7 +237,32 @@ pub const SIGNALS: [SignalDef; 17] = [
     ),
     signal(vr::LOCKUP_STATE, "lockup_state", "1", "Lock-up clutch state: 0 open, 1 slipping, 2 locked"),
     signal(vr::LOCKUP_SLIP, "lockup_slip_rad_s", "rad/s", "Lock-up clutch slip: pump speed - turbine speed"),
+    SignalDef {
+        models: &[Model::Table],
+        state: Some(3),
+        lag: true,
+        ..signal(
+            vr::LAG_TORQUE,
+            "lagged_pump_torque_nm",
+            "N.m",
+            "Lag state T_lag of the table model's first-order lag: the lagged steady pump torque (docs/lag.md)",
+        )
+    },
 ];
+
+/// Whether an FMU with these tunable parameters is of a table model with the first-order lag (its
+/// specification has `lag_time_constant_s`): the lag state is then a continuous state.
+pub fn has_lag(parameters: &[Parameter]) -> bool {
+    parameters.iter().any(|p| p.key == LAG_KEY)
+}
+
+/// The unit of the time derivative of a quantity of unit `unit`.
+pub fn derivative_unit(unit: &str) -> String {
+    match unit {
+        "N.m" => "N.m/s".to_string(),
+        _ => format!("{unit}2"),
+    }
+}
 
 /// A rate of a speed input, for Model Exchange: an optional input, zero when not connected.
 /// Co-Simulation takes the rates from `fmi2SetRealInputDerivatives` or from the last
@@ -373,13 +402,13 @@ pub fn is_derivative(vr: u32) -> bool {
     (FIRST_DERIVATIVE..FIRST_DERIVATIVE + COORDINATES).contains(&vr)
 }
 
-/// The continuous states of a model under a causality in Model Exchange: (signal, coordinate), in
-/// coordinate order.
-pub fn states(model: Model, causality: Causality) -> Vec<(&'static SignalDef, usize)> {
+/// The continuous states of a model (with the table model's lag or not) under a causality in Model
+/// Exchange: (signal, coordinate), in coordinate order.
+pub fn states(model: Model, causality: Causality, lag: bool) -> Vec<(&'static SignalDef, usize)> {
     let inputs = inputs(causality);
     let mut states: Vec<_> = SIGNALS
         .iter()
-        .filter(|s| s.models.contains(&model) && !inputs.contains(&s.vr))
+        .filter(|s| s.models.contains(&model) && !inputs.contains(&s.vr) && (lag || !s.lag))
         .filter_map(|s| s.state.map(|c| (s, c)))
         .collect();
     states.sort_by_key(|&(_, c)| c);
@@ -401,12 +430,13 @@ const fn unit(name: &'static str, base: &'static [(&'static str, i32)]) -> UnitD
     UnitDef { name, base, display: &[] }
 }
 
-pub const UNITS: [UnitDef; 13] = [
+pub const UNITS: [UnitDef; 14] = [
     unit("N.m", &[("kg", 1), ("m", 2), ("s", -2)]),
     UnitDef { display: &[("rpm", 30.0 / std::f64::consts::PI)], ..unit("rad/s", &[("s", -1), ("rad", 1)]) },
     unit("m3/s", &[("m", 3), ("s", -1)]),
     unit("rad/s2", &[("s", -2), ("rad", 1)]),
     unit("m3/s2", &[("m", 3), ("s", -2)]),
+    unit("N.m/s", &[("kg", 1), ("m", 2), ("s", -3)]),
     unit("kg.m2", &[("kg", 1), ("m", 2)]),
     unit("N.m.s2/rad2", &[("kg", 1), ("m", 2), ("rad", -2)]),
     unit("m", &[("m", 1)]),
@@ -622,9 +652,10 @@ impl Variable {
 }
 
 /// The signals: inputs of the causality, else outputs.
-fn signal_variables(model: Model, causality: Causality) -> Vec<Variable> {
+fn signal_variables(model: Model, causality: Causality, lag: bool) -> Vec<Variable> {
     let inputs = all_inputs(causality);
-    let signals = SIGNALS.iter().filter(|s| s.models.contains(&model) && has_signal(causality, s.vr));
+    let signals =
+        SIGNALS.iter().filter(|s| s.models.contains(&model) && has_signal(causality, s.vr) && (lag || !s.lag));
     signals
         .map(|s| {
             if inputs.contains(&s.vr) {
@@ -688,8 +719,8 @@ fn rate_and_start_variables(model: Model, causality: Causality) -> Vec<Variable>
 }
 
 /// `der(x)` of each continuous state `x`, in coordinate order.
-fn derivative_variables(model: Model, causality: Causality) -> Vec<Variable> {
-    states(model, causality)
+fn derivative_variables(model: Model, causality: Causality, lag: bool) -> Vec<Variable> {
+    states(model, causality, lag)
         .into_iter()
         .map(|(s, c)| {
             let mut v = Variable::new(
@@ -697,7 +728,7 @@ fn derivative_variables(model: Model, causality: Causality) -> Vec<Variable> {
                 &format!("der({})", s.name),
                 "local",
                 "continuous",
-                &format!("{}2", s.unit),
+                &derivative_unit(s.unit),
             )
             .describe(format!("Time derivative of {}", s.name));
             v.initial = Some("calculated");
@@ -726,9 +757,10 @@ fn parameter_variables(parameters: &[Parameter]) -> Vec<Variable> {
 /// `<ModelVariables>`: the signals by value reference, the input rates, the start-value
 /// parameters, the derivatives of the states, the tunable parameters.
 pub fn variables(model: Model, causality: Causality, parameters: &[Parameter]) -> Vec<Variable> {
-    let mut out = signal_variables(model, causality);
+    let lag = has_lag(parameters);
+    let mut out = signal_variables(model, causality, lag);
     out.extend(rate_and_start_variables(model, causality));
-    out.extend(derivative_variables(model, causality));
+    out.extend(derivative_variables(model, causality, lag));
     out.extend(parameter_variables(parameters));
     out
 }
@@ -773,7 +805,8 @@ mod tests {
         assert_eq!(unit_of("table_capacity_factor_nm_s2[3]"), "N.m.s2/rad2");
         assert_eq!(unit_of("table_speed_ratio[3]"), "1");
         assert_eq!(unit_of("pump_exit_angle_rad"), "rad");
-        for p in SIGNALS.iter().map(|s| s.unit).chain([RATE_UNIT]) {
+        let states = SIGNALS.iter().filter(|s| s.state.is_some()).map(|s| derivative_unit(s.unit));
+        for p in SIGNALS.iter().map(|s| s.unit.to_string()).chain(states).chain([RATE_UNIT.into()]) {
             assert!(UNITS.iter().any(|u| u.name == p), "{p}");
         }
     }
