@@ -6,6 +6,8 @@ these are the places where they meet."""
 from __future__ import annotations
 
 import dataclasses
+import sys
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -19,6 +21,9 @@ from tcsim.models import drives
 from tcsim.models.converter import Converter, load_converter
 from tcsim.models.steady import steady_state
 from tcsim.transient import simulate
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from lockup_energy import dense_run, energy_residual  # noqa: E402
 
 T_END_S = 6.0
 #: Lock-up capacity command: 0 until 1 s, 800 N·m from 2 s to 4 s, 0 from 5 s (as test_lockup.py).
@@ -56,34 +61,6 @@ def _grid() -> np.ndarray:
     return np.round(np.linspace(0.0, T_END_S, 6001), 12)
 
 
-def _residual(f: pd.DataFrame) -> tuple[float, float]:
-    """The energy identity's residual with the clutch booked, and the energy through the pump, J."""
-    t = f["time_s"].to_numpy()
-    trap = lambda c: float(np.trapezoid(f[c].to_numpy(), t))  # noqa: E731
-    lhs = trap("converter_input_power_w") + f["lockup_lock_work_j"].iloc[-1]
-    rhs = (
-        f["stored_energy_j"].iloc[-1]
-        - f["stored_energy_j"].iloc[0]
-        + trap("fluid_loss_power_w")
-        + trap("lockup_loss_power_w")
-        + f["lockup_lock_loss_j"].iloc[-1]
-    )
-    return lhs - rhs, float(np.trapezoid(np.abs(f["pump_torque_nm"] * f["pump_speed_rad_s"]), t))
-
-
-def _dense_run(conv: Converter, make) -> pd.DataFrame:
-    """The run sampled on 1 ms plus every 5 µs for 10 ms after each event (the trapezoidal
-    integrals then see the jumps of the power columns; the solution does not depend on them)."""
-    first = simulate(conv, make(), "table", times_s=_grid())
-    after = np.arange(0, 2001) * 5e-6
-    extra = np.unique(np.concatenate([e.time_s + after for e in first.events] or [[]]))
-    extra = extra[(extra < T_END_S) & np.concatenate([[True], np.diff(extra) >= 2e-6])]
-    grid = _grid()
-    near = np.abs(grid[:, None] - extra[None, :]).min(axis=1) < 2e-6 if len(extra) else np.zeros(len(grid), bool)
-    times = np.sort(np.concatenate([grid[~near], extra]))
-    return simulate(conv, make(), "table", times_s=times).frame()
-
-
 def _drive_c() -> drives.PumpTorqueLoad:
     t = _grid()
     return drives.PumpTorqueLoad(
@@ -103,7 +80,7 @@ def test_two_tables_with_the_lag_and_the_clutch_lock_and_close_the_energy_identi
     """The lag state, the solved input torque and the clutch's lock in one run: it locks while the
     command holds and breaks away when it falls, the clutch and the converter never deliver power,
     and the energy identity closes with the clutch's losses booked."""
-    f = _dense_run(two_lagged, make)
+    f = dense_run(two_lagged, make, "table", _grid()).frame()
     states = set(f["lockup_state"])
     assert {0.0, 2.0} <= states, states
     locked = f[f["lockup_state"] == 2]
@@ -112,7 +89,7 @@ def test_two_tables_with_the_lag_and_the_clutch_lock_and_close_the_energy_identi
     assert (f["lockup_loss_power_w"] >= 0).all() and (f["fluid_loss_power_w"] >= -1e-9).all()
     # the run crosses between the tables (pump torque through 100 … 300 N·m is 150 or 200 here)
     assert f["pump_torque_nm"].between(100.0, 300.0).mean() > 0.5
-    residual, through = _residual(f)
+    residual, through = energy_residual(f)
     assert abs(residual) < ENERGY_REL * through, (residual, through)
 
 

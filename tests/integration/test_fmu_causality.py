@@ -230,6 +230,8 @@ def test_a_negative_or_non_finite_capacity_is_refused(fmu_paths, capfd, value):
     slave = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier="tcsim_converter", instanceName="cap")
     try:
         slave.instantiate()
+        slave.setupExperiment(startTime=0.0)
+        slave.enterInitializationMode()
         slave.setReal([vr], [100.0])
         with pytest.raises(Exception, match="fmi2SetReal"):
             slave.setReal([vr], [value])

@@ -6,6 +6,7 @@ it had before it used the component."""
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -13,7 +14,11 @@ import pandas as pd
 import pytest
 
 from tcsim import transient
+from tcsim.errors import InputError
 from tcsim.models import drives
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from lockup_energy import dense_run, energy_residual  # noqa: E402
 
 T_END_S = 6.0
 # Capacity command: 0 until 1 s, up to 800 N·m at 2 s, held, down to 0 from 4 s to 5 s.
@@ -45,36 +50,8 @@ def _drive_c(capacity=COMMAND, t: np.ndarray | None = None) -> drives.PumpTorque
 
 
 def _run(make, model: str) -> transient.TransientResult:
-    """A run sampled on a 1 ms grid plus each event's time and every 5 µs over the 10 ms after it, so
-    that the trapezoidal integrals of the energy identity see every jump of the power columns and
-    the millisecond in which a broken-away clutch's slip builds up (the drive is the same; the
-    solution does not depend on the output times)."""
-    first = transient.simulate("li-sunden-2016", make(), model, times_s=_grid())
-    after = np.arange(0, 2001) * 5e-6
-    extra = np.unique(np.concatenate([e.time_s + after for e in first.events] or [[]]))
-    extra = extra[(extra < T_END_S) & np.concatenate([[True], np.diff(extra) >= 2e-6])]
-    grid = _grid()
-    near = np.abs(grid[:, None] - extra[None, :]).min(axis=1) < 2e-6 if len(extra) else np.zeros(len(grid), bool)
-    times = np.sort(np.concatenate([grid[~near], extra]))
-    run = transient.simulate("li-sunden-2016", make(), model, times_s=times)
-    assert [(e.time_s, e.kind) for e in run.events] == [(e.time_s, e.kind) for e in first.events]
-    return run
-
-
-def _residual(f: pd.DataFrame) -> tuple[float, float]:
-    """The energy identity's residual and the energy through the pump, J."""
-    t = f["time_s"].to_numpy()
-    trap = lambda c: float(np.trapezoid(f[c].to_numpy(), t))  # noqa: E731
-    lhs = trap("converter_input_power_w") + f["lockup_lock_work_j"].iloc[-1]
-    rhs = (
-        f["stored_energy_j"].iloc[-1]
-        - f["stored_energy_j"].iloc[0]
-        + trap("fluid_loss_power_w")
-        + trap("lockup_loss_power_w")
-        + f["lockup_lock_loss_j"].iloc[-1]
-    )
-    through = float(np.trapezoid(np.abs(f["pump_torque_nm"] * f["pump_speed_rad_s"]), t))
-    return lhs - rhs, through
+    """A run sampled on a 1 ms grid, dense after each event (``lockup_energy.dense_run``)."""
+    return dense_run("li-sunden-2016", make, model, _grid())
 
 
 @pytest.fixture(scope="module", params=MODELS)
@@ -108,7 +85,7 @@ def _check_lock_and_breakaway(run: transient.TransientResult) -> pd.DataFrame:
     # the locked clutch's torque stays within static friction
     cap = np.interp(locked["time_s"], *COMMAND)
     assert (locked["lockup_torque_nm"].abs() <= 1.2 * cap + 1e-9).all()
-    residual, through = _residual(f)
+    residual, through = energy_residual(f)
     assert abs(residual) < ENERGY_REL * through, (residual, through)
     return f
 
@@ -238,3 +215,31 @@ def test_launch_lockup_events_as_before(cli, tmp_path):
         got = events[(events["model"] == model) & events["kind"].str.startswith("lockup")]
         assert list(got["kind"]) == [k for k, _ in expected], model
         assert np.allclose(got["time_s"], [t for _, t in expected], rtol=0, atol=1e-3), model
+
+
+# ---------------------------------------------------------------------------------------------
+# the capacity's range: 0 to 1e6 N·m (tcsim_core::engine::lockup::MAX_CAPACITY_NM)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_the_largest_capacity_locks_at_once_from_a_large_slip(model):
+    """1e6 N·m engaged at t = 0 against 600 N·m on the pump and a load driving the turbine backwards
+    (hundreds of rad/s of slip): the clutch locks within a millisecond and the run completes. (At
+    1e8 N·m this run's integrator failed: measured, the reason for the limit.)"""
+    t = np.linspace(0.0, 0.5, 51)
+    d = drives.PumpTorqueLoad(t, np.full_like(t, 600.0), 0.05, load_torque_nm=-500.0, lockup_capacity_nm=1e6)
+    run = transient.simulate("li-sunden-2016", d, model, times_s=t)
+    lock = next(e.time_s for e in run.events if e.kind == "lockup-lock")
+    assert lock < 1e-3
+    f = run.frame()
+    after = f[f["time_s"] > lock]
+    assert (after["lockup_state"] == 2).all() and (after["pump_speed_rad_s"] == after["turbine_speed_rad_s"]).all()
+
+
+@pytest.mark.parametrize("value", [1.0000001e6, 1e10, -1e-300])
+def test_a_capacity_outside_0_to_1e6_is_refused_by_the_drive(value):
+    t = np.linspace(0.0, 1.0, 11)
+    cap = np.where(t < 0.5, 0.0, value)
+    d = drives.PumpTorqueLoad(t, np.full_like(t, 200.0), 1.2, lockup_capacity_nm=cap)
+    with pytest.raises(InputError, match=r"lockup_capacity_nm\[5\] = .*from 0 to 1e6 N·m"):
+        transient.simulate("li-sunden-2016", d, "table")

@@ -17,8 +17,36 @@ use tcsim_core::CoreResult;
 
 use crate::variables::{
     self, causality_of, drive_parameter, has_signal, is_derivative, is_input, signal_name, start_parameter, vr, Model,
-    DRIVE_PARAMETERS, FIRST_DERIVATIVE, FIRST_PARAMETER, RATES, SIGNALS, SIGNAL_SLOTS, START_PARAMETERS,
+    COORDINATES, DRIVE_PARAMETERS, FIRST_DERIVATIVE, FIRST_PARAMETER, RATES, SIGNALS, SIGNAL_SLOTS, START_PARAMETERS,
 };
+
+/// Where an instance is in the FMI 2.0 calling sequence (Co-Simulation and Model Exchange; the
+/// event and continuous-time modes of Model Exchange are both `Running`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Phase {
+    /// After `fmi2Instantiate` or `fmi2Reset`.
+    Instantiated,
+    /// Between `fmi2EnterInitializationMode` and `fmi2ExitInitializationMode`.
+    Initialization,
+    /// After `fmi2ExitInitializationMode` (stepComplete; event or continuous-time mode).
+    Running,
+    /// After `fmi2Terminate`.
+    Terminated,
+}
+
+impl Phase {
+    pub const ALL: [Phase; 4] = [Phase::Instantiated, Phase::Initialization, Phase::Running, Phase::Terminated];
+
+    /// The state's name in the FMI 2.0 standard.
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Instantiated => "instantiated",
+            Phase::Initialization => "initialization mode",
+            Phase::Running => "stepComplete/event/continuous-time mode",
+            Phase::Terminated => "terminated",
+        }
+    }
+}
 
 /// A parameter: the spec entry `model[key]` (scalar) or `model[key][index]`.
 #[derive(Debug, Clone)]
@@ -113,21 +141,25 @@ pub struct Instance {
     /// Signal values by value reference (inputs as set, outputs as computed).
     pub signals: [f64; SIGNAL_SLOTS],
     /// Input rates given with `fmi2SetRealInputDerivatives` for the coming step.
-    rates: [Option<f64>; SIGNAL_SLOTS],
+    pub(crate) rates: [Option<f64>; SIGNAL_SLOTS],
     /// Model Exchange: the model, all coordinates, the mode and the time.
-    me: Option<ModelExchange>,
+    pub(crate) me: Option<ModelExchange>,
     /// Values of the start-value parameters ([`START_PARAMETERS`], value references 30–34).
-    start: [f64; START_PARAMETERS.len()],
+    pub(crate) start: [f64; START_PARAMETERS.len()],
     /// Values of the drive's fixed parameters ([`DRIVE_PARAMETERS`], value references 35–37).
-    drive: [f64; DRIVE_PARAMETERS.len()],
+    pub(crate) drive: [f64; DRIVE_PARAMETERS.len()],
     /// Inputs at the previous communication point, for the rate estimate.
-    previous: Option<(f64, [f64; 2])>,
-    stepper: Option<Stepper<Box<dyn ConverterDynamics + Send>>>,
-    rebuild: bool,
+    pub(crate) previous: Option<(f64, [f64; 2])>,
+    pub(crate) stepper: Option<Stepper<Box<dyn ConverterDynamics + Send>>>,
+    pub(crate) rebuild: bool,
+    /// Co-Simulation: the time derivatives of the coordinates at the last communication point.
+    pub(crate) derivatives: [f64; COORDINATES as usize],
+    /// The initialisation in initialisation mode is that of the current inputs and parameters.
+    pub(crate) fresh: bool,
     /// Instantiated for Model Exchange (else Co-Simulation).
     pub model_exchange: bool,
-    /// Between fmi2EnterInitializationMode and fmi2ExitInitializationMode.
-    pub initializing: bool,
+    /// Where the instance is in the calling sequence.
+    pub phase: Phase,
 }
 
 impl Instance {
@@ -154,9 +186,53 @@ impl Instance {
             previous: None,
             stepper: None,
             rebuild: false,
+            derivatives: [f64::NAN; COORDINATES as usize],
+            fresh: false,
             model_exchange: false,
-            initializing: false,
+            phase: Phase::Instantiated,
         }
+    }
+
+    /// An error unless the instance is in one of `allowed`.
+    pub fn require(&self, call: &str, allowed: &[Phase]) -> Result<(), String> {
+        if allowed.contains(&self.phase) {
+            return Ok(());
+        }
+        let names: Vec<&str> = allowed.iter().map(|p| p.name()).collect();
+        Err(format!("{call} is not allowed in state {}: expected {}", self.phase.name(), names.join(" or ")))
+    }
+
+    /// `fmi2EnterInitializationMode`.
+    pub fn enter_initialization(&mut self) -> Result<(), String> {
+        self.require("fmi2EnterInitializationMode", &[Phase::Instantiated])?;
+        self.phase = Phase::Initialization;
+        self.fresh = false;
+        Ok(())
+    }
+
+    /// `fmi2ExitInitializationMode`: the initial state of the inputs and start values set so far.
+    /// On failure the instance stays in initialisation mode (a corrected value may be set).
+    pub fn exit_initialization(&mut self) -> Result<(), String> {
+        self.require("fmi2ExitInitializationMode", &[Phase::Initialization])?;
+        self.initialize()?;
+        self.phase = Phase::Running;
+        Ok(())
+    }
+
+    /// `fmi2Terminate`.
+    pub fn terminate(&mut self) -> Result<(), String> {
+        self.require("fmi2Terminate", &[Phase::Running])?;
+        self.phase = Phase::Terminated;
+        Ok(())
+    }
+
+    /// In initialisation mode, the initialisation of the current inputs and parameters (the
+    /// outputs, states and derivatives read then are those of the steady state or start values).
+    pub fn provisional(&mut self) -> Result<(), String> {
+        if self.phase == Phase::Initialization && !self.fresh {
+            self.initialize()?;
+        }
+        Ok(())
     }
 
     /// The value references of the two inputs.
@@ -174,44 +250,88 @@ impl Instance {
         [self.signals[a], self.signals[b]]
     }
 
-    fn model(&self) -> CoreResult<Box<dyn ConverterDynamics + Send>> {
+    pub(crate) fn model(&self) -> CoreResult<Box<dyn ConverterDynamics + Send>> {
         build_model(&Spec { model: &self.config.model, parameters: &self.config.parameters })
     }
 
     pub fn get(&mut self, vr: u32) -> Option<f64> {
-        if let Some(i) = start_parameter(vr) {
-            return Some(self.start[i]);
-        }
-        if let Some(i) = drive_parameter(vr) {
-            return Some(self.drive[i]);
-        }
-        let output = is_derivative(vr) || ((vr as usize) < SIGNAL_SLOTS && !self.settable(vr as usize));
-        if self.initializing && output {
-            // in initialisation mode the outputs are the steady state for the inputs set so far
-            let _ = self.initialize();
-        }
-        if self.me.is_some() {
-            return self.me_get(vr);
-        }
-        if (vr as usize) < SIGNAL_SLOTS {
-            return Some(self.signals[vr as usize]);
-        }
-        let i = vr.checked_sub(FIRST_PARAMETER)? as usize;
-        self.config.parameters.get(i).map(|p| p.value)
+        self.read(vr).ok()
     }
 
-    /// Set a value; inputs any time, parameters before or between steps (tunable). Outputs are
-    /// not settable.
-    pub fn set(&mut self, vr: u32, value: f64) -> Result<(), String> {
+    /// The value of `vr`. In initialisation mode the outputs and derivatives are those of the
+    /// initial state for the inputs and start values set so far (which stay settable).
+    pub fn read(&mut self, vr: u32) -> Result<f64, String> {
+        let unknown = || format!("no variable with value reference {vr}");
         if let Some(i) = start_parameter(vr) {
-            if self.stepper.is_some() || (self.me.is_some() && !self.initializing) {
+            return Ok(self.start[i]);
+        }
+        if let Some(i) = drive_parameter(vr) {
+            return Ok(self.drive[i]);
+        }
+        let computed = is_derivative(vr) || ((vr as usize) < SIGNAL_SLOTS && !self.settable(vr as usize));
+        if computed {
+            self.provisional()?;
+        }
+        if self.me.is_some() {
+            return self.me_get(vr).ok_or_else(unknown);
+        }
+        if is_derivative(vr) {
+            return Ok(self.derivatives[(vr - FIRST_DERIVATIVE) as usize]);
+        }
+        if (vr as usize) < SIGNAL_SLOTS {
+            return Ok(self.signals[vr as usize]);
+        }
+        let i = vr.checked_sub(FIRST_PARAMETER).ok_or_else(unknown)? as usize;
+        self.config.parameters.get(i).map(|p| p.value).ok_or_else(unknown)
+    }
+
+    /// Set one value: [`Instance::set_all`] of one.
+    pub fn set(&mut self, vr: u32, value: f64) -> Result<(), String> {
+        self.set_all(&[vr], &[value])
+    }
+
+    /// Set values (`fmi2SetReal`), all or none: inputs any time before `fmi2Terminate`, the
+    /// start-value parameters before `fmi2ExitInitializationMode`, the tunable parameters any time
+    /// (checked together when the simulation runs, else at `fmi2ExitInitializationMode`). Outputs
+    /// are not settable, non-finite values are refused. A refused call changes nothing.
+    pub fn set_all(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), String> {
+        self.require("fmi2SetReal", &[Phase::Instantiated, Phase::Initialization, Phase::Running])?;
+        let saved = (self.signals, self.start, self.drive, self.config.parameters.clone());
+        let result = self.apply(vrs, values);
+        if result.is_err() {
+            (self.signals, self.start, self.drive, self.config.parameters) = saved;
+        }
+        self.fresh = false;
+        result
+    }
+
+    fn apply(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), String> {
+        let mut tuned = false;
+        for (&vr, &value) in vrs.iter().zip(values) {
+            tuned |= self.set_one(vr, value)?;
+        }
+        if tuned && self.phase == Phase::Running {
+            // tunable: check the new parameters now; Co-Simulation applies them at the next step
+            let model = self.model().map_err(|e| e.to_string())?;
+            match self.me.as_mut() {
+                Some(me) => me.model = model,
+                None => self.rebuild = true,
+            }
+        }
+        Ok(())
+    }
+
+    /// Set one value without the model check; whether it was a tunable parameter.
+    fn set_one(&mut self, vr: u32, value: f64) -> Result<bool, String> {
+        if let Some(i) = start_parameter(vr) {
+            if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
                 return Err("the start-value parameters are fixed after initialisation".into());
             }
             if !value.is_finite() {
                 return Err(format!("start-value parameter {vr} = {value}: expected a finite value"));
             }
             self.start[i] = value;
-            return Ok(());
+            return Ok(false);
         }
         if let Some(i) = drive_parameter(vr) {
             return self.set_drive_parameter(i, value);
@@ -230,38 +350,38 @@ impl Instance {
                 return Err(format!("{name} = {value}: expected a capacity of zero or more (N.m)"));
             }
             self.signals[vr as usize] = value;
-            return Ok(());
+            return Ok(false);
         }
         let i = vr
             .checked_sub(FIRST_PARAMETER)
             .map(|i| i as usize)
             .filter(|&i| i < self.config.parameters.len())
             .ok_or(format!("no variable with value reference {vr}"))?;
+        if !value.is_finite() {
+            return Err(format!("parameter {vr} = {value}: expected a finite value"));
+        }
         self.config.parameters[i].value = value;
-        if self.stepper.is_some() {
-            // tunable: check the new parameters now, apply them at the next step
-            self.model().map_err(|e| e.to_string())?;
-            self.rebuild = true;
-        }
-        if let Some(me) = self.me.as_mut() {
-            me.model = build_model(&Spec { model: &self.config.model, parameters: &self.config.parameters })
-                .map_err(|e| e.to_string())?;
-        }
-        Ok(())
+        Ok(true)
     }
 
     pub fn set_rate(&mut self, vr: u32, order: i32, value: f64) -> Result<(), String> {
+        self.require("fmi2SetRealInputDerivatives", &[Phase::Initialization, Phase::Running])?;
         let input = self.input_refs().contains(&(vr as usize)) || variables::COMMON_INPUTS.contains(&vr);
         if order != 1 || !input {
             return Err(format!(
                 "input derivatives of order 1 of the inputs only (value reference {vr}, order {order})"
             ));
         }
+        if !value.is_finite() {
+            return Err(format!("input derivative of value reference {vr} = {value}: expected a finite value"));
+        }
         self.rates[vr as usize] = Some(value);
+        self.fresh = false;
         Ok(())
     }
 
     fn publish(&mut self, sample: &Sample) {
+        self.derivatives = sample.u_dot;
         let Some(stepper) = &self.stepper else { return };
         let r = row(&stepper.model, sample);
         let inputs = self.input_refs();
@@ -281,7 +401,9 @@ impl Instance {
     /// `fmi2ExitInitializationMode`: the steady state consistent with the inputs.
     pub fn initialize(&mut self) -> Result<(), String> {
         if self.model_exchange {
-            return self.me_initialize();
+            self.me_initialize()?;
+            self.fresh = true;
+            return Ok(());
         }
         let model = self.model().map_err(|e| e.to_string())?;
         let mut stepper = Stepper::new(model, self.config.causality, self.options);
@@ -294,12 +416,23 @@ impl Instance {
         self.stepper = Some(stepper);
         self.previous = Some((self.start_time, self.inputs()));
         self.publish(&sample);
+        self.fresh = true;
         Ok(())
     }
 
-    /// `fmi2DoStep` from `t` over `h`: the inputs move linearly from their values at `t` with
-    /// their given rates, or else the rates of the last interval (first-order hold).
+    /// `fmi2DoStep` from `t` over `h`. An input given a rate with `fmi2SetRealInputDerivatives`
+    /// moves linearly with it over the whole step. Otherwise its rate is estimated from the last
+    /// communication interval and used over at most that interval's length, then the input is
+    /// held (bounded extrapolation: a step far longer than the last interval holds the input at
+    /// its value one interval ahead). The first step holds the inputs.
     pub fn do_step(&mut self, t: f64, h: f64) -> Result<(), String> {
+        if self.model_exchange {
+            return Err("fmi2DoStep on a Model Exchange instance".into());
+        }
+        self.require("fmi2DoStep", &[Phase::Running])?;
+        if !(t.is_finite() && h.is_finite() && h > 0.0) {
+            return Err(format!("fmi2DoStep(t = {t}, h = {h}): expected a finite time and a finite, positive step"));
+        }
         if self.rebuild {
             let model = self.model().map_err(|e| e.to_string())?;
             if let Some(s) = self.stepper.as_mut() {
@@ -309,15 +442,17 @@ impl Instance {
         }
         let start = self.inputs();
         let refs = self.input_refs();
-        let estimated = match self.previous {
-            Some((tp, prev)) if t > tp => [(start[0] - prev[0]) / (t - tp), (start[1] - prev[1]) / (t - tp)],
-            _ => [0.0, 0.0],
-        };
-        let end = [0, 1].map(|k| start[k] + h * self.rates[refs[k]].unwrap_or(estimated[k]));
+        // each input's rate and for how long it applies
+        let ramp: [(f64, f64); 2] = [0, 1].map(|k| match (self.rates[refs[k]], self.previous) {
+            (Some(rate), _) => (rate, h),
+            (None, Some((tp, prev))) if t > tp => ((start[k] - prev[k]) / (t - tp), (t - tp).min(h)),
+            _ => (0.0, h),
+        });
         // the capacity: held over the interval, unless its rate is given (then linear, not below 0)
         let capacity = self.signals[vr::LOCKUP_CAPACITY as usize];
-        let capacity_end = (capacity + h * self.rates[vr::LOCKUP_CAPACITY as usize].unwrap_or(0.0)).max(0.0);
-        let extra = self.stepper_drive([capacity, capacity_end]);
+        let capacity_rate = self.rates[vr::LOCKUP_CAPACITY as usize].unwrap_or(0.0);
+        let capacity_at = move |tau: f64| (capacity + capacity_rate * tau).max(0.0);
+        let extra = self.stepper_drive([capacity, capacity]);
         let stepper = self.stepper.as_mut().ok_or("fmi2DoStep before initialisation")?;
         stepper.extra = extra;
         if (stepper.time_s() - t).abs() > 1e-9 * t.abs().max(1.0) {
@@ -326,11 +461,38 @@ impl Instance {
                 stepper.time_s()
             ));
         }
-        let sample = stepper.do_step(h, start, end).map_err(|e| e.to_string())?;
+        // the corners of the piecewise-linear inputs (a ramp as long as the step has none)
+        let mut corners: Vec<f64> = ramp.iter().map(|r| r.1).filter(|&c| c < h * (1.0 - 1e-9)).collect();
+        corners.sort_by(f64::total_cmp);
+        corners.dedup();
+        corners.push(h);
+        let at = |tau: f64| {
+            [0, 1].map(|k| start[k] + ramp[k].0 * if ramp[k].1 >= h * (1.0 - 1e-9) { tau } else { tau.min(ramp[k].1) })
+        };
+        let (mut tau, mut sample, saved) = (0.0, None, stepper.state());
+        for c in corners {
+            stepper.extra.lockup_capacity_nm = Some([capacity_at(tau), capacity_at(c)]);
+            match stepper.do_step(c - tau, at(tau), at(c)) {
+                Ok(s) => sample = Some(s),
+                Err(e) => {
+                    stepper.set_state(&saved); // a failed step leaves the instance at t
+                    return Err(e.to_string());
+                }
+            }
+            tau = c;
+        }
         self.previous = Some((t, start));
         self.rates = [None; SIGNAL_SLOTS];
-        self.publish(&sample);
+        if let Some(sample) = sample {
+            self.publish(&sample);
+        }
         Ok(())
+    }
+
+    /// Whether the model is the table model with its first-order lag (a fourth state,
+    /// [`variables::has_lag`]).
+    pub(crate) fn lag(&self) -> bool {
+        self.config.model.contains_key(tcsim_core::converter::spec::LAG_KEY)
     }
 
     /// The clutch and the load of the stepper, with the capacity at the start and end of an interval.
@@ -345,25 +507,27 @@ impl Instance {
     }
 
     /// Set a drive parameter: before initialisation only, finite and at least its minimum.
-    fn set_drive_parameter(&mut self, i: usize, value: f64) -> Result<(), String> {
+    fn set_drive_parameter(&mut self, i: usize, value: f64) -> Result<bool, String> {
         let d = &DRIVE_PARAMETERS[i];
-        if self.stepper.is_some() || (self.me.is_some() && !self.initializing) {
+        if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
             return Err(format!("{} is fixed after initialisation", d.name));
         }
         if !(value.is_finite() && value >= d.min) {
             return Err(format!("{} = {value}: expected a finite value of {} or more", d.name, d.min));
         }
         self.drive[i] = value;
-        Ok(())
+        Ok(false)
     }
 
     /// `fmi2Reset`: back to the instantiated state, parameters at their start values.
     pub fn reset(&mut self) {
+        let model_exchange = self.model_exchange;
         for p in &mut self.config.parameters {
             p.value = p.start;
         }
         let config = self.config.clone();
         *self = Instance::new(config);
+        self.model_exchange = model_exchange;
     }
 }
 
@@ -382,11 +546,10 @@ mod tests {
         let mut inst = Instance::new(Configuration::parse(CONFIG).unwrap());
         inst.set(0, 100.0).unwrap();
         inst.set(2, 0.0).unwrap();
-        inst.initializing = true;
+        inst.enter_initialization().unwrap();
         // outputs read in initialisation mode are the steady state for the inputs
         assert!((inst.get(1).unwrap() - (100.0f64 / 0.0032).sqrt()).abs() < 1e-9);
-        inst.initializing = false;
-        inst.initialize().unwrap();
+        inst.exit_initialization().unwrap();
         // steady state at stall: CF ω² = 100 N·m, turbine torque TR × 100
         assert!((inst.get(1).unwrap() - (100.0f64 / 0.0032).sqrt()).abs() < 1e-9);
         assert!((inst.get(3).unwrap() - 210.0).abs() < 1e-9);
@@ -426,12 +589,12 @@ mod tests {
 
 /// The Model Exchange side of an instance.
 pub struct ModelExchange {
-    model: Box<dyn ConverterDynamics + Send>,
+    pub(crate) model: Box<dyn ConverterDynamics + Send>,
     /// All four coordinates; the state coordinates are set by the host.
-    u: [f64; 4],
-    mode: Mode,
-    time_s: f64,
-    coordinates: Vec<usize>,
+    pub(crate) u: [f64; 4],
+    pub(crate) mode: Mode,
+    pub(crate) time_s: f64,
+    pub(crate) coordinates: Vec<usize>,
 }
 
 impl Instance {
@@ -454,7 +617,7 @@ impl Instance {
     }
 
     /// The drive of the current inputs and their rates (linear about the current time).
-    fn me_drive(&self, t: f64) -> Result<Drive, String> {
+    pub(crate) fn me_drive(&self, t: f64) -> Result<Drive, String> {
         let line = |name: &str, value: f64, rate: f64| {
             Signal::new(name, vec![t, t + 1.0], vec![value, value + rate], 0.0).map_err(|e| e.to_string())
         };
@@ -499,10 +662,11 @@ impl Instance {
         Ok(())
     }
 
-    /// The number of continuous states and of event indicators.
+    /// The number of continuous states and of event indicators (of the variable table, as the
+    /// modelDescription.xml declares them: known from instantiation on).
     pub fn me_sizes(&self) -> (usize, usize) {
-        match &self.me {
-            Some(me) => (me.coordinates.len(), self.model_kind().map_or(0, Model::event_indicators)),
+        match self.model_kind() {
+            Some(m) => (variables::states(m, self.config.causality, self.lag()).len(), m.event_indicators()),
             None => (0, 0),
         }
     }
@@ -517,11 +681,17 @@ impl Instance {
     }
 
     pub fn me_set_time(&mut self, t: f64) -> Result<(), String> {
+        if !t.is_finite() {
+            return Err(format!("fmi2SetTime({t}): expected a finite time"));
+        }
         self.me.as_mut().ok_or("fmi2SetTime before initialisation")?.time_s = t;
         Ok(())
     }
 
     pub fn me_set_states(&mut self, x: &[f64]) -> Result<(), String> {
+        if let Some(v) = x.iter().find(|v| !v.is_finite()) {
+            return Err(format!("fmi2SetContinuousStates: a state = {v}: expected finite values"));
+        }
         let me = self.me.as_mut().ok_or("fmi2SetContinuousStates before initialisation")?;
         if x.len() != me.coordinates.len() {
             return Err(format!("{} continuous states given, expected {}", x.len(), me.coordinates.len()));
@@ -540,11 +710,13 @@ impl Instance {
         Ok(())
     }
 
+    /// The nominal values of the continuous states (100 rad/s, 0.05 m³/s), from instantiation on.
     pub fn me_nominals(&self, x: &mut [f64]) -> Result<(), String> {
-        let me = self.me_state()?;
-        for (&c, v) in me.coordinates.iter().zip(x.iter_mut()) {
+        let model = self.model_kind().ok_or("no model kind")?;
+        let lag = self.lag();
+        for ((_, c), v) in variables::states(model, self.config.causality, lag).into_iter().zip(x.iter_mut()) {
             // the flow's scale, or (the table model's lag state, in the same slot) a torque's
-            *v = if c == FLOW && !me.model.lag_state() { 0.05 } else { 100.0 };
+            *v = if c == FLOW && !lag { 0.05 } else { 100.0 };
         }
         Ok(())
     }

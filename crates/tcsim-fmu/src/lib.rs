@@ -16,12 +16,16 @@
 #![allow(clippy::missing_safety_doc)]
 
 mod instance;
+mod snapshot;
+pub mod uri;
 pub mod variables;
 
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-pub use instance::{Configuration, Instance};
+use instance::Phase::{Initialization, Instantiated, Running, Terminated};
+pub use instance::{Configuration, Instance, Phase};
+pub use snapshot::Snapshot;
 pub use variables::{FIRST_PARAMETER, MODEL_IDENTIFIER, SIGNALS};
 
 type Status = c_int;
@@ -30,6 +34,13 @@ const ERROR: Status = 3;
 const FATAL: Status = 4;
 const MODEL_EXCHANGE: c_int = 0;
 const CO_SIMULATION: c_int = 1;
+
+/// The log categories the library uses (declared in `<LogCategories>` of modelDescription.xml):
+/// name and description.
+pub const LOG_CATEGORIES: [(&str, &str); 2] = [
+    ("logStatusError", "Calls that return fmi2Error, with the reason"),
+    ("logStatusFatal", "Internal errors (a bug of the FMU), with the reason"),
+];
 
 type Logger = unsafe extern "C" fn(*mut c_void, *const c_char, Status, *const c_char, *const c_char, ...);
 
@@ -56,7 +67,7 @@ impl Component {
         let Some(cb) = self.callbacks else { return };
         let Some(logger) = cb.logger else { return };
         let msg = CString::new(message.replace('\0', " ")).unwrap_or_default();
-        let category = if status >= ERROR { c"logStatusError" } else { c"logAll" };
+        let category = if status >= FATAL { c"logStatusFatal" } else { c"logStatusError" };
         // the message is passed as an argument of "%s", so a '%' in it is not a format
         unsafe { logger(cb.environment, self.name.as_ptr(), status, category.as_ptr(), c"%s".as_ptr(), msg.as_ptr()) };
     }
@@ -110,12 +121,19 @@ unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], String> {
     Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
 }
 
-fn resources_path(location: &str) -> String {
-    let path = location.strip_prefix("file://").unwrap_or(location);
-    // file:///C:/... on Windows; percent-encoded spaces
-    let path =
-        if path.len() > 2 && path.as_bytes()[0] == b'/' && path.as_bytes()[2] == b':' { &path[1..] } else { path };
-    path.replace("%20", " ").trim_end_matches('/').to_string()
+/// The GUID the FMU was exported with (`guid` of model.json; none in a hand-written one).
+fn exported_guid(text: &str) -> Option<String> {
+    let doc: serde_json::Value = serde_json::from_str(text).ok()?;
+    doc.get("guid")?.as_str().map(str::to_string)
+}
+
+/// Check the instance's phase, and that it is of the interface (`Some(true)`: Model Exchange).
+fn require(comp: &Component, call: &str, model_exchange: Option<bool>, allowed: &[Phase]) -> Result<(), String> {
+    if let Some(me) = model_exchange.filter(|&me| me != comp.instance.model_exchange) {
+        let (wanted, is) = if me { ("Model Exchange", "Co-Simulation") } else { ("Co-Simulation", "Model Exchange") };
+        return Err(format!("{call} is a {wanted} function: this is a {is} instance"));
+    }
+    comp.instance.require(call, allowed)
 }
 
 #[no_mangle]
@@ -132,17 +150,31 @@ pub extern "C" fn fmi2GetVersion() -> *const c_char {
 pub unsafe extern "C" fn fmi2SetDebugLogging(
     c: *mut c_void,
     _on: c_int,
-    _n: usize,
-    _categories: *const *const c_char,
+    n: usize,
+    categories: *const *const c_char,
 ) -> Status {
-    unsafe { with(c, |_| Ok(())) }
+    unsafe {
+        with(c, |_| {
+            for &p in slice(categories, n)? {
+                if p.is_null() {
+                    return Err("null log category".into());
+                }
+                let name = CStr::from_ptr(p).to_string_lossy();
+                if !LOG_CATEGORIES.iter().any(|(c, _)| *c == name) {
+                    let known: Vec<&str> = LOG_CATEGORIES.iter().map(|c| c.0).collect();
+                    return Err(format!("log category {name:?}: expected one of {}", known.join(", ")));
+                }
+            }
+            Ok(())
+        })
+    }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Instantiate(
     name: *const c_char,
     kind: c_int,
-    _guid: *const c_char,
+    guid: *const c_char,
     resources: *const c_char,
     callbacks: *const Callbacks,
     _visible: c_int,
@@ -170,11 +202,23 @@ pub unsafe extern "C" fn fmi2Instantiate(
         if resources.is_null() {
             return fail("no fmuResourceLocation".into());
         }
-        let dir = resources_path(&unsafe { CStr::from_ptr(resources) }.to_string_lossy());
+        let dir = match uri::resources_path(&unsafe { CStr::from_ptr(resources) }.to_string_lossy()) {
+            Ok(dir) => dir,
+            Err(msg) => return fail(msg),
+        };
         let text = match std::fs::read_to_string(format!("{dir}/model.json")) {
             Ok(t) => t,
             Err(e) => return fail(format!("{dir}/model.json: {e}")),
         };
+        if let Some(expected) = exported_guid(&text) {
+            let given = if guid.is_null() { None } else { Some(unsafe { CStr::from_ptr(guid) }.to_string_lossy()) };
+            if given.as_deref() != Some(expected.as_str()) {
+                return fail(format!(
+                    "GUID {}: expected {expected} (the modelDescription.xml of this FMU)",
+                    given.map_or_else(|| "null".to_string(), |g| format!("{g:?}"))
+                ));
+            }
+        }
         match Configuration::parse(&text) {
             Ok(config) => {
                 let mut instance = Instance::new(config);
@@ -205,6 +249,10 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
 ) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2SetupExperiment", None, &[Instantiated])?;
+            if !start.is_finite() {
+                return Err(format!("fmi2SetupExperiment: startTime = {start}: expected a finite time"));
+            }
             if tolerance_defined != 0 && tolerance.is_finite() && tolerance > 0.0 {
                 comp.instance.options.rtol = tolerance.min(1e-4);
             }
@@ -216,27 +264,17 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: *mut c_void) -> Status {
-    unsafe {
-        with(c, |comp| {
-            comp.instance.initializing = true;
-            Ok(())
-        })
-    }
+    unsafe { with(c, |comp| comp.instance.enter_initialization()) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: *mut c_void) -> Status {
-    unsafe {
-        with(c, |comp| {
-            comp.instance.initializing = false;
-            comp.instance.initialize()
-        })
-    }
+    unsafe { with(c, |comp| comp.instance.exit_initialization()) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Terminate(c: *mut c_void) -> Status {
-    unsafe { with(c, |_| Ok(())) }
+    unsafe { with(c, |comp| comp.instance.terminate()) }
 }
 
 #[no_mangle]
@@ -253,9 +291,10 @@ pub unsafe extern "C" fn fmi2Reset(c: *mut c_void) -> Status {
 pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, n: usize, values: *mut f64) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2GetReal", None, &[Initialization, Running, Terminated])?;
             let (vr, values) = (slice(vr, n)?, slice_mut(values, n)?);
             for (r, v) in vr.iter().zip(values.iter_mut()) {
-                *v = comp.instance.get(*r).ok_or(format!("no variable with value reference {r}"))?;
+                *v = comp.instance.read(*r)?;
             }
             Ok(())
         })
@@ -264,14 +303,7 @@ pub unsafe extern "C" fn fmi2GetReal(c: *mut c_void, vr: *const u32, n: usize, v
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetReal(c: *mut c_void, vr: *const u32, n: usize, values: *const f64) -> Status {
-    unsafe {
-        with(c, |comp| {
-            for (r, v) in slice(vr, n)?.iter().zip(slice(values, n)?) {
-                comp.instance.set(*r, *v)?;
-            }
-            Ok(())
-        })
-    }
+    unsafe { with(c, |comp| comp.instance.set_all(slice(vr, n)?, slice(values, n)?)) }
 }
 
 /// Integer, Boolean and String variables: the FMU has none.
@@ -314,39 +346,100 @@ unsafe fn unsupported(c: *mut c_void, what: &str) -> Status {
     unsafe { with(c, |_| Err(format!("{what} is not supported by this FMU"))) }
 }
 
-#[no_mangle]
-pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, _s: *mut *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi2GetFMUstate") }
+/// Store `snap` behind `*s`: a new FMU state, or over the one `*s` points to.
+unsafe fn store(s: *mut *mut c_void, snap: Snapshot) -> Result<(), String> {
+    if s.is_null() {
+        return Err("null fmi2FMUstate pointer".into());
+    }
+    let existing = unsafe { *s } as *mut Snapshot;
+    if existing.is_null() {
+        unsafe { *s = Box::into_raw(Box::new(snap)) as *mut c_void };
+    } else {
+        let existing = unsafe { &mut *existing };
+        existing.check_live()?;
+        *existing = snap;
+    }
+    Ok(())
+}
+
+/// The FMU state behind `s`.
+unsafe fn stored<'a>(s: *mut c_void) -> Result<&'a Snapshot, String> {
+    if s.is_null() {
+        return Err("null fmi2FMUstate".into());
+    }
+    let snap = unsafe { &*(s as *const Snapshot) };
+    snap.check_live()?;
+    Ok(snap)
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, _s: *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi2SetFMUstate") }
+pub unsafe extern "C" fn fmi2GetFMUstate(c: *mut c_void, s: *mut *mut c_void) -> Status {
+    unsafe { with(c, |comp| store(s, comp.instance.snapshot())) }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, _s: *mut *mut c_void) -> Status {
-    unsafe { unsupported(c, "fmi2FreeFMUstate") }
+pub unsafe extern "C" fn fmi2SetFMUstate(c: *mut c_void, s: *mut c_void) -> Status {
+    unsafe { with(c, |comp| comp.instance.restore(stored(s)?)) }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: *mut c_void, _s: *mut c_void, _n: *mut usize) -> Status {
-    unsafe { unsupported(c, "fmi2SerializedFMUstateSize") }
+pub unsafe extern "C" fn fmi2FreeFMUstate(c: *mut c_void, s: *mut *mut c_void) -> Status {
+    unsafe {
+        with(c, |_| {
+            if s.is_null() || (*s).is_null() {
+                return Ok(());
+            }
+            stored(*s)?;
+            let mut snap = Box::from_raw(*s as *mut Snapshot);
+            snap.kill();
+            drop(snap);
+            *s = std::ptr::null_mut();
+            Ok(())
+        })
+    }
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi2SerializeFMUstate(c: *mut c_void, _s: *mut c_void, _b: *mut c_char, _n: usize) -> Status {
-    unsafe { unsupported(c, "fmi2SerializeFMUstate") }
+pub unsafe extern "C" fn fmi2SerializedFMUstateSize(c: *mut c_void, s: *mut c_void, n: *mut usize) -> Status {
+    unsafe {
+        with(c, |_| {
+            let size = stored(s)?.to_bytes().len();
+            if n.is_null() {
+                return Err("null size pointer".into());
+            }
+            *n = size;
+            Ok(())
+        })
+    }
+}
+
+#[no_mangle]
+pub unsafe extern "C" fn fmi2SerializeFMUstate(c: *mut c_void, s: *mut c_void, b: *mut c_char, n: usize) -> Status {
+    unsafe {
+        with(c, |_| {
+            let bytes = stored(s)?.to_bytes();
+            if n < bytes.len() {
+                return Err(format!("serialised FMU state of {} bytes: the buffer has {n}", bytes.len()));
+            }
+            slice_mut(b as *mut u8, bytes.len())?.copy_from_slice(&bytes);
+            Ok(())
+        })
+    }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
     c: *mut c_void,
-    _b: *const c_char,
-    _n: usize,
-    _s: *mut *mut c_void,
+    b: *const c_char,
+    n: usize,
+    s: *mut *mut c_void,
 ) -> Status {
-    unsafe { unsupported(c, "fmi2DeSerializeFMUstate") }
+    unsafe {
+        with(c, |comp| {
+            let snap = Snapshot::from_bytes(slice(b as *const u8, n)?, &comp.instance)?;
+            store(s, snap)
+        })
+    }
 }
 
 #[no_mangle]
@@ -372,6 +465,7 @@ pub unsafe extern "C" fn fmi2SetRealInputDerivatives(
 ) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2SetRealInputDerivatives", Some(false), &[Initialization, Running])?;
             for ((r, o), v) in slice(vr, n)?.iter().zip(slice(order, n)?).zip(slice(values, n)?) {
                 comp.instance.set_rate(*r, *o, *v)?;
             }
@@ -442,13 +536,14 @@ pub struct EventInfo {
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterEventMode(c: *mut c_void) -> Status {
-    unsafe { with(c, |_| Ok(())) }
+    unsafe { with(c, |comp| require(comp, "fmi2EnterEventMode", Some(true), &[Running])) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2NewDiscreteStates(c: *mut c_void, info: *mut EventInfo) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2NewDiscreteStates", Some(true), &[Running])?;
             let changed = comp.instance.me_new_discrete_states()?;
             if info.is_null() {
                 return Err("null fmi2EventInfo".into());
@@ -467,7 +562,7 @@ pub unsafe extern "C" fn fmi2NewDiscreteStates(c: *mut c_void, info: *mut EventI
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: *mut c_void) -> Status {
-    unsafe { with(c, |_| Ok(())) }
+    unsafe { with(c, |comp| require(comp, "fmi2EnterContinuousTimeMode", Some(true), &[Running])) }
 }
 
 #[no_mangle]
@@ -478,7 +573,8 @@ pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
     terminate: *mut c_int,
 ) -> Status {
     unsafe {
-        with(c, |_| {
+        with(c, |comp| {
+            require(comp, "fmi2CompletedIntegratorStep", Some(true), &[Running])?;
             if !enter_event_mode.is_null() {
                 *enter_event_mode = 0;
             }
@@ -492,12 +588,22 @@ pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetTime(c: *mut c_void, t: f64) -> Status {
-    unsafe { with(c, |comp| comp.instance.me_set_time(t)) }
+    unsafe {
+        with(c, |comp| {
+            require(comp, "fmi2SetTime", Some(true), &[Running])?;
+            comp.instance.me_set_time(t)
+        })
+    }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetContinuousStates(c: *mut c_void, x: *const f64, n: usize) -> Status {
-    unsafe { with(c, |comp| comp.instance.me_set_states(slice(x, n)?)) }
+    unsafe {
+        with(c, |comp| {
+            require(comp, "fmi2SetContinuousStates", Some(true), &[Running])?;
+            comp.instance.me_set_states(slice(x, n)?)
+        })
+    }
 }
 
 /// Check the host's array size against the model's.
@@ -513,7 +619,9 @@ fn sized(n: usize, expected: usize, what: &str) -> Result<(), String> {
 pub unsafe extern "C" fn fmi2GetContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2GetContinuousStates", Some(true), &[Initialization, Running, Terminated])?;
             sized(n, comp.instance.me_sizes().0, "continuous states")?;
+            comp.instance.provisional()?;
             comp.instance.me_get_states(slice_mut(x, n)?)
         })
     }
@@ -523,6 +631,7 @@ pub unsafe extern "C" fn fmi2GetContinuousStates(c: *mut c_void, x: *mut f64, n:
 pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(c: *mut c_void, x: *mut f64, n: usize) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2GetNominalsOfContinuousStates", Some(true), &Phase::ALL)?;
             sized(n, comp.instance.me_sizes().0, "continuous states")?;
             comp.instance.me_nominals(slice_mut(x, n)?)
         })
@@ -533,7 +642,9 @@ pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(c: *mut c_void, x: *m
 pub unsafe extern "C" fn fmi2GetDerivatives(c: *mut c_void, dx: *mut f64, n: usize) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2GetDerivatives", Some(true), &[Initialization, Running, Terminated])?;
             sized(n, comp.instance.me_sizes().0, "derivatives")?;
+            comp.instance.provisional()?;
             comp.instance.me_derivatives(slice_mut(dx, n)?)
         })
     }
@@ -543,7 +654,9 @@ pub unsafe extern "C" fn fmi2GetDerivatives(c: *mut c_void, dx: *mut f64, n: usi
 pub unsafe extern "C" fn fmi2GetEventIndicators(c: *mut c_void, g: *mut f64, n: usize) -> Status {
     unsafe {
         with(c, |comp| {
+            require(comp, "fmi2GetEventIndicators", Some(true), &[Initialization, Running, Terminated])?;
             sized(n, comp.instance.me_sizes().1, "event indicators")?;
+            comp.instance.provisional()?;
             comp.instance.me_indicators(slice_mut(g, n)?)
         })
     }

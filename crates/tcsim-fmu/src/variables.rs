@@ -666,12 +666,67 @@ fn signal_variables(model: Model, causality: Causality, lag: bool) -> Vec<Variab
             } else {
                 let mut v = Variable::new(s.vr, s.name, "output", "continuous", s.unit).describe(s.description);
                 v.initial = Some("calculated");
-                // a state (pump speed, flow, stator speed) does not depend directly on the inputs
-                v.dependencies = Some(if s.state.is_some() { vec![] } else { inputs.clone() });
+                v.dependencies = Some(direct_dependencies(model, causality, s));
                 v
             }
         })
         .collect()
+}
+
+/// The inputs an output depends on directly (`<ModelStructure>`; measured in Model Exchange by
+/// tests/integration/test_fmu_conformance.py). A state (pump speed, flow, stator speed): none. Any
+/// other output: the speed inputs, and for each rotor whose external torque the output contains
+/// (pump torque: the pump; turbine torque: the turbine; torque ratio: both; for Hrovat & Tobler,
+/// whose mass matrix couples the rotors through the flow, every torque contains both) the rate
+/// input of its speed when the speed is an input, else the torque input that drives it.
+pub fn direct_dependencies(model: Model, causality: Causality, s: &SignalDef) -> Vec<u32> {
+    if s.state.is_some() && !inputs(causality).contains(&s.vr) {
+        return vec![];
+    }
+    let inputs = inputs(causality);
+    let torque_inputs = [vr::PUMP_TORQUE, vr::LOAD_TORQUE];
+    let mut deps: Vec<u32> = inputs.iter().copied().filter(|i| !torque_inputs.contains(i)).collect();
+    match s.vr {
+        // the clutch's slip is of the speeds only; its state code (0 open, 1 slipping) follows the
+        // command; its torque is C·tanh(slip/s_c) slipping, the constraint torque locked: every input
+        vr::LOCKUP_SLIP => return deps,
+        vr::LOCKUP_STATE => return COMMON_INPUTS.to_vec(),
+        vr::LOCKUP_TORQUE => {
+            let mut all: Vec<u32> = all_inputs(causality).into_iter().chain(rate_inputs(causality)).collect();
+            all.sort_unstable();
+            return all;
+        }
+        // the fluid's stator torque sees the clutch only through Hrovat & Tobler's coupled mass
+        // matrix, and only where a rotor speed is free
+        vr::SPEED_RATIO => {}
+        vr::STATOR_TORQUE if model != Model::HrovatTobler || causality == Causality::Speeds => {}
+        _ => deps.extend(COMMON_INPUTS),
+    }
+    let rotors: &[u32] = match s.vr {
+        vr::SPEED_RATIO => &[],
+        _ if model == Model::HrovatTobler => &[vr::PUMP_SPEED, vr::TURBINE_SPEED],
+        vr::PUMP_TORQUE => &[vr::PUMP_SPEED],
+        vr::TURBINE_TORQUE => &[vr::TURBINE_SPEED],
+        vr::TORQUE_RATIO => &[vr::PUMP_SPEED, vr::TURBINE_SPEED],
+        _ => &[],
+    };
+    for &rotor in rotors {
+        match RATES.iter().find(|r| r.of == rotor) {
+            Some(rate) if inputs.contains(&rotor) => deps.push(rate.vr),
+            _ if rotor == vr::PUMP_SPEED && inputs.contains(&vr::PUMP_TORQUE) => deps.push(vr::PUMP_TORQUE),
+            _ if rotor == vr::TURBINE_SPEED && inputs.contains(&vr::LOAD_TORQUE) => deps.push(vr::LOAD_TORQUE),
+            _ => {}
+        }
+    }
+    deps.sort_unstable();
+    deps.dedup();
+    deps
+}
+
+/// The rate inputs of a causality's speed inputs (Model Exchange).
+fn rate_inputs(causality: Causality) -> Vec<u32> {
+    let inputs = inputs(causality);
+    RATES.iter().filter(|r| inputs.contains(&r.of)).map(|r| r.vr).collect()
 }
 
 /// The input rates of the speed inputs, then the start-value parameters of the model's states.

@@ -140,6 +140,7 @@ pub fn fmu_units() -> Vec<(&'static str, Vec<(&'static str, i32)>, Vec<(&'static
 
 pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("FMU_MODEL_IDENTIFIER", variables::MODEL_IDENTIFIER)?;
+    m.add("FMU_LOG_CATEGORIES", tcsim_fmu::LOG_CATEGORIES.to_vec())?;
     m.add("FMU_FIRST_PARAMETER_VR", variables::FIRST_PARAMETER)?;
     m.add_function(wrap_pyfunction!(fmu_variables, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_signals, m)?)?;

@@ -813,34 +813,16 @@ fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal
 }
 
 /// The lock-up clutch's command of a drive dict: `lockup_capacity_nm` (a constant or one value per
-/// time, N·m ≥ 0) and `lockup_static_to_kinetic` (≥ 1, default
+/// time, N·m, checked by [`LockupCommand::new`]) and `lockup_static_to_kinetic` (≥ 1, default
 /// [`tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC`]); None without a capacity.
 fn lockup_from(d: &Bound<'_, PyDict>, window: f64) -> PyResult<Option<LockupCommand>> {
     if d.get_item("lockup_capacity_nm")?.is_none() {
         return Ok(None);
     }
     let capacity_nm = signal_from(d, "lockup_capacity_nm", window)?;
-    if let Some((i, v)) = capacity_nm.values().iter().enumerate().find(|(_, v)| !(v.is_finite() && **v >= 0.0)) {
-        let field = format!("lockup_capacity_nm[{i}]");
-        return Err(input_error(CoreError::of(
-            InputSource::Drive,
-            field,
-            v,
-            "a finite capacity of zero or more in N·m",
-        )));
-    }
     let static_to_kinetic: f64 =
         opt_item(d, "lockup_static_to_kinetic")?.unwrap_or(tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC);
-    if !(static_to_kinetic.is_finite() && static_to_kinetic >= 1.0) {
-        let expected = "a finite static-to-kinetic friction ratio of 1 or more";
-        return Err(input_error(CoreError::of(
-            InputSource::Drive,
-            "lockup_static_to_kinetic",
-            static_to_kinetic,
-            expected,
-        )));
-    }
-    Ok(Some(LockupCommand { capacity_nm, static_to_kinetic }))
+    LockupCommand::new(capacity_nm, static_to_kinetic).map(Some).map_err(input_error)
 }
 
 fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
@@ -1209,6 +1191,13 @@ fn default_flow_time_constant_s(geometry: PyReadonlyArray2<'_, f64>, fluid_lengt
     })
 }
 
+/// The lock-up clutch's command limits (`tcsim_core::engine::lockup`): `max_capacity_nm` and the
+/// wording `capacity_expected`, for the readers that name a file's row.
+#[pyfunction]
+fn lockup_limits() -> (f64, &'static str) {
+    (tcsim_core::engine::lockup::MAX_CAPACITY_NM, tcsim_core::engine::lockup::CAPACITY_EXPECTED)
+}
+
 /// The unit conversions of the core (`tcsim_core::units`), by name: `rad_s_per_rpm`, `m_s_per_km_h`,
 /// `nm_per_lbf_ft`, `gravity_m_s2`. Python's `tcsim.units` takes its constants from here.
 #[pyfunction]
@@ -1328,6 +1317,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capacity_conventions, m)?)?;
     m.add_function(wrap_pyfunction!(default_flow_time_constant_s, m)?)?;
     m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
+    m.add_function(wrap_pyfunction!(lockup_limits, m)?)?;
     m.add_function(wrap_pyfunction!(plausibility_ranges, m)?)?;
     m.add_function(wrap_pyfunction!(reference_pump_speed_rpm, m)?)?;
     m.add_function(wrap_pyfunction!(reference_pump_speed_rad_s, m)?)?;

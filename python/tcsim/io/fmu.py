@@ -208,11 +208,18 @@ def _header(
         f'  generationTool={a("tcsim " + version)} generationDateAndTime="{stamp}" license="MIT"',
         f'  variableNamingConvention="flat" numberOfEventIndicators="{_core.fmu_event_indicators(model.name)}">',
         f'  <ModelExchange modelIdentifier="{MODEL_IDENTIFIER}" completedIntegratorStepNotNeeded="true"'
-        ' canGetAndSetFMUstate="false" canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+        ' canGetAndSetFMUstate="true" canSerializeFMUstate="true" providesDirectionalDerivative="false"/>',
         f'  <CoSimulation modelIdentifier="{MODEL_IDENTIFIER}" canHandleVariableCommunicationStepSize="true"'
-        ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="false"'
-        ' canSerializeFMUstate="false" providesDirectionalDerivative="false"/>',
+        ' canInterpolateInputs="true" maxOutputDerivativeOrder="0" canGetAndSetFMUstate="true"'
+        ' canSerializeFMUstate="true" providesDirectionalDerivative="false"/>',
     ]
+
+
+def _log_categories() -> list[str]:
+    """``<LogCategories>``: the categories the library logs with (:data:`tcsim._core.FMU_LOG_CATEGORIES`)."""
+    lines = ["  <LogCategories>"]
+    lines += [f"    <Category name={xml_attr(n)} description={xml_attr(d)}/>" for n, d in _core.FMU_LOG_CATEGORIES]
+    return [*lines, "  </LogCategories>"]
 
 
 def _unit_definitions() -> list[str]:
@@ -283,6 +290,7 @@ def model_description_xml(
         [
             *_header(model, causality, variables, name, guid, stamp),
             *_unit_definitions(),
+            *_log_categories(),
             '  <DefaultExperiment startTime="0.0" stopTime="10.0" tolerance="1e-06" stepSize="0.001"/>',
             *_model_variables(variables, index),
             *_model_structure(variables, index),
@@ -580,8 +588,9 @@ def export_fmu(
     out = _output_path(out_path)
     dyn = resolve_model(converter if isinstance(converter, (Converter, DynamicModel)) else str(converter), model)
     _check_model(dyn, causality)
-    xml = model_description_xml(dyn, causality)
-    config = model_json(dyn, causality)
+    guid = "{" + str(uuid.uuid4()) + "}"
+    xml = model_description_xml(dyn, causality, guid=guid)
+    config = {**model_json(dyn, causality), "guid": guid}  # checked by fmi2Instantiate
     libs = find_libraries()
     for lib in libs:
         _check_library(lib)

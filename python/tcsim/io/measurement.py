@@ -36,6 +36,7 @@ from typing import TypeVar
 import numpy as np
 import pandas as pd
 
+from .. import _core
 from ..errors import InputError
 from ..models.measurement import Measurement
 from ..models.plausibility import check_plausible
@@ -511,18 +512,19 @@ def check_finite(path: Path, column: str, values: np.ndarray, time_s: np.ndarray
         )
 
 
-#: Channels that cannot be negative: the lock-up clutch's capacity command (docs/lockup.md).
+#: Channels that are a lock-up clutch's capacity command, 0 to the core's limit (docs/lockup.md).
 NON_NEGATIVE: tuple[str, ...] = ("lockup_capacity_nm",)
+#: The core's capacity limit, N·m, and its wording (``tcsim_core::engine::lockup``).
+MAX_CAPACITY_NM, CAPACITY_EXPECTED = _core.lockup_limits()
 
 
 def check_non_negative(path: Path, column: str, values: np.ndarray, time_s: np.ndarray | None) -> None:
-    """An InputError naming the first negative value (a capacity command of a clutch)."""
-    bad = np.flatnonzero(values < 0)
+    """An InputError naming the first value outside 0 … :data:`MAX_CAPACITY_NM` (a capacity command
+    of a clutch), with its row and time."""
+    bad = np.flatnonzero((values < 0) | (values > MAX_CAPACITY_NM))
     if len(bad):
         row = int(bad[0])
-        raise InputError(
-            str(path), column, f"{values[row]:g} at {_at(row, time_s)}", "a lock-up capacity of zero or more in N·m"
-        )
+        raise InputError(str(path), column, f"{values[row]:g} at {_at(row, time_s)}", CAPACITY_EXPECTED)
 
 
 def check_increasing(path: Path, column: str, time: np.ndarray) -> None:
@@ -615,9 +617,9 @@ def read_measurement(
         factor = _unit_factor(path, p.column, unit, p.canonical) if unit else p.name_factor
         if factor != 1.0:
             values = values * factor
-        _plausible(path, p.column, p.canonical, values, time_s, allow_implausible)
-        if p.canonical in NON_NEGATIVE:
+        if p.canonical in NON_NEGATIVE:  # a hard limit first: no plausibility warning for a refused value
             check_non_negative(path, p.column, values, time_s)
+        _plausible(path, p.column, p.canonical, values, time_s, allow_implausible)
         out[p.canonical] = values
     time_s = out.pop("time_s")
     return Measurement(str(path), time_s, out)

@@ -745,11 +745,33 @@ impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::converter::quasi_dynamic::QuasiDynamics;
     use crate::converter::table::Characteristic;
 
+    /// A torque-dependent pair: C.1 at 100 N·m, C.1 with CF +20 % and TR nearer 1 at 300 N·m.
+    fn torque_pair() -> TorqueCharacteristic {
+        let heavier = Characteristic::new(
+            c1().speed_ratio().to_vec(),
+            c1().torque_ratio().iter().map(|t| 1.0 + 0.8 * (t - 1.0)).collect(),
+            c1().capacity_factor_nm_s2().iter().map(|c| 1.2 * c).collect(),
+        )
+        .unwrap();
+        TorqueCharacteristic::new(vec![100.0, 300.0], vec![c1(), heavier]).unwrap()
+    }
+
+    /// A table with coast rows (JAMBE-like, the `table` overrun rule).
+    fn coast_table() -> Characteristic {
+        Characteristic::new(
+            vec![-0.1, 0.0, 0.5, 0.9, 1.0, 1.5, 2.1],
+            vec![1.81, 1.81, 1.36, 1.0, 1.0, 1.0, 1.0],
+            vec![3.5e-3, 3.5e-3, 3.9e-3, 2.7e-3, 0.0, -1.5e-3, -2.4e-3],
+        )
+        .unwrap()
+    }
+
+    /// Li & Sundén (2016) Table C.1, CF in N·m/(rad/s)² (the core's unit tests' table).
     pub(crate) fn c1() -> Characteristic {
         Characteristic::new(
             vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
@@ -840,21 +862,10 @@ mod tests {
     fn table_jacobians_match_finite_differences_in_every_quadrant() {
         // a coast-row table (JAMBE-like: the `table` overrun rule) and Table C.1 (the mirror),
         // in CF and in K interpolation
-        let coast = Characteristic::new(
-            vec![-0.1, 0.0, 0.5, 0.9, 1.0, 1.5, 2.1],
-            vec![1.81, 1.81, 1.36, 1.0, 1.0, 1.0, 1.0],
-            vec![3.5e-3, 3.5e-3, 3.9e-3, 2.7e-3, 0.0, -1.5e-3, -2.4e-3],
-        )
-        .unwrap();
+        let coast = coast_table();
         // and a torque-dependent pair (C.1 at 100 N·m, C.1 with CF +20 % and TR nearer 1 at 300 N·m):
         // the solved input torque's gradient enters the Jacobian
-        let heavier = Characteristic::new(
-            c1().speed_ratio().to_vec(),
-            c1().torque_ratio().iter().map(|t| 1.0 + 0.8 * (t - 1.0)).collect(),
-            c1().capacity_factor_nm_s2().iter().map(|c| 1.2 * c).collect(),
-        )
-        .unwrap();
-        let pair = TorqueCharacteristic::new(vec![100.0, 300.0], vec![c1(), heavier]).unwrap();
+        let pair = torque_pair();
         let tables: [TorqueCharacteristic; 4] =
             [c1().into(), c1().with_rules(None, Some("k_factor")).unwrap().into(), coast.into(), pair];
         let points = [
@@ -901,19 +912,13 @@ mod tests {
     /// is the steady pump torque the lagged torques are the mixed table's.
     #[test]
     fn lagged_torque_dependent_table_jacobian_matches_finite_differences() {
-        let heavier = Characteristic::new(
-            c1().speed_ratio().to_vec(),
-            c1().torque_ratio().iter().map(|t| 1.0 + 0.8 * (t - 1.0)).collect(),
-            c1().capacity_factor_nm_s2().iter().map(|c| 1.2 * c).collect(),
-        )
-        .unwrap();
-        let pair = TorqueCharacteristic::new(vec![100.0, 300.0], vec![c1(), heavier]).unwrap();
+        let pair = torque_pair();
         let m = TableDynamics { characteristic: pair.clone(), inertia: inertia(), lag: TorqueLag::new(0.05).ok() };
         let mut mixed = 0;
         let points = [[250.0, 90.0], [200.0, 150.0], [300.0, 57.0], [180.0, 100.0], [-200.0, -70.0], [150.0, 410.0]];
         for [wp, wt] in points {
             let t = pair.torques(wp, wt);
-            let (a, b) = (c1().torques(wp, wt).torque_ratio, pair.tables()[1].torques(wp, wt).torque_ratio);
+            let (a, b) = (pair.tables()[0].torques(wp, wt).torque_ratio, pair.tables()[1].torques(wp, wt).torque_ratio);
             mixed += usize::from((t.torque_ratio - a).abs() > 1e-9 && (t.torque_ratio - b).abs() > 1e-9);
             let f = m.forces(&[wp, wt, 0.0, t.pump_nm], 1.0);
             assert_eq!((-f[PUMP], f[TURBINE], f[FLOW]), (t.pump_nm, t.torque_ratio * t.pump_nm, 0.0));
@@ -929,12 +934,7 @@ mod tests {
     /// (the Simscape form `T_t = TR·T_lag`).
     #[test]
     fn lagged_table_is_passive_at_any_state() {
-        let coast = Characteristic::new(
-            vec![-0.1, 0.0, 0.5, 0.9, 1.0, 1.5, 2.1],
-            vec![1.81, 1.81, 1.36, 1.0, 1.0, 1.0, 1.0],
-            vec![3.5e-3, 3.5e-3, 3.9e-3, 2.7e-3, 0.0, -1.5e-3, -2.4e-3],
-        )
-        .unwrap();
+        let coast = coast_table();
         let mut seed = 12345u64;
         let mut rnd = |lo: f64, hi: f64| {
             seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);

@@ -618,18 +618,7 @@ fn passivity_error(i: usize, tr: f64, e: f64, sr: f64, cf: f64, segment: Option<
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn c1() -> Characteristic {
-        // Li & Sundén (2016) Table C.1, CF in N·m/(rad/s)²
-        Characteristic::new(
-            vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
-            vec![2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
-            [3.272, 3.257, 3.228, 3.181, 3.112, 3.017, 2.887, 2.713, 2.481, 2.370, 1.842, 1.237, 0.187]
-                .map(|v| v * 1e-3)
-                .to_vec(),
-        )
-        .unwrap()
-    }
+    use crate::converter::dynamics::tests::c1;
 
     #[test]
     fn reproduces_table_points_exactly() {

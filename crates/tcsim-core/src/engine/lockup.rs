@@ -20,6 +20,7 @@
 //! from chattering between lock and slip.
 
 use crate::engine::signal::Signal;
+use crate::error::{CoreError, CoreResult, InputSource};
 
 /// Slip scale of the regularised clutch friction (tanh), rad/s: a clutch carrying 96 % of its
 /// capacity slips by `2·CLUTCH_SLIP_RAD_S`.
@@ -32,8 +33,17 @@ pub const REARM_DELAY_S: f64 = 0.1;
 /// Default ratio of static to kinetic friction of the lock-up clutch (the vehicle's default too).
 pub const DEFAULT_STATIC_TO_KINETIC: f64 = 1.2;
 
-/// The command of the clutch in a drive: the capacity against time, N·m (≥ 0, checked by the
-/// caller's reader), and the static-to-kinetic friction ratio (≥ 1).
+/// Largest capacity command, N·m. A clutch needs a few times the engine torque to lock (the bundled
+/// vehicle: 600 N·m); commands of 10⁸ N·m engaged at hundreds of rad/s of slip make the friction
+/// torque too stiff for the integrator (measured: solver failure at 10⁸ N·m, 600 rad/s of slip), so
+/// 10⁶ N·m, a hundred times any automotive converter's torque and ten times below that, is the limit.
+pub const MAX_CAPACITY_NM: f64 = 1.0e6;
+/// What a capacity command must be (the one wording of the limit, for every reader).
+pub const CAPACITY_EXPECTED: &str = "a finite lock-up capacity from 0 to 1e6 N·m";
+
+/// The command of the clutch in a drive: the capacity against time, N·m (0 to
+/// [`MAX_CAPACITY_NM`], checked by [`LockupCommand::new`]), and the static-to-kinetic friction ratio
+/// (≥ 1).
 #[derive(Debug, Clone)]
 pub struct LockupCommand {
     pub capacity_nm: Signal,
@@ -41,6 +51,27 @@ pub struct LockupCommand {
 }
 
 impl LockupCommand {
+    /// A command with its values checked: every capacity finite, in 0..=[`MAX_CAPACITY_NM`]
+    /// (field `lockup_capacity_nm[i]`), and a finite static-to-kinetic ratio ≥ 1
+    /// (`lockup_static_to_kinetic`); errors are the drive's.
+    pub fn new(capacity_nm: Signal, static_to_kinetic: f64) -> CoreResult<Self> {
+        let values = capacity_nm.values();
+        if let Some((i, &v)) = values.iter().enumerate().find(|(_, v)| !(0.0..=MAX_CAPACITY_NM).contains(*v)) {
+            let field =
+                if values.len() == 1 { "lockup_capacity_nm".to_string() } else { format!("lockup_capacity_nm[{i}]") };
+            return Err(CoreError::of(InputSource::Drive, field, v, CAPACITY_EXPECTED));
+        }
+        if !(static_to_kinetic.is_finite() && static_to_kinetic >= 1.0) {
+            return Err(CoreError::of(
+                InputSource::Drive,
+                "lockup_static_to_kinetic",
+                static_to_kinetic,
+                "a finite static-to-kinetic friction ratio of 1 or more",
+            ));
+        }
+        Ok(Self { capacity_nm, static_to_kinetic })
+    }
+
     /// The capacity at `t`, N·m (negative commands count as zero).
     pub fn capacity(&self, t: f64) -> f64 {
         self.capacity_nm.value(t).max(0.0)
@@ -149,6 +180,20 @@ pub fn initial_mode(slip_rad_s: f64, t: f64) -> ClutchMode {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_command_is_checked_once_for_every_reader() {
+        let ok = |v: f64| LockupCommand::new(Signal::constant(v), DEFAULT_STATIC_TO_KINETIC).is_ok();
+        assert!(ok(0.0) && ok(350.0) && ok(MAX_CAPACITY_NM));
+        for bad in [-1e-300, -5.0, MAX_CAPACITY_NM * (1.0 + f64::EPSILON), 1e10, f64::NAN, f64::INFINITY] {
+            let e = LockupCommand::new(Signal::constant(bad), 1.2).unwrap_err();
+            assert_eq!((e.field.as_str(), e.expected.as_str()), ("lockup_capacity_nm", CAPACITY_EXPECTED), "{bad}");
+        }
+        for ratio in [0.99, f64::NAN, f64::INFINITY] {
+            let e = LockupCommand::new(Signal::constant(10.0), ratio).unwrap_err();
+            assert_eq!(e.field, "lockup_static_to_kinetic");
+        }
+    }
 
     #[test]
     fn torque_law_is_odd_bounded_and_dissipative() {

@@ -52,6 +52,15 @@ impl Default for StepperDrive {
     }
 }
 
+/// The state of a [`Stepper`] between two intervals.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepperState {
+    pub time_s: f64,
+    pub inputs: [f64; 2],
+    pub u: Vec4,
+    pub mode: Mode,
+}
+
 /// A model, its state and modes, advanced interval by interval.
 pub struct Stepper<M: ConverterDynamics> {
     pub model: M,
@@ -176,6 +185,22 @@ impl<M: ConverterDynamics> Stepper<M> {
         self.mode = traj.end_mode;
         self.last = Some(end);
         Ok(end)
+    }
+
+    /// What the continuation depends on: the time, the inputs, the coordinates and the modes (an
+    /// FMU state, `fmi2GetFMUstate`).
+    pub fn state(&self) -> StepperState {
+        StepperState { time_s: self.time_s, inputs: self.inputs, u: self.u, mode: self.mode }
+    }
+
+    /// Continue from `state` (of [`Stepper::state`]); the next step continues bit for bit as the
+    /// stepper it came from did.
+    pub fn set_state(&mut self, state: &StepperState) {
+        self.time_s = state.time_s;
+        self.inputs = state.inputs;
+        self.u = state.u;
+        self.mode = state.mode;
+        self.last = None;
     }
 
     pub fn time_s(&self) -> f64 {
