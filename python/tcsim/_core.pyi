@@ -228,6 +228,9 @@ def fmu_signals() -> list[dict[str, Any]]:
 def fmu_causalities() -> list[tuple[str, list[str]]]:
     """The ``--causality`` choices with the names of their two inputs."""
 
+def fmu_common_inputs() -> list[str]:
+    """The inputs every causality has besides its two (``lockup_capacity_nm``)."""
+
 def fmu_event_indicators(model: str) -> int:
     """``numberOfEventIndicators`` of the FMU of a model kind."""
 

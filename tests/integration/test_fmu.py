@@ -151,12 +151,14 @@ def test_fmu_contents(fmus, model):
     variables = root.find("ModelVariables").findall("ScalarVariable")
     by_vr = {int(v.get("valueReference")): v for v in variables}
     assert {vr for vr in by_vr if vr < 12} == EXPECTED_SIGNALS[model]
-    # Model Exchange: the rate of the turbine speed input, and a derivative per continuous state
-    # (pump speed 20, stator speed 22, flow 23)
+    # Model Exchange: the rate of the turbine speed input, the lock-up clutch's input (15) and
+    # outputs (16-18), and a derivative per continuous state (pump speed 20, stator speed 22,
+    # flow 23); the clutch's friction ratio (37)
     states = {"table": {20}, "quasi-dynamic": {20, 23}, "hrovat-tobler": {20, 22, 23}}[model]
     starts = {"table": {30, 31}, "quasi-dynamic": {30, 31, 33}, "hrovat-tobler": {30, 31, 32, 33}}[model]
-    assert {vr for vr in by_vr if 12 <= vr < 100} == {13} | states | starts
-    assert root.get("numberOfEventIndicators") == ("3" if model == "hrovat-tobler" else "0")
+    assert {vr for vr in by_vr if 12 <= vr < 100} == {13, 15, 16, 17, 18, 37} | states | starts
+    # the stator clutch and the flow direction (Hrovat & Tobler), and the lock-up clutch
+    assert root.get("numberOfEventIndicators") == ("4" if model == "hrovat-tobler" else "1")
     for i, p in enumerate(config["parameters"]):
         v = by_vr[100 + i]
         assert v.get("name") == p["name"] and v.get("causality") == "parameter" and v.get("variability") == "tunable"
@@ -380,7 +382,7 @@ def test_export_api_input_errors(library_env, tmp_path):
     with pytest.raises(InputError, match="--model"):
         tfmu.export_fmu(CONVERTER, "no-such-model", tmp_path / "x.fmu")
     with pytest.raises(InputError, match="--causality"):
-        tfmu.export_fmu(CONVERTER, "table", tmp_path / "x.fmu", causality="torques")
+        tfmu.export_fmu(CONVERTER, "table", tmp_path / "x.fmu", causality="turbine-torque")
     with pytest.raises(InputError, match=r"\.fmu"):
         tfmu.export_fmu(CONVERTER, "table", tmp_path / "x.zip")
     with pytest.raises(InputError, match="shape_effect"):  # beyond the mass-matrix bound: refused at export
@@ -423,7 +425,7 @@ def test_cli_export_fmu(cli, library_env, tmp_path):
     "args, field",
     [
         (("--model", "nonsense"), "--model"),
-        (("--model", "table", "--causality", "torques"), "--causality"),
+        (("--model", "table", "--causality", "turbine-torque"), "--causality"),
     ],
 )
 def test_cli_export_fmu_bad_input_is_exit_2(cli, library_env, tmp_path, args, field):

@@ -18,7 +18,7 @@ from tcsim.models.dynamic import dynamic_model
 REFERENCE = Path(__file__).resolve().parents[1] / "data" / "fmu"
 CONVERTER = "li-sunden-2016"
 MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
-CAUSALITIES = ("pump-torque", "speeds")
+CAUSALITIES = ("pump-torque", "speeds", "torques")
 
 
 def _normalised(xml: str) -> str:
@@ -68,6 +68,6 @@ def test_the_table_answers_for_the_tunable_parameters():
 def test_bad_model_or_causality_is_an_input_error():
     spec = dynamic_model(CONVERTER, "table").spec
     with pytest.raises(_core.CoreInputError):
-        _core.fmu_variables(spec, "torques")
+        _core.fmu_variables(spec, "turbine-torque")
     with pytest.raises(_core.CoreInputError):
         _core.fmu_variables({**spec, "kind": "lockup"}, "speeds")

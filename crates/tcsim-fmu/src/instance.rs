@@ -6,17 +6,18 @@ use tcsim_core::converter::dynamics::ConverterDynamics;
 use tcsim_core::converter::dynamics::FLOW;
 use tcsim_core::converter::spec::{build_model, ModelSpec};
 use tcsim_core::engine::converter_events::{Mode, Sample};
-use tcsim_core::engine::isolated::{initial_mode, initial_state, Drive, InitialState};
-use tcsim_core::engine::mode_view::ModeView;
+use tcsim_core::engine::isolated::{initial_mode, initial_state, Drive, InitialState, TurbineLoad};
+use tcsim_core::engine::lockup::{ClutchMode, LockupCommand};
+use tcsim_core::engine::mode_view::{ModeView, LOCKUP_INDICATOR};
 use tcsim_core::engine::options::SolverOptions;
 use tcsim_core::engine::outputs::{row, COLUMNS};
 use tcsim_core::engine::signal::Signal;
-use tcsim_core::engine::stepper::{Causality, Stepper};
+use tcsim_core::engine::stepper::{Causality, Stepper, StepperDrive};
 use tcsim_core::CoreResult;
 
 use crate::variables::{
-    self, causality_of, is_derivative, is_input, signal_name, start_parameter, vr, Model, COORDINATES,
-    FIRST_DERIVATIVE, FIRST_PARAMETER, RATES, SIGNALS, SIGNAL_SLOTS, START_PARAMETERS,
+    self, causality_of, drive_parameter, has_signal, is_derivative, is_input, signal_name, start_parameter, vr, Model,
+    COORDINATES, DRIVE_PARAMETERS, FIRST_DERIVATIVE, FIRST_PARAMETER, RATES, SIGNALS, SIGNAL_SLOTS, START_PARAMETERS,
 };
 
 /// Where an instance is in the FMI 2.0 calling sequence (Co-Simulation and Model Exchange; the
@@ -78,9 +79,10 @@ impl Configuration {
         let doc: Value = serde_json::from_str(text).map_err(|e| format!("model.json: {e}"))?;
         let causality = match doc.get("causality").and_then(Value::as_str) {
             None => Causality::PumpTorqueTurbineSpeed,
-            Some(name) => {
-                causality_of(name).ok_or(format!("model.json: causality {name:?}: expected pump-torque or speeds"))?
-            }
+            Some(name) => causality_of(name).ok_or_else(|| {
+                let names: Vec<&str> = variables::CAUSALITIES.iter().map(|c| c.0).collect();
+                format!("model.json: causality {name:?}: expected one of {}", names.join(", "))
+            })?,
         };
         let model = doc.get("model").and_then(Value::as_object).cloned().ok_or("model.json: no \"model\" object")?;
         let mut parameters = Vec::new();
@@ -142,8 +144,10 @@ pub struct Instance {
     pub(crate) rates: [Option<f64>; SIGNAL_SLOTS],
     /// Model Exchange: the model, all coordinates, the mode and the time.
     pub(crate) me: Option<ModelExchange>,
-    /// Values of the start-value parameters ([`START_PARAMETERS`], value references 30–33).
+    /// Values of the start-value parameters ([`START_PARAMETERS`], value references 30–34).
     pub(crate) start: [f64; START_PARAMETERS.len()],
+    /// Values of the drive's fixed parameters ([`DRIVE_PARAMETERS`], value references 35–37).
+    pub(crate) drive: [f64; DRIVE_PARAMETERS.len()],
     /// Inputs at the previous communication point, for the rate estimate.
     pub(crate) previous: Option<(f64, [f64; 2])>,
     pub(crate) stepper: Option<Stepper<Box<dyn ConverterDynamics + Send>>>,
@@ -178,6 +182,7 @@ impl Instance {
             rates: [None; SIGNAL_SLOTS],
             me: None,
             start: START_PARAMETERS.map(|s| s.start),
+            drive: DRIVE_PARAMETERS.map(|d| d.start),
             previous: None,
             stepper: None,
             rebuild: false,
@@ -260,6 +265,9 @@ impl Instance {
         if let Some(i) = start_parameter(vr) {
             return Ok(self.start[i]);
         }
+        if let Some(i) = drive_parameter(vr) {
+            return Ok(self.drive[i]);
+        }
         let computed = is_derivative(vr) || ((vr as usize) < SIGNAL_SLOTS && !self.settable(vr as usize));
         if computed {
             self.provisional()?;
@@ -288,10 +296,10 @@ impl Instance {
     /// are not settable, non-finite values are refused. A refused call changes nothing.
     pub fn set_all(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         self.require("fmi2SetReal", &[Phase::Instantiated, Phase::Initialization, Phase::Running])?;
-        let saved = (self.signals, self.start, self.config.parameters.clone());
+        let saved = (self.signals, self.start, self.drive, self.config.parameters.clone());
         let result = self.apply(vrs, values);
         if result.is_err() {
-            (self.signals, self.start, self.config.parameters) = saved;
+            (self.signals, self.start, self.drive, self.config.parameters) = saved;
         }
         self.fresh = false;
         result
@@ -325,12 +333,21 @@ impl Instance {
             self.start[i] = value;
             return Ok(false);
         }
+        if let Some(i) = drive_parameter(vr) {
+            return self.set_drive_parameter(i, value);
+        }
         if let Some(name) = signal_name(vr) {
+            if !has_signal(self.config.causality, vr) && variables::signal_def(vr).is_some() {
+                return Err(format!("no variable with value reference {vr} under this causality"));
+            }
             if !self.settable(vr as usize) {
                 return Err(format!("{name} is an output and cannot be set"));
             }
             if !value.is_finite() {
                 return Err(format!("{name} = {value}: expected a finite value"));
+            }
+            if vr == vr::LOCKUP_CAPACITY && value < 0.0 {
+                return Err(format!("{name} = {value}: expected a capacity of zero or more (N.m)"));
             }
             self.signals[vr as usize] = value;
             return Ok(false);
@@ -349,7 +366,8 @@ impl Instance {
 
     pub fn set_rate(&mut self, vr: u32, order: i32, value: f64) -> Result<(), String> {
         self.require("fmi2SetRealInputDerivatives", &[Phase::Initialization, Phase::Running])?;
-        if order != 1 || !self.input_refs().contains(&(vr as usize)) {
+        let input = self.input_refs().contains(&(vr as usize)) || variables::COMMON_INPUTS.contains(&vr);
+        if order != 1 || !input {
             return Err(format!(
                 "input derivatives of order 1 of the inputs only (value reference {vr}, order {order})"
             ));
@@ -375,6 +393,9 @@ impl Instance {
                 }
             }
         }
+        if stepper.model.lag_state() {
+            self.signals[vr::LAG_TORQUE as usize] = sample.u[FLOW]; // the lag state is no output column
+        }
     }
 
     /// `fmi2ExitInitializationMode`: the steady state consistent with the inputs.
@@ -386,6 +407,8 @@ impl Instance {
         }
         let model = self.model().map_err(|e| e.to_string())?;
         let mut stepper = Stepper::new(model, self.config.causality, self.options);
+        let capacity = self.signals[vr::LOCKUP_CAPACITY as usize];
+        stepper.extra = self.stepper_drive([capacity, capacity]);
         let refs = self.input_refs();
         let rates = [self.rates[refs[0]].unwrap_or(0.0), self.rates[refs[1]].unwrap_or(0.0)];
         let sample =
@@ -425,7 +448,13 @@ impl Instance {
             (None, Some((tp, prev))) if t > tp => ((start[k] - prev[k]) / (t - tp), (t - tp).min(h)),
             _ => (0.0, h),
         });
+        // the capacity: held over the interval, unless its rate is given (then linear, not below 0)
+        let capacity = self.signals[vr::LOCKUP_CAPACITY as usize];
+        let capacity_rate = self.rates[vr::LOCKUP_CAPACITY as usize].unwrap_or(0.0);
+        let capacity_at = move |tau: f64| (capacity + capacity_rate * tau).max(0.0);
+        let extra = self.stepper_drive([capacity, capacity]);
         let stepper = self.stepper.as_mut().ok_or("fmi2DoStep before initialisation")?;
+        stepper.extra = extra;
         if (stepper.time_s() - t).abs() > 1e-9 * t.abs().max(1.0) {
             return Err(format!(
                 "communication point {t} s: expected the end of the last step, {} s",
@@ -442,6 +471,7 @@ impl Instance {
         };
         let (mut tau, mut sample, saved) = (0.0, None, stepper.state());
         for c in corners {
+            stepper.extra.lockup_capacity_nm = Some([capacity_at(tau), capacity_at(c)]);
             match stepper.do_step(c - tau, at(tau), at(c)) {
                 Ok(s) => sample = Some(s),
                 Err(e) => {
@@ -457,6 +487,36 @@ impl Instance {
             self.publish(&sample);
         }
         Ok(())
+    }
+
+    /// Whether the model is the table model with its first-order lag (a fourth state,
+    /// [`variables::has_lag`]).
+    pub(crate) fn lag(&self) -> bool {
+        self.config.model.contains_key(tcsim_core::converter::spec::LAG_KEY)
+    }
+
+    /// The clutch and the load of the stepper, with the capacity at the start and end of an interval.
+    fn stepper_drive(&self, capacity_nm: [f64; 2]) -> StepperDrive {
+        let d = |vr: u32| drive_parameter(vr).map_or(f64::NAN, |i| self.drive[i]);
+        StepperDrive {
+            lockup_capacity_nm: Some(capacity_nm),
+            lockup_static_to_kinetic: d(vr::LOCKUP_STATIC_TO_KINETIC),
+            load_inertia_kg_m2: d(vr::LOAD_INERTIA),
+            load_drag_nm_s2: d(vr::LOAD_DRAG),
+        }
+    }
+
+    /// Set a drive parameter: before initialisation only, finite and at least its minimum.
+    fn set_drive_parameter(&mut self, i: usize, value: f64) -> Result<bool, String> {
+        let d = &DRIVE_PARAMETERS[i];
+        if !matches!(self.phase, Phase::Instantiated | Phase::Initialization) {
+            return Err(format!("{} is fixed after initialisation", d.name));
+        }
+        if !(value.is_finite() && value >= d.min) {
+            return Err(format!("{} = {value}: expected a finite value of {} or more", d.name, d.min));
+        }
+        self.drive[i] = value;
+        Ok(false)
     }
 
     /// `fmi2Reset`: back to the instantiated state, parameters at their start values.
@@ -541,13 +601,16 @@ impl Instance {
     /// The initial state the start-value parameters ask for (none: the steady state).
     fn initial(&self) -> InitialState {
         let start = |vr: u32| start_parameter(vr).map_or(f64::NAN, |i| self.start[i]);
+        // drive (c): the turbine speed is a state; the steady start is at its initial value
+        let turbine_speed_rad_s =
+            (self.config.causality == Causality::Torques).then(|| start(vr::INITIAL_TURBINE_SPEED));
         if start(vr::START_FROM_STEADY_STATE) != 0.0 {
-            return InitialState::default();
+            return InitialState { turbine_speed_rad_s, ..InitialState::default() };
         }
         let pump_given = variables::inputs(self.config.causality).contains(&vr::PUMP_SPEED);
         InitialState {
             pump_speed_rad_s: (!pump_given).then(|| start(vr::INITIAL_PUMP_SPEED)),
-            turbine_speed_rad_s: None,
+            turbine_speed_rad_s,
             stator_speed_rad_s: Some(start(vr::INITIAL_STATOR_SPEED)),
             flow_m3_s: Some(start(vr::INITIAL_FLOW)),
         }
@@ -560,28 +623,36 @@ impl Instance {
         };
         let s = |vr: u32| self.signals[vr as usize];
         let turbine = line("turbine_speed_rad_s", s(vr::TURBINE_SPEED), s(vr::TURBINE_ACCEL))?;
+        let extra = self.stepper_drive([s(vr::LOCKUP_CAPACITY); 2]);
+        let lockup = Some(LockupCommand {
+            capacity_nm: Signal::constant(s(vr::LOCKUP_CAPACITY)),
+            static_to_kinetic: extra.lockup_static_to_kinetic,
+        });
         Ok(match self.config.causality {
             Causality::PumpTorqueTurbineSpeed => Drive::PumpTorqueTurbineSpeed {
                 pump_torque_nm: Signal::constant(s(vr::PUMP_TORQUE)),
                 turbine_speed_rad_s: turbine,
-                lockup: None,
+                lockup,
             },
             Causality::Speeds => Drive::Speeds {
                 pump_speed_rad_s: line("pump_speed_rad_s", s(vr::PUMP_SPEED), s(vr::PUMP_ACCEL))?,
                 turbine_speed_rad_s: turbine,
-                lockup: None,
+                lockup,
+            },
+            Causality::Torques => Drive::PumpTorqueLoad {
+                pump_torque_nm: Signal::constant(s(vr::PUMP_TORQUE)),
+                load: TurbineLoad {
+                    torque_nm: Signal::constant(s(vr::LOAD_TORQUE)),
+                    inertia_kg_m2: extra.load_inertia_kg_m2,
+                    drag_nm_s2: extra.load_drag_nm_s2,
+                },
+                lockup,
             },
         })
     }
 
     fn me_initialize(&mut self) -> Result<(), String> {
         let model = self.model().map_err(|e| e.to_string())?;
-        if model.lag_state() {
-            // the modelDescription declares the table model's states without the lag's
-            return Err("Model Exchange of the table model with lag_time_constant_s is not supported (its lag state \
-                        is not among the FMU's declared states): use Co-Simulation (docs/lag.md)"
-                .to_string());
-        }
         let t = self.start_time;
         let drive = self.me_drive(t)?;
         let u = initial_state(&model, &drive, t, &self.initial()).map_err(|e| e.to_string())?;
@@ -595,7 +666,7 @@ impl Instance {
     /// modelDescription.xml declares them: known from instantiation on).
     pub fn me_sizes(&self) -> (usize, usize) {
         match self.model_kind() {
-            Some(m) => (variables::states(m, self.config.causality).len(), m.event_indicators()),
+            Some(m) => (variables::states(m, self.config.causality, self.lag()).len(), m.event_indicators()),
             None => (0, 0),
         }
     }
@@ -642,8 +713,10 @@ impl Instance {
     /// The nominal values of the continuous states (100 rad/s, 0.05 m³/s), from instantiation on.
     pub fn me_nominals(&self, x: &mut [f64]) -> Result<(), String> {
         let model = self.model_kind().ok_or("no model kind")?;
-        for ((_, c), v) in variables::states(model, self.config.causality).into_iter().zip(x.iter_mut()) {
-            *v = if c == FLOW { 0.05 } else { 100.0 };
+        let lag = self.lag();
+        for ((_, c), v) in variables::states(model, self.config.causality, lag).into_iter().zip(x.iter_mut()) {
+            // the flow's scale, or (the table model's lag state, in the same slot) a torque's
+            *v = if c == FLOW && !lag { 0.05 } else { 100.0 };
         }
         Ok(())
     }
@@ -661,11 +734,21 @@ impl Instance {
     pub fn me_indicators(&self, g: &mut [f64]) -> Result<(), String> {
         let me = self.me_state()?;
         let drive = self.me_drive(me.time_s)?;
-        let values = ModeView::new(&me.model, &drive, me.mode).indicators(&me.u, me.time_s, &self.options.hysteresis);
-        for (v, x) in g.iter_mut().zip(values) {
-            *v = x;
+        let mut values =
+            ModeView::new(&me.model, &drive, me.mode).indicators(&me.u, me.time_s, &self.options.hysteresis);
+        if self.locked_without_capacity(me.mode) {
+            values[LOCKUP_INDICATOR] = -1.0; // the command fell to zero: the clutch opens
+        }
+        let slots = self.model_kind().map_or_else(Vec::new, Model::indicator_slots);
+        for (v, &slot) in g.iter_mut().zip(&slots) {
+            *v = values[slot];
         }
         Ok(())
+    }
+
+    /// A locked clutch whose command is zero (it has no roots: the host's zero opens it at once).
+    fn locked_without_capacity(&self, mode: Mode) -> bool {
+        mode.lockup.is_locked() && self.signals[vr::LOCKUP_CAPACITY as usize] <= 0.0
     }
 
     /// `fmi2NewDiscreteStates`: apply every due switch; whether the states changed.
@@ -675,6 +758,10 @@ impl Instance {
         let drive = self.me_drive(me.time_s)?;
         let (mut u, mut mode, t) = (me.u, me.mode, me.time_s);
         let mut changed = false;
+        if self.locked_without_capacity(mode) {
+            mode.lockup = ClutchMode::Unarmed { since_s: t };
+            changed = true;
+        }
         for _ in 0..8 {
             match ModeView::new(&me.model, &drive, mode).event(&mut u, t, &h) {
                 Some((_, next)) => {
@@ -705,6 +792,9 @@ impl Instance {
             }
             let drive = self.me_drive(me.time_s).ok()?;
             let sample = ModeView::new(&me.model, &drive, me.mode).sample(&me.u, me.time_s);
+            if vr == vr::LAG_TORQUE {
+                return me.model.lag_state().then_some(sample.u[FLOW]);
+            }
             let r = row(&me.model, &sample);
             return COLUMNS.iter().position(|c| *c == name).map(|c| r[c]);
         }
@@ -748,6 +838,7 @@ impl Instance {
 #[cfg(test)]
 mod me_tests {
     use super::*;
+    use crate::variables::SpecValue;
 
     /// A model specification of each kind (JSON).
     fn spec(model: Model) -> String {
@@ -772,31 +863,70 @@ mod me_tests {
     /// Exchange, the derivatives' value references and the stator clutch.
     #[test]
     fn the_variable_table_agrees_with_the_engine() {
-        for model in Model::ALL {
+        // each model, and the table model with its first-order lag (a fourth state)
+        let lagged = spec(Model::Table).replacen('{', r#"{"lag_time_constant_s": 0.05, "#, 1);
+        let cases = Model::ALL.map(|m| (m, spec(m), false)).into_iter().chain([(Model::Table, lagged, true)]);
+        for (model, model_spec, lag) in cases {
+            let params = if lag { vec![("lag_time_constant_s".to_string(), SpecValue::Scalar(0.05))] } else { vec![] };
+            let params = variables::parameters(&params).unwrap();
+            let entries = if lag { r#"[{"key": "lag_time_constant_s"}]"# } else { "[]" };
             for (name, causality, _) in variables::CAUSALITIES {
-                let text = format!(r#"{{"causality": "{name}", "model": {}, "parameters": []}}"#, spec(model));
+                let text = format!(r#"{{"causality": "{name}", "model": {model_spec}, "parameters": {entries}}}"#);
                 let mut inst = Instance::new(Configuration::parse(&text).unwrap());
                 assert_eq!(inst.config.causality, causality);
                 inst.model_exchange = true;
                 inst.initialize().unwrap();
                 let me = inst.me.as_ref().unwrap();
-                let table: Vec<usize> = variables::states(model, causality).iter().map(|&(_, c)| c).collect();
+                assert_eq!(me.model.lag_state(), lag);
+                let table: Vec<usize> = variables::states(model, causality, lag).iter().map(|&(_, c)| c).collect();
                 assert_eq!(me.coordinates, table, "{model:?} {name}");
-                assert_eq!(me.model.has_stator_clutch(), model.event_indicators() > 0, "{model:?}");
+                assert_eq!(me.model.has_stator_clutch(), model.event_indicators() > 1, "{model:?}");
                 assert_eq!(inst.me_sizes(), (table.len(), model.event_indicators()));
-                for (s, c) in variables::states(model, causality) {
+                for (s, c) in variables::states(model, causality, lag) {
                     let der = inst.get(FIRST_DERIVATIVE + c as u32).unwrap();
                     assert!(der.is_finite(), "der({}) = {der}", s.name);
                 }
                 // every declared variable can be read, every input set
-                for v in variables::variables(model, causality, &[]) {
-                    assert!(inst.get(v.vr).is_some(), "{model:?} {name}: {}", v.name);
+                for v in variables::variables(model, causality, &params) {
+                    assert!(inst.get(v.vr).is_some_and(f64::is_finite), "{model:?} {name}: {}", v.name);
                     if v.causality == "input" {
                         inst.set(v.vr, v.start.unwrap()).unwrap();
                     }
                 }
             }
         }
+    }
+
+    /// Drive (c) in Model Exchange: both speeds are states; a locked clutch links the turbine to the
+    /// pump (the momentum-conserving projection makes the two states equal, and their derivatives
+    /// are equal while it holds); a command set to zero opens it at the next event.
+    #[test]
+    fn a_locked_clutch_in_drive_c_joins_the_speed_states() {
+        let text = format!(r#"{{"causality": "torques", "model": {}, "parameters": []}}"#, spec(Model::Table));
+        let mut inst = Instance::new(Configuration::parse(&text).unwrap());
+        inst.model_exchange = true;
+        inst.set(vr::PUMP_TORQUE, 100.0).unwrap();
+        inst.set(vr::LOCKUP_CAPACITY, 500.0).unwrap();
+        assert!(inst.set(vr::LOCKUP_CAPACITY, -1.0).unwrap_err().contains("lockup_capacity_nm = -1"));
+        inst.initialize().unwrap();
+        assert_eq!(inst.me_sizes(), (2, 1));
+        assert_eq!(inst.get(vr::LOCKUP_STATE), Some(1.0)); // slipping from the stall
+        inst.me_set_states(&[100.0, 99.8]).unwrap();
+        let mut g = [0.0];
+        inst.me_indicators(&mut g).unwrap();
+        assert!(g[0] < 0.0, "the slip is below the sync threshold: {g:?}");
+        assert!(inst.me_new_discrete_states().unwrap());
+        let (mut x, mut dx) = ([0.0; 2], [0.0; 2]);
+        inst.me_get_states(&mut x).unwrap();
+        inst.me_derivatives(&mut dx).unwrap();
+        assert!(x[0] == x[1] && dx[0] == dx[1] && x[0] > 99.8 && x[0] < 100.0, "{x:?} {dx:?}");
+        assert_eq!(inst.get(vr::LOCKUP_STATE), Some(2.0));
+        assert_eq!(inst.get(vr::LOCKUP_SLIP), Some(0.0));
+        inst.set(vr::LOCKUP_CAPACITY, 0.0).unwrap();
+        inst.me_indicators(&mut g).unwrap();
+        assert!(g[0] < 0.0);
+        assert!(inst.me_new_discrete_states().unwrap());
+        assert_eq!(inst.get(vr::LOCKUP_STATE), Some(0.0));
     }
 
     #[test]
@@ -812,12 +942,12 @@ mod me_tests {
         inst.set(0, 150.0).unwrap();
         inst.set(2, 0.0).unwrap();
         inst.initialize().unwrap();
-        assert_eq!(inst.me_sizes(), (3, 3));
+        assert_eq!(inst.me_sizes(), (3, 4));
         // at the steady state the derivatives vanish and no event is due
         let mut dx = [1.0; 3];
         inst.me_derivatives(&mut dx).unwrap();
         assert!(dx.iter().all(|d| d.abs() < 1e-6), "{dx:?}");
-        let mut g = [0.0; 3];
+        let mut g = [0.0; 4];
         inst.me_indicators(&mut g).unwrap();
         assert!(g.iter().all(|v| *v > 0.0));
         assert!(!inst.me_new_discrete_states().unwrap());

@@ -124,7 +124,7 @@ impl Instance {
             (Some(model), None, Some((time_s, u, mode))) => {
                 let kind = self.config.model.get("kind").and_then(|k| k.as_str()).and_then(Model::from_kind);
                 let coordinates = kind.map_or_else(Vec::new, |k| {
-                    variables::states(k, self.config.causality).into_iter().map(|(_, c)| c).collect()
+                    variables::states(k, self.config.causality, self.lag()).into_iter().map(|(_, c)| c).collect()
                 });
                 self.me = Some(ModelExchange { model, u, mode, time_s, coordinates });
             }

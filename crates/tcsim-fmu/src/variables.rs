@@ -9,7 +9,9 @@
 //! value reference whatever the model and the causality; a model lists the signals it has.
 
 use tcsim_core::converter::hrovat_tobler::HtParam;
-use tcsim_core::engine::mode_view::EVENT_INDICATORS;
+use tcsim_core::converter::spec::LAG_KEY;
+use tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC;
+use tcsim_core::engine::mode_view::{EVENT_INDICATORS, LOCKUP_INDICATOR};
 use tcsim_core::engine::stepper::Causality;
 
 /// `modelIdentifier` of the FMU: the binary is `binaries/<platform>/tcsim_converter.<ext>`.
@@ -17,12 +19,12 @@ pub const MODEL_IDENTIFIER: &str = "tcsim_converter";
 /// Value reference of the first tunable parameter; parameter i has `FIRST_PARAMETER + i`.
 pub const FIRST_PARAMETER: u32 = 100;
 /// Value reference of the derivative of state coordinate 0 (pump speed); coordinate c has
-/// `FIRST_DERIVATIVE + c` (2 stator speed, 3 flow).
+/// `FIRST_DERIVATIVE + c` (1 turbine speed, 2 stator speed, 3 flow).
 pub const FIRST_DERIVATIVE: u32 = 20;
 /// Number of coordinates of a converter model (pump, turbine, stator speed, flow).
 pub const COORDINATES: u32 = 4;
 /// Value references of the signals and the input rates: `0..SIGNAL_SLOTS`.
-pub const SIGNAL_SLOTS: usize = 14;
+pub const SIGNAL_SLOTS: usize = 20;
 
 /// Value references of the signals.
 pub mod vr {
@@ -40,10 +42,20 @@ pub mod vr {
     pub const EFFECTIVE_TORQUE_RATIO: u32 = 11;
     pub const PUMP_ACCEL: u32 = 12;
     pub const TURBINE_ACCEL: u32 = 13;
+    pub const LOAD_TORQUE: u32 = 14;
+    pub const LOCKUP_CAPACITY: u32 = 15;
+    pub const LOCKUP_TORQUE: u32 = 16;
+    pub const LOCKUP_STATE: u32 = 17;
+    pub const LOCKUP_SLIP: u32 = 18;
+    pub const LAG_TORQUE: u32 = 19;
     pub const START_FROM_STEADY_STATE: u32 = 30;
     pub const INITIAL_PUMP_SPEED: u32 = 31;
     pub const INITIAL_STATOR_SPEED: u32 = 32;
     pub const INITIAL_FLOW: u32 = 33;
+    pub const INITIAL_TURBINE_SPEED: u32 = 34;
+    pub const LOAD_INERTIA: u32 = 35;
+    pub const LOAD_DRAG: u32 = 36;
+    pub const LOCKUP_STATIC_TO_KINETIC: u32 = 37;
 }
 
 /// The converter models an FMU can hold (`kind` of the model specification).
@@ -71,20 +83,36 @@ impl Model {
     }
 
     /// Event indicators in Model Exchange: the stator clutch and the flow direction (Hrovat &
-    /// Tobler, the only model with a stator clutch); none for the others.
+    /// Tobler, the only model with a stator clutch), then the lock-up clutch (every model).
     pub fn event_indicators(self) -> usize {
+        self.indicator_slots().len()
+    }
+
+    /// The slots of `tcsim_core::engine::mode_view::ModeView::indicators` that are the FMU's event
+    /// indicators, in order: all of them for Hrovat & Tobler, the lock-up clutch's for the others.
+    pub fn indicator_slots(self) -> Vec<usize> {
         match self {
-            Model::HrovatTobler => EVENT_INDICATORS,
-            Model::Table | Model::QuasiDynamic => 0,
+            Model::HrovatTobler => (0..EVENT_INDICATORS).collect(),
+            Model::Table | Model::QuasiDynamic => vec![LOCKUP_INDICATOR],
         }
     }
 }
 
-/// The `--causality` choices, by name, with the value references of their two inputs.
-pub const CAUSALITIES: [(&str, Causality, [u32; 2]); 2] = [
+/// The `--causality` choices, by name, with the value references of their two inputs (the drive's;
+/// every causality has the lock-up capacity input [`vr::LOCKUP_CAPACITY`] besides).
+pub const CAUSALITIES: [(&str, Causality, [u32; 2]); 3] = [
     ("pump-torque", Causality::PumpTorqueTurbineSpeed, [vr::PUMP_TORQUE, vr::TURBINE_SPEED]),
     ("speeds", Causality::Speeds, [vr::PUMP_SPEED, vr::TURBINE_SPEED]),
+    ("torques", Causality::Torques, [vr::PUMP_TORQUE, vr::LOAD_TORQUE]),
 ];
+
+/// The inputs of every causality besides its two: the lock-up clutch's capacity.
+pub const COMMON_INPUTS: [u32; 1] = [vr::LOCKUP_CAPACITY];
+
+/// Every input of a causality: its two, then [`COMMON_INPUTS`].
+pub fn all_inputs(causality: Causality) -> Vec<u32> {
+    inputs(causality).into_iter().chain(COMMON_INPUTS).collect()
+}
 
 /// The causality of a `--causality` name.
 pub fn causality_of(name: &str) -> Option<Causality> {
@@ -110,17 +138,21 @@ pub struct SignalDef {
     pub state: Option<usize>,
     /// The start value when the signal is an input.
     pub start: Option<f64>,
+    /// The causality the signal belongs to, if only one has it (the load torque).
+    pub only: Option<Causality>,
+    /// Only in an FMU of the table model with the lag ([`has_lag`]): the lag state.
+    pub lag: bool,
 }
 
 const ALL: &[Model] = &Model::ALL;
 
 const fn signal(vr: u32, name: &'static str, unit: &'static str, description: &'static str) -> SignalDef {
-    SignalDef { vr, name, unit, description, models: ALL, state: None, start: None }
+    SignalDef { vr, name, unit, description, models: ALL, state: None, start: None, only: None, lag: false }
 }
 
 /// The signals in value-reference order (a part-load stall as the inputs' start: 50 N·m at the
-/// pump, or the pump at 150 rad/s).
-pub const SIGNALS: [SignalDef; 12] = [
+/// pump, or the pump at 150 rad/s; no load torque, an open lock-up clutch).
+pub const SIGNALS: [SignalDef; 18] = [
     SignalDef {
         start: Some(50.0),
         ..signal(vr::PUMP_TORQUE, "pump_torque_nm", "N.m", "Torque on the pump (engine torque at the converter input)")
@@ -131,6 +163,7 @@ pub const SIGNALS: [SignalDef; 12] = [
         ..signal(vr::PUMP_SPEED, "pump_speed_rad_s", "rad/s", "Pump (impeller) speed")
     },
     SignalDef {
+        state: Some(1),
         start: Some(0.0),
         ..signal(vr::TURBINE_SPEED, "turbine_speed_rad_s", "rad/s", "Turbine speed (transmission input speed)")
     },
@@ -176,7 +209,60 @@ pub const SIGNALS: [SignalDef; 12] = [
         "1",
         "Effective torque ratio: effective turbine / effective pump torque",
     ),
+    SignalDef {
+        start: Some(0.0),
+        only: Some(Causality::Torques),
+        ..signal(
+            vr::LOAD_TORQUE,
+            "load_torque_nm",
+            "N.m",
+            "Load torque on the turbine shaft (the driveline's, reflected to the turbine), opposing forward \
+             rotation: positive decelerates the turbine",
+        )
+    },
+    SignalDef {
+        start: Some(0.0),
+        ..signal(
+            vr::LOCKUP_CAPACITY,
+            "lockup_capacity_nm",
+            "N.m",
+            "Lock-up clutch capacity command (>= 0; 0 open): the torque it transmits while slipping",
+        )
+    },
+    signal(
+        vr::LOCKUP_TORQUE,
+        "lockup_torque_nm",
+        "N.m",
+        "Torque the lock-up clutch transmits from pump to turbine (included in pump and turbine torque)",
+    ),
+    signal(vr::LOCKUP_STATE, "lockup_state", "1", "Lock-up clutch state: 0 open, 1 slipping, 2 locked"),
+    signal(vr::LOCKUP_SLIP, "lockup_slip_rad_s", "rad/s", "Lock-up clutch slip: pump speed - turbine speed"),
+    SignalDef {
+        models: &[Model::Table],
+        state: Some(3),
+        lag: true,
+        ..signal(
+            vr::LAG_TORQUE,
+            "lagged_pump_torque_nm",
+            "N.m",
+            "Lag state T_lag of the table model's first-order lag: the lagged steady pump torque (docs/lag.md)",
+        )
+    },
 ];
+
+/// Whether an FMU with these tunable parameters is of a table model with the first-order lag (its
+/// specification has `lag_time_constant_s`): the lag state is then a continuous state.
+pub fn has_lag(parameters: &[Parameter]) -> bool {
+    parameters.iter().any(|p| p.key == LAG_KEY)
+}
+
+/// The unit of the time derivative of a quantity of unit `unit`.
+pub fn derivative_unit(unit: &str) -> String {
+    match unit {
+        "N.m" => "N.m/s".to_string(),
+        _ => format!("{unit}2"),
+    }
+}
 
 /// A rate of a speed input, for Model Exchange: an optional input, zero when not connected.
 /// Co-Simulation takes the rates from `fmi2SetRealInputDerivatives` or from the last
@@ -219,16 +305,71 @@ pub struct StartDef {
 }
 
 /// `start_from_steady_state` (1: the steady state consistent with the inputs, as `tcsim replay`;
-/// 0: the `initial_*` values), then the initial pump speed, stator speed and flow.
-pub const START_PARAMETERS: [StartDef; 4] = [
+/// 0: the `initial_*` values), then the initial pump speed, stator speed, flow and turbine speed
+/// (the last only where the turbine speed is a state, [`Causality::Torques`]: there it is the
+/// start's turbine speed whatever `start_from_steady_state`, as drive (c)'s; 0, a vehicle at rest).
+pub const START_PARAMETERS: [StartDef; 5] = [
     StartDef { vr: vr::START_FROM_STEADY_STATE, of: None, start: 1.0 },
     StartDef { vr: vr::INITIAL_PUMP_SPEED, of: Some(vr::PUMP_SPEED), start: 150.0 },
     StartDef { vr: vr::INITIAL_STATOR_SPEED, of: Some(vr::STATOR_SPEED), start: 0.0 },
     StartDef { vr: vr::INITIAL_FLOW, of: Some(vr::FLOW), start: 0.05 },
+    StartDef { vr: vr::INITIAL_TURBINE_SPEED, of: Some(vr::TURBINE_SPEED), start: 0.0 },
 ];
 const START_FROM_STEADY_STATE: &str = "start_from_steady_state";
 const START_FROM_STEADY_STATE_DESCRIPTION: &str =
     "1: start at the steady state consistent with the inputs (as tcsim replay); 0: at the initial_* values";
+
+/// A fixed parameter of the drive (value references 35–37, fixed after initialisation): the load of
+/// [`Causality::Torques`] and the lock-up clutch's friction ratio.
+#[derive(Debug, Clone, Copy)]
+pub struct DriveParameterDef {
+    pub vr: u32,
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub description: &'static str,
+    pub start: f64,
+    /// The least value allowed (the value must be finite too).
+    pub min: f64,
+    /// The causality that has it, if only one does.
+    pub only: Option<Causality>,
+}
+
+/// The drive's fixed parameters.
+pub const DRIVE_PARAMETERS: [DriveParameterDef; 3] = [
+    DriveParameterDef {
+        vr: vr::LOAD_INERTIA,
+        name: "load_inertia_kg_m2",
+        unit: "kg.m2",
+        description: "Load inertia on the turbine (driveline reflected to the turbine; 0: the host's model has it)",
+        start: 0.0,
+        min: 0.0,
+        only: Some(Causality::Torques),
+    },
+    DriveParameterDef {
+        vr: vr::LOAD_DRAG,
+        name: "load_drag_nm_s2",
+        unit: "N.m.s2/rad2",
+        description: "Load drag on the turbine: drag * w_t * |w_t| opposing rotation, added to load_torque_nm",
+        start: 0.0,
+        min: 0.0,
+        only: Some(Causality::Torques),
+    },
+    DriveParameterDef {
+        vr: vr::LOCKUP_STATIC_TO_KINETIC,
+        name: "lockup_static_to_kinetic",
+        unit: "1",
+        description: "Lock-up clutch: static-to-kinetic friction ratio (a locked clutch breaks away above it \
+                      times lockup_capacity_nm)",
+        start: DEFAULT_STATIC_TO_KINETIC,
+        min: 1.0,
+        only: None,
+    },
+];
+
+/// The drive parameter of value reference `vr`: its position in [`DRIVE_PARAMETERS`].
+pub fn drive_parameter(vr: u32) -> Option<usize> {
+    DRIVE_PARAMETERS.iter().position(|d| d.vr == vr)
+}
 
 /// The start-value parameter of value reference `vr`: its position in [`START_PARAMETERS`].
 pub fn start_parameter(vr: u32) -> Option<usize> {
@@ -247,8 +388,13 @@ pub fn signal_name(vr: u32) -> Option<&'static str> {
 
 /// Whether `vr` may be set under `causality`: one of its inputs or the rate of a speed input.
 pub fn is_input(causality: Causality, vr: u32) -> bool {
-    let inputs = inputs(causality);
+    let inputs = all_inputs(causality);
     inputs.contains(&vr) || RATES.iter().any(|r| r.vr == vr && inputs.contains(&r.of))
+}
+
+/// Whether signal `vr` is a variable of the FMU under `causality` (not another causality's own).
+pub fn has_signal(causality: Causality, vr: u32) -> bool {
+    signal_def(vr).is_some_and(|s| s.only.is_none_or(|c| c == causality))
 }
 
 /// Whether `vr` is the derivative of a model coordinate.
@@ -256,13 +402,13 @@ pub fn is_derivative(vr: u32) -> bool {
     (FIRST_DERIVATIVE..FIRST_DERIVATIVE + COORDINATES).contains(&vr)
 }
 
-/// The continuous states of a model under a causality in Model Exchange: (signal, coordinate), in
-/// coordinate order.
-pub fn states(model: Model, causality: Causality) -> Vec<(&'static SignalDef, usize)> {
+/// The continuous states of a model (with the table model's lag or not) under a causality in Model
+/// Exchange: (signal, coordinate), in coordinate order.
+pub fn states(model: Model, causality: Causality, lag: bool) -> Vec<(&'static SignalDef, usize)> {
     let inputs = inputs(causality);
     let mut states: Vec<_> = SIGNALS
         .iter()
-        .filter(|s| s.models.contains(&model) && !inputs.contains(&s.vr))
+        .filter(|s| s.models.contains(&model) && !inputs.contains(&s.vr) && (lag || !s.lag))
         .filter_map(|s| s.state.map(|c| (s, c)))
         .collect();
     states.sort_by_key(|&(_, c)| c);
@@ -284,12 +430,13 @@ const fn unit(name: &'static str, base: &'static [(&'static str, i32)]) -> UnitD
     UnitDef { name, base, display: &[] }
 }
 
-pub const UNITS: [UnitDef; 13] = [
+pub const UNITS: [UnitDef; 14] = [
     unit("N.m", &[("kg", 1), ("m", 2), ("s", -2)]),
     UnitDef { display: &[("rpm", 30.0 / std::f64::consts::PI)], ..unit("rad/s", &[("s", -1), ("rad", 1)]) },
     unit("m3/s", &[("m", 3), ("s", -1)]),
     unit("rad/s2", &[("s", -2), ("rad", 1)]),
     unit("m3/s2", &[("m", 3), ("s", -2)]),
+    unit("N.m/s", &[("kg", 1), ("m", 2), ("s", -3)]),
     unit("kg.m2", &[("kg", 1), ("m", 2)]),
     unit("N.m.s2/rad2", &[("kg", 1), ("m", 2), ("rad", -2)]),
     unit("m", &[("m", 1)]),
@@ -505,9 +652,10 @@ impl Variable {
 }
 
 /// The signals: inputs of the causality, else outputs.
-fn signal_variables(model: Model, causality: Causality) -> Vec<Variable> {
-    let inputs = inputs(causality);
-    let signals = SIGNALS.iter().filter(|s| s.models.contains(&model));
+fn signal_variables(model: Model, causality: Causality, lag: bool) -> Vec<Variable> {
+    let inputs = all_inputs(causality);
+    let signals =
+        SIGNALS.iter().filter(|s| s.models.contains(&model) && has_signal(causality, s.vr) && (lag || !s.lag));
     signals
         .map(|s| {
             if inputs.contains(&s.vr) {
@@ -536,7 +684,24 @@ pub fn direct_dependencies(model: Model, causality: Causality, s: &SignalDef) ->
         return vec![];
     }
     let inputs = inputs(causality);
-    let mut deps: Vec<u32> = inputs.iter().copied().filter(|&i| i != vr::PUMP_TORQUE).collect();
+    let torque_inputs = [vr::PUMP_TORQUE, vr::LOAD_TORQUE];
+    let mut deps: Vec<u32> = inputs.iter().copied().filter(|i| !torque_inputs.contains(i)).collect();
+    match s.vr {
+        // the clutch's slip is of the speeds only; its state code (0 open, 1 slipping) follows the
+        // command; its torque is C·tanh(slip/s_c) slipping, the constraint torque locked: every input
+        vr::LOCKUP_SLIP => return deps,
+        vr::LOCKUP_STATE => return COMMON_INPUTS.to_vec(),
+        vr::LOCKUP_TORQUE => {
+            let mut all: Vec<u32> = all_inputs(causality).into_iter().chain(rate_inputs(causality)).collect();
+            all.sort_unstable();
+            return all;
+        }
+        // the fluid's stator torque sees the clutch only through Hrovat & Tobler's coupled mass
+        // matrix, and only where a rotor speed is free
+        vr::SPEED_RATIO => {}
+        vr::STATOR_TORQUE if model != Model::HrovatTobler || causality == Causality::Speeds => {}
+        _ => deps.extend(COMMON_INPUTS),
+    }
     let rotors: &[u32] = match s.vr {
         vr::SPEED_RATIO => &[],
         _ if model == Model::HrovatTobler => &[vr::PUMP_SPEED, vr::TURBINE_SPEED],
@@ -549,12 +714,19 @@ pub fn direct_dependencies(model: Model, causality: Causality, s: &SignalDef) ->
         match RATES.iter().find(|r| r.of == rotor) {
             Some(rate) if inputs.contains(&rotor) => deps.push(rate.vr),
             _ if rotor == vr::PUMP_SPEED && inputs.contains(&vr::PUMP_TORQUE) => deps.push(vr::PUMP_TORQUE),
+            _ if rotor == vr::TURBINE_SPEED && inputs.contains(&vr::LOAD_TORQUE) => deps.push(vr::LOAD_TORQUE),
             _ => {}
         }
     }
     deps.sort_unstable();
     deps.dedup();
     deps
+}
+
+/// The rate inputs of a causality's speed inputs (Model Exchange).
+fn rate_inputs(causality: Causality) -> Vec<u32> {
+    let inputs = inputs(causality);
+    RATES.iter().filter(|r| inputs.contains(&r.of)).map(|r| r.vr).collect()
 }
 
 /// The input rates of the speed inputs, then the start-value parameters of the model's states.
@@ -582,20 +754,28 @@ fn rate_and_start_variables(model: Model, causality: Causality) -> Vec<Variable>
             Some(sig) if sig.models.contains(&model) && !inputs.contains(&sig.vr) => {
                 let spaced = sig.name.replace('_', " ");
                 let words = spaced.rsplitn(3, ' ').last().unwrap_or_default();
+                let when = if sig.vr == vr::TURBINE_SPEED {
+                    "whatever start_from_steady_state (the steady start is at this turbine speed)"
+                } else {
+                    "when start_from_steady_state = 0"
+                };
                 fixed(s.vr, &format!("initial_{}", sig.name), sig.unit)
-                    .describe(format!("Initial {words} when start_from_steady_state = 0"))
+                    .describe(format!("Initial {words} {when}"))
                     .start(s.start, xml_number(s.start))
             }
             Some(_) => continue,
         };
         out.push(variable);
     }
+    for d in DRIVE_PARAMETERS.iter().filter(|d| d.only.is_none_or(|c| c == causality)) {
+        out.push(fixed(d.vr, d.name, d.unit).describe(d.description).start(d.start, xml_number(d.start)));
+    }
     out
 }
 
 /// `der(x)` of each continuous state `x`, in coordinate order.
-fn derivative_variables(model: Model, causality: Causality) -> Vec<Variable> {
-    states(model, causality)
+fn derivative_variables(model: Model, causality: Causality, lag: bool) -> Vec<Variable> {
+    states(model, causality, lag)
         .into_iter()
         .map(|(s, c)| {
             let mut v = Variable::new(
@@ -603,7 +783,7 @@ fn derivative_variables(model: Model, causality: Causality) -> Vec<Variable> {
                 &format!("der({})", s.name),
                 "local",
                 "continuous",
-                &format!("{}2", s.unit),
+                &derivative_unit(s.unit),
             )
             .describe(format!("Time derivative of {}", s.name));
             v.initial = Some("calculated");
@@ -632,9 +812,10 @@ fn parameter_variables(parameters: &[Parameter]) -> Vec<Variable> {
 /// `<ModelVariables>`: the signals by value reference, the input rates, the start-value
 /// parameters, the derivatives of the states, the tunable parameters.
 pub fn variables(model: Model, causality: Causality, parameters: &[Parameter]) -> Vec<Variable> {
-    let mut out = signal_variables(model, causality);
+    let lag = has_lag(parameters);
+    let mut out = signal_variables(model, causality, lag);
     out.extend(rate_and_start_variables(model, causality));
-    out.extend(derivative_variables(model, causality));
+    out.extend(derivative_variables(model, causality, lag));
     out.extend(parameter_variables(parameters));
     out
 }
@@ -691,6 +872,7 @@ mod tests {
                 assert_eq!(vrs.len(), vars.len());
                 assert!(vars.iter().all(|v| (v.vr as usize) < SIGNAL_SLOTS
                     || start_parameter(v.vr).is_some()
+                    || drive_parameter(v.vr).is_some()
                     || is_derivative(v.vr)
                     || v.vr >= FIRST_PARAMETER));
                 for v in vars.iter().filter(|v| v.causality == "input") {
@@ -714,7 +896,8 @@ mod tests {
         assert_eq!(unit_of("table_capacity_factor_nm_s2[3]"), "N.m.s2/rad2");
         assert_eq!(unit_of("table_speed_ratio[3]"), "1");
         assert_eq!(unit_of("pump_exit_angle_rad"), "rad");
-        for p in SIGNALS.iter().map(|s| s.unit).chain([RATE_UNIT]) {
+        let states = SIGNALS.iter().filter(|s| s.state.is_some()).map(|s| derivative_unit(s.unit));
+        for p in SIGNALS.iter().map(|s| s.unit.to_string()).chain(states).chain([RATE_UNIT.into()]) {
             assert!(UNITS.iter().any(|u| u.name == p), "{p}");
         }
     }

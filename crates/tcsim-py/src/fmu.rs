@@ -64,7 +64,7 @@ fn variable_dict<'py>(py: Python<'py>, v: &Variable) -> PyResult<Bound<'py, PyDi
 }
 
 /// The variables of the FMU of the model specification `spec` (`tcsim.transient.DynamicModel.spec`,
-/// whose `kind` is the model) under `causality` (`pump-torque` or `speeds`), in the order of
+/// whose `kind` is the model) under `causality` (`pump-torque`, `speeds` or `torques`), in the order of
 /// `<ModelVariables>`: dicts with `vr`, `name`, `causality`, `variability`, `initial`, `unit`,
 /// `display_unit`, `description`, `start`, `start_text` (as the XML writes it), `derivative_of`
 /// (the state's value reference, for `der(x)`), `dependencies` (an output's direct inputs) and,
@@ -81,7 +81,7 @@ pub fn fmu_variables<'py>(
     };
     let model = model_of(&kind)?;
     let causality = variables::causality_of(causality)
-        .ok_or_else(|| input_error(CoreError::new("causality", causality, "pump-torque or speeds")))?;
+        .ok_or_else(|| input_error(CoreError::new("causality", causality, "pump-torque, speeds or torques")))?;
     let params = variables::parameters(&spec_entries(spec)?).map_err(pyo3::exceptions::PyValueError::new_err)?;
     variables::variables(model, causality, &params).iter().map(|v| variable_dict(py, v)).collect()
 }
@@ -115,6 +115,12 @@ pub fn fmu_causalities() -> Vec<(&'static str, [&'static str; 2])> {
         .collect()
 }
 
+/// The names of the inputs every causality has besides its two (the lock-up capacity).
+#[pyfunction]
+pub fn fmu_common_inputs() -> Vec<&'static str> {
+    variables::COMMON_INPUTS.iter().map(|&vr| variables::signal_name(vr).unwrap_or_default()).collect()
+}
+
 /// `numberOfEventIndicators` of the FMU of a model kind.
 #[pyfunction]
 pub fn fmu_event_indicators(model: &str) -> PyResult<usize> {
@@ -146,6 +152,7 @@ pub fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(fmu_variables, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_signals, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_causalities, m)?)?;
+    m.add_function(wrap_pyfunction!(fmu_common_inputs, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_event_indicators, m)?)?;
     m.add_function(wrap_pyfunction!(fmu_units, m)?)?;
     m.add("FMU_TIME_VR", variables::TIME)?;

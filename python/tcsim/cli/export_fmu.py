@@ -22,7 +22,7 @@ def export_fmu_command(converter: str, model: str, out: Path, causality: str, fm
     import json
     import zipfile
 
-    from ..io.fmu import CAUSALITIES
+    from ..io.fmu import CAUSALITIES, COMMON_INPUTS
     from ..io.fmu import export_fmu as write_fmu
     from ..io.fmu3 import fmi_version as version_of
 
@@ -31,10 +31,10 @@ def export_fmu_command(converter: str, model: str, out: Path, causality: str, fm
     with zipfile.ZipFile(path) as zf:
         params = json.loads(zf.read("resources/model.json"))["parameters"]
         platforms = sorted({n.split("/")[1] for n in zf.namelist() if n.startswith("binaries/")})
-    inputs = CAUSALITIES[causality]
+    inputs = (*CAUSALITIES[causality], *COMMON_INPUTS)
     return (
         f"{model} model of {converter} written to {path} (FMI {fmi.name} Model Exchange and Co-Simulation, "
-        f"{', '.join(platforms)}; inputs {' and '.join(inputs)}; {len(params)} tunable parameters)"
+        f"{', '.join(platforms)}; inputs {', '.join(inputs)}; {len(params)} tunable parameters)"
     )
 
 
@@ -44,7 +44,11 @@ def export_fmu(
     out: Annotated[Path, typer.Option("--out", "-o", help="the FMU file to write (*.fmu)")],
     causality: Annotated[
         str,
-        typer.Option("--causality", help="pump-torque (pump torque and turbine speed in) | speeds (both speeds in)"),
+        typer.Option(
+            "--causality",
+            help="pump-torque (pump torque and turbine speed in) | speeds (both speeds in) | "
+            "torques (pump torque and turbine load torque in, both speeds out)",
+        ),
     ] = "pump-torque",
     fmi_version: Annotated[
         str, typer.Option("--fmi-version", help="2 (FMI 2.0, the default) | 3 (FMI 3.0)", metavar="2|3")

@@ -4,7 +4,7 @@ no Python inside.
 ::
 
     tcsim export-fmu CONVERTER --model table|hrovat-tobler|quasi-dynamic -o FILE.fmu
-                     [--causality pump-torque|speeds] [--fmi-version 2|3]
+                     [--causality pump-torque|speeds|torques] [--fmi-version 2|3]
 
 The FMU is a zip archive:
 
@@ -22,9 +22,13 @@ The FMU is a zip archive:
   ``tcsim-core`` and ``tcsim-fmu`` and the workspace's ``Cargo.toml``/``Cargo.lock``.
 
 Causality (thesis/VSIM choice by default): ``pump-torque`` has the inputs ``pump_torque_nm`` and
-``turbine_speed_rad_s``; ``speeds`` has ``pump_speed_rad_s`` and ``turbine_speed_rad_s``. Every other
-signal of the model is an output. The FMU starts from the steady state consistent with the inputs
-set before ``fmi2ExitInitializationMode`` (as ``tcsim replay``).
+``turbine_speed_rad_s``; ``speeds`` has ``pump_speed_rad_s`` and ``turbine_speed_rad_s``; ``torques``
+has ``pump_torque_nm`` and ``load_torque_nm`` (drive (c) of :class:`tcsim.transient.PumpTorqueLoad`:
+both speeds are states and outputs, no input is differentiated; parameters ``load_inertia_kg_m2`` and
+``load_drag_nm_s2``, default 0). Every causality has the input ``lockup_capacity_nm`` (N·m ≥ 0,
+default 0) of the lock-up clutch, with the outputs ``lockup_torque_nm``, ``lockup_state`` and
+``lockup_slip_rad_s``. Every other signal of the model is an output. The FMU starts from the steady
+state consistent with the inputs set before ``fmi2ExitInitializationMode`` (as ``tcsim replay``).
 
 Errors: a bad converter, model, causality or output file is an :class:`~tcsim.errors.InputError`
 (exit 2); a library that cannot be found or built is a :class:`FmuLibraryError` (exit 1).
@@ -57,7 +61,7 @@ from xml.sax.saxutils import quoteattr
 from .. import _core
 from ..errors import InputError, TcsimWarning
 from ..models.converter import MODELS, Converter
-from ..models.drives import Drive, PumpTorqueTurbineSpeed, Speeds
+from ..models.drives import Drive, PumpTorqueLoad, PumpTorqueTurbineSpeed, Speeds
 from ..models.dynamic import DynamicModel, resolve_model
 from ..simulation.transient import SolverError, simulate
 from .fmu_sources import PACKAGED_DIR, SOURCES_DIR, copy_rust_sources, is_source_tree
@@ -82,6 +86,8 @@ PLATFORM_OF_SUFFIX = {".so": "linux64", ".dll": "win64", ".dylib": "darwin64"}
 FIRST_PARAMETER_VR: int = _core.FMU_FIRST_PARAMETER_VR
 #: ``--causality`` choices: the two inputs of each.
 CAUSALITIES: dict[str, tuple[str, str]] = {name: (a, b) for name, (a, b) in _core.fmu_causalities()}
+#: The inputs of every causality besides its two: the lock-up clutch's capacity.
+COMMON_INPUTS: tuple[str, ...] = tuple(_core.fmu_common_inputs())
 
 
 class FmuLibraryError(RuntimeError):
@@ -193,7 +199,7 @@ def _header(
     outputs = ", ".join(v["name"] for v in variables if v["causality"] == "output")
     description = (
         f"Torque converter {stem}, {model.name} model (tcsim {version}). Inputs "
-        f"{', '.join(CAUSALITIES[causality])}; outputs {outputs}. Starts from the steady "
+        f"{', '.join((*CAUSALITIES[causality], *COMMON_INPUTS))}; outputs {outputs}. Starts from the steady "
         "state consistent with the inputs."
     )
     return [
@@ -557,9 +563,20 @@ def _check_model(model: DynamicModel, causality: str) -> None:
     """A short run from the default inputs' steady state, so that an inadmissible model (a shape
     effect beyond the mass-matrix bound, ...) is an input error now, not an fmi2Error later."""
     t = [0.0, 1e-3]
-    start = {v["name"]: [v["start"]] * 2 for v in fmu_variables(model, causality) if v["causality"] == "input"}
+    variables = fmu_variables(model, causality)
+    start = {v["name"]: [v["start"]] * 2 for v in variables if v["causality"] in ("input", "parameter")}
     first, second = (start[name] for name in CAUSALITIES[causality])  # the table's start values
-    drive: Drive = (Speeds if causality == "speeds" else PumpTorqueTurbineSpeed)(t, first, second)
+    drive: Drive
+    if causality == "torques":
+        drive = PumpTorqueLoad(
+            t,
+            first,
+            load_inertia_kg_m2=start["load_inertia_kg_m2"][0],
+            load_torque_nm=second,
+            load_drag_nm_s2=start["load_drag_nm_s2"][0],
+        )
+    else:
+        drive = (Speeds if causality == "speeds" else PumpTorqueTurbineSpeed)(t, first, second)
     try:
         simulate(model, drive)
     except SolverError:
@@ -673,4 +690,5 @@ __all__: Sequence[str] = (
     "FmuLibraryError",
     "SIGNALS",
     "CAUSALITIES",
+    "COMMON_INPUTS",
 )

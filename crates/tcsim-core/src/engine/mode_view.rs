@@ -7,10 +7,12 @@ use crate::engine::converter_segment::{switch, Root, Segment};
 use crate::engine::isolated::Drive;
 use crate::engine::options::Hysteresis;
 
-/// Number of event indicators of a model in [`ModeView`]: the stator clutch, and two for the flow
-/// direction (for models without them, indicators that never change sign). The host's drives have
-/// no lock-up clutch.
-pub const EVENT_INDICATORS: usize = 3;
+/// Number of event indicators of a model in [`ModeView`]: the stator clutch, two for the flow
+/// direction, and the lock-up clutch (its lock, arm or breakaway root, whichever the clutch's mode
+/// has); for models or drives without them, indicators that never change sign.
+pub const EVENT_INDICATORS: usize = 4;
+/// The slot of the lock-up clutch's indicator in [`ModeView::indicators`].
+pub const LOCKUP_INDICATOR: usize = 3;
 
 /// One mode of a model under a drive, seen from outside: the coordinates that are states in some
 /// mode, their rates, the event indicators and the mode switches. This is what a Model Exchange
@@ -50,7 +52,7 @@ impl<'a> ModeView<'a> {
                 Root::Converter(ConverterRoot::StatorTorque | ConverterRoot::StatorSpeed) => 0,
                 Root::Converter(ConverterRoot::Flow | ConverterRoot::FlowStartsPositive) => 1,
                 Root::Converter(ConverterRoot::FlowStartsNegative) => 2,
-                Root::Lockup(_) => continue, // not in a host's drive
+                Root::Lockup(_) => LOCKUP_INDICATOR,
             };
             g[slot] = v;
         }
