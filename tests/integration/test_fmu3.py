@@ -100,7 +100,7 @@ def test_fmi3_fmu_validates(fmus, model, causality):
     with zipfile.ZipFile(path) as zf:
         assert "binaries/x86_64-windows/tcsim_converter.dll" in zf.read("sources/README.md").decode()
     assert config[fmu3.TOKEN_KEY] == md.guid  # FMPy reads the instantiationToken as guid
-    assert md.numberOfEventIndicators == (3 if model == "hrovat-tobler" else 0)
+    assert md.numberOfEventIndicators == (4 if model == "hrovat-tobler" else 1)  # stator and flow; the lock-up clutch
 
 
 @pytest.mark.parametrize("model", MODELS)
@@ -123,8 +123,9 @@ def test_fmi3_variables_are_the_fmi2_variables(fmus, model):
     extra = {vr: row for vr, row in t3.items() if vr not in t2}
     assert {k: v for k, v in t3.items() if k in t2} == t2
     assert extra.pop(fmu3.TIME_VR)[:2] == ("time", "independent")
-    assert {row[0] for row in extra.values()} == (
-        {"stator_clutch_indicator", "flow_indicator", "reverse_flow_indicator"} if model == "hrovat-tobler" else set()
+    stator_and_flow = {"stator_clutch_indicator", "flow_indicator", "reverse_flow_indicator"}
+    assert {row[0] for row in extra.values()} == {"lockup_clutch_indicator"} | (
+        stator_and_flow if model == "hrovat-tobler" else set()
     )
     assert [u.variable.valueReference for u in md3.eventIndicators] == sorted(extra)
 

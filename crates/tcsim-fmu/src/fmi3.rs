@@ -81,7 +81,7 @@ impl Instance3 {
     /// The number of continuous states and of event indicators (known from instantiation on).
     fn sizes(&self) -> (usize, usize) {
         match self.model() {
-            Some(m) => (states(m, self.instance.config.causality).len(), m.event_indicators()),
+            Some(m) => (states(m, self.instance.config.causality, self.instance.lag()).len(), m.event_indicators()),
             None => (0, 0),
         }
     }
@@ -109,7 +109,9 @@ impl Instance3 {
         if is_derivative(vr) {
             let c = (vr - FIRST_DERIVATIVE) as usize;
             let declared = self.model().is_some_and(|m| {
-                states(m, self.instance.config.causality).iter().any(|&(_, coordinate)| coordinate == c)
+                states(m, self.instance.config.causality, self.instance.lag())
+                    .iter()
+                    .any(|&(_, coordinate)| coordinate == c)
             });
             if !declared {
                 return Err(format!("no variable with value reference {vr}"));

@@ -7,7 +7,7 @@ use tcsim_core::converter::dynamics::FLOW;
 use tcsim_core::converter::spec::{build_model, ModelSpec};
 use tcsim_core::engine::converter_events::{Mode, Sample};
 use tcsim_core::engine::isolated::{initial_mode, initial_state, Drive, InitialState, TurbineLoad};
-use tcsim_core::engine::lockup::{ClutchMode, LockupCommand};
+use tcsim_core::engine::lockup::{self, ClutchMode, LockupCommand};
 use tcsim_core::engine::mode_view::{ModeView, LOCKUP_INDICATOR};
 use tcsim_core::engine::options::SolverOptions;
 use tcsim_core::engine::outputs::{row, COLUMNS};
@@ -346,8 +346,12 @@ impl Instance {
             if !value.is_finite() {
                 return Err(format!("{name} = {value}: expected a finite value"));
             }
-            if vr == vr::LOCKUP_CAPACITY && value < 0.0 {
-                return Err(format!("{name} = {value}: expected a capacity of zero or more (N.m)"));
+            if vr == vr::LOCKUP_CAPACITY {
+                // the core's one check of a capacity command (0 to its limit)
+                let command = LockupCommand::new(Signal::constant(value), lockup::DEFAULT_STATIC_TO_KINETIC);
+                if let Err(e) = command {
+                    return Err(format!("{name} = {value}: expected {}", e.expected));
+                }
             }
             self.signals[vr as usize] = value;
             return Ok(false);

@@ -834,9 +834,11 @@ pub const EVENT_INDICATOR_NAMES: [(&str, &str); EVENT_INDICATORS] = [
     ("stator_clutch_indicator", "Event indicator of the stator one-way clutch (positive while its state holds)"),
     ("flow_indicator", "Event indicator of the flow direction (positive while it holds)"),
     ("reverse_flow_indicator", "Event indicator of flow starting in reverse (positive while it does not)"),
+    ("lockup_clutch_indicator", "Event indicator of the lock-up clutch (positive while its state holds)"),
 ];
 
-/// The event indicator of value reference `vr`: its index.
+/// The event indicator of value reference `vr`: its slot in the engine's indicators (the variable
+/// exists for the models whose [`Model::indicator_slots`] hold it).
 pub fn event_indicator(vr: u32) -> Option<usize> {
     vr.checked_sub(FIRST_EVENT_INDICATOR).map(|i| i as usize).filter(|&i| i < EVENT_INDICATORS)
 }
@@ -844,12 +846,13 @@ pub fn event_indicator(vr: u32) -> Option<usize> {
 /// The event indicators of a model as FMI 3.0 variables (`local`, `continuous`, `calculated`, no
 /// unit: each is a torque, a speed or a flow, by the mode); none for a model without them.
 pub fn event_indicator_variables(model: Model) -> Vec<Variable> {
-    EVENT_INDICATOR_NAMES[..model.event_indicators()]
-        .iter()
-        .enumerate()
-        .map(|(i, (name, description))| {
+    model
+        .indicator_slots()
+        .into_iter()
+        .map(|i| {
+            let (name, description) = EVENT_INDICATOR_NAMES[i];
             let mut v =
-                Variable::new(FIRST_EVENT_INDICATOR + i as u32, name, "local", "continuous", "").describe(*description);
+                Variable::new(FIRST_EVENT_INDICATOR + i as u32, name, "local", "continuous", "").describe(description);
             v.initial = Some("calculated");
             v
         })
