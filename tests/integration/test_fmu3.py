@@ -310,8 +310,9 @@ def test_fmi3_every_declared_variable_can_be_read_after_initialisation(fmus, cls
         assert values[fmu3.TIME_VR] == 0.5
         indicators = [u.variable.valueReference for u in md.eventIndicators]
         if cls is FMU3Model:
-            assert inst.getNumberOfContinuousStates() == 3 and inst.getNumberOfEventIndicators() == 3
-            assert [values[vr] for vr in indicators] == _array(inst.getEventIndicators, 3)
+            # stator, flow, reverse flow and the lock-up clutch
+            assert inst.getNumberOfContinuousStates() == 3 and inst.getNumberOfEventIndicators() == 4
+            assert [values[vr] for vr in indicators] == _array(inst.getEventIndicators, 4)
             assert [values[20], values[22], values[23]] == _array(inst.getContinuousStateDerivatives, 3)
         assert all(values[vr] > 0.0 for vr in indicators)  # stall: the stator locked, flow forward
         inst.terminate()

@@ -158,25 +158,7 @@ unsafe fn with(c: *mut c_void, f: impl FnOnce(&mut Instance3) -> Result<(), Stri
     }
 }
 
-unsafe fn slice<'a, T>(p: *const T, n: usize) -> Result<&'a [T], String> {
-    if n == 0 {
-        return Ok(&[]);
-    }
-    if p.is_null() {
-        return Err("null array".into());
-    }
-    Ok(unsafe { std::slice::from_raw_parts(p, n) })
-}
-
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], String> {
-    if n == 0 {
-        return Ok(&mut []);
-    }
-    if p.is_null() {
-        return Err("null array".into());
-    }
-    Ok(unsafe { std::slice::from_raw_parts_mut(p, n) })
-}
+use crate::{slice, slice_mut};
 
 unsafe fn text(p: *const c_char) -> Option<String> {
     if p.is_null() {

@@ -102,7 +102,8 @@ unsafe fn with(c: *mut c_void, f: impl FnOnce(&mut Component) -> Result<(), Stri
     }
 }
 
-unsafe fn slice<'a, T>(p: *const T, n: usize) -> Result<&'a [T], String> {
+/// The C array `p[..n]` (empty for n = 0; an error for a null pointer), for FMI 2.0 and 3.0.
+pub(crate) unsafe fn slice<'a, T>(p: *const T, n: usize) -> Result<&'a [T], String> {
     if n == 0 {
         return Ok(&[]);
     }
@@ -112,7 +113,8 @@ unsafe fn slice<'a, T>(p: *const T, n: usize) -> Result<&'a [T], String> {
     Ok(unsafe { std::slice::from_raw_parts(p, n) })
 }
 
-unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], String> {
+/// The C array `p[..n]`, writable (see [`slice`]).
+pub(crate) unsafe fn slice_mut<'a, T>(p: *mut T, n: usize) -> Result<&'a mut [T], String> {
     if n == 0 {
         return Ok(&mut []);
     }
