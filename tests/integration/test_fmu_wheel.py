@@ -87,11 +87,14 @@ def installed(wheel, tmp_path_factory) -> dict[str, object]:
         text=True,
         check=True,
     ).stdout.strip()
-    dependencies = [p for p in sys.path if p.endswith(("site-packages", "dist-packages")) and Path(p).is_dir()]
-    (Path(site_dir) / "zz_test_dependencies.pth").write_text("\n".join(dependencies) + "\n")
+    # the wheel first: with the dependencies' .pth in place, pip would see this process's tcsim (a
+    # non-editable install from the same wheel in CI) as "already satisfied" and install nothing
     pip = [sys.executable, "-m", "pip", "--python", str(python), "install", "--no-deps", "--no-index", str(wheel)]
     p = subprocess.run(pip, capture_output=True, text=True, timeout=600)
     assert p.returncode == 0, p.stderr
+    assert (home / "bin" / "tcsim").is_file(), p.stdout
+    dependencies = [p for p in sys.path if p.endswith(("site-packages", "dist-packages")) and Path(p).is_dir()]
+    (Path(site_dir) / "zz_test_dependencies.pth").write_text("\n".join(dependencies) + "\n")
     env = {k: v for k, v in os.environ.items() if k not in (tfmu.LIBRARY_ENV, "PYTHONPATH", "VIRTUAL_ENV")}
     env["PATH"] = os.pathsep.join([str(home / "bin"), _without_cargo(os.environ.get("PATH", ""))])
     return {"home": home, "python": python, "env": env}
