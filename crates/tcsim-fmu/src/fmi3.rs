@@ -131,14 +131,6 @@ impl Instance3 {
     }
 }
 
-fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown panic".into())
-}
-
 /// Run `f` on the instance; an error or a panic is logged and becomes `fmi3Error`.
 unsafe fn with(c: *mut c_void, f: impl FnOnce(&mut Instance3) -> Result<(), String>) -> Status {
     if c.is_null() {
@@ -158,7 +150,7 @@ unsafe fn with(c: *mut c_void, f: impl FnOnce(&mut Instance3) -> Result<(), Stri
     }
 }
 
-use crate::{slice, slice_mut};
+use crate::{panic_message, slice, slice_mut};
 
 unsafe fn text(p: *const c_char) -> Option<String> {
     if p.is_null() {
