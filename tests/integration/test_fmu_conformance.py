@@ -476,6 +476,38 @@ def test_co_simulation_keeps_its_rate_input(fmus, instance):
         assert inst.get([accel]) == [7.0]
 
 
+def test_co_simulation_rate_input_is_the_input_derivative(fmus, instance):
+    """In Co-Simulation a rate input set before fmi2DoStep is its speed's rate over that step: the
+    same run, bit for bit, as fmi2SetRealInputDerivatives with that value; the next step without it
+    takes the last interval's rate. (FMI 2.0 ignored the rate inputs in Co-Simulation until they
+    were found connected in fmi-sim: the same step with and without them was equal.)"""
+    fmu = fmus[("hrovat-tobler", "speeds")]
+    pump, turbine = fmu.by_name["pump_speed_rad_s"], fmu.by_name["turbine_speed_rad_s"]
+    accel, torque = fmu.by_name["pump_accel_rad_s2"], fmu.by_name["pump_torque_nm"]
+    one = ctypes.c_int(1)
+
+    def run(how: str) -> list[float]:
+        inst = instance(fmu, CS)
+        inst.start(_inputs(fmu, "speeds"))
+        assert inst.step(0.0, 0.01) == OK and inst.set({pump: 185.0, turbine: 61.0}) == OK
+        if how == "input":
+            assert inst.set({accel: 900.0}) == OK
+        elif how == "derivative":
+            derivative = (ctypes.c_double * 1)(900.0)
+            refs = (ctypes.c_uint * 1)(pump)
+            assert inst("fmi2SetRealInputDerivatives", refs, 1, ctypes.byref(one), derivative) == OK
+        assert inst.step(0.01, 0.01) == OK and inst.set({pump: 190.0, turbine: 62.0}) == OK
+        first = inst.get([torque])[0]
+        assert inst.step(0.02, 0.01) == OK  # no rate given: the last interval's, 500 rad/s² for all three
+        return [first, inst.get([torque])[0]]
+
+    given, derivative, estimated = run("input"), run("derivative"), run("none")
+    assert given == derivative
+    # I_p·(900 − 500 rad/s²) ≈ 40 N·m more pump torque over the step with the given rate
+    assert given[0] - estimated[0] > 10.0
+    assert given[1] == pytest.approx(estimated[1], abs=1.0)
+
+
 # ---------------------------------------------------------------------------------------------
 # 9. FMU state
 

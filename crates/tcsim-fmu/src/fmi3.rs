@@ -20,9 +20,7 @@ use serde_json::Value;
 
 use crate::instance::{Configuration, Instance, Phase};
 use crate::snapshot::Snapshot;
-use crate::variables::{
-    event_indicator, is_derivative, is_input, states, Model, FIRST_DERIVATIVE, RATES, SIGNAL_SLOTS, TIME,
-};
+use crate::variables::{event_indicator, is_derivative, is_input, states, Model, FIRST_DERIVATIVE, SIGNAL_SLOTS, TIME};
 
 type Status = i32;
 const OK: Status = 0;
@@ -423,15 +421,7 @@ pub unsafe extern "C" fn fmi3SetFloat64(
                 return Err(format!("value reference {r} is calculated and cannot be set"));
             }
             // all or nothing, as fmi2SetReal
-            inst.instance.set_all(vr, values)?;
-            for (r, v) in vr.iter().zip(values) {
-                if let Some(rate) = RATES.iter().find(|rate| rate.vr == *r).filter(|_| !inst.instance.model_exchange) {
-                    // Co-Simulation: the rate of a speed input over the coming step (FMI 3.0 has no
-                    // fmi2SetRealInputDerivatives); unset, the last interval's
-                    inst.instance.set_rate(rate.of, 1, *v)?;
-                }
-            }
-            Ok(())
+            inst.instance.set_all(vr, values)
         })
     }
 }

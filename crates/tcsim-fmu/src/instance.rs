@@ -296,10 +296,10 @@ impl Instance {
     /// are not settable, non-finite values are refused. A refused call changes nothing.
     pub fn set_all(&mut self, vrs: &[u32], values: &[f64]) -> Result<(), String> {
         self.require("fmi2SetReal", &[Phase::Instantiated, Phase::Initialization, Phase::Running])?;
-        let saved = (self.signals, self.start, self.drive, self.config.parameters.clone());
+        let saved = (self.signals, self.rates, self.start, self.drive, self.config.parameters.clone());
         let result = self.apply(vrs, values);
         if result.is_err() {
-            (self.signals, self.start, self.drive, self.config.parameters) = saved;
+            (self.signals, self.rates, self.start, self.drive, self.config.parameters) = saved;
         }
         self.fresh = false;
         result
@@ -354,6 +354,12 @@ impl Instance {
                 }
             }
             self.signals[vr as usize] = value;
+            if let Some(rate) = RATES.iter().find(|r| r.vr == vr).filter(|_| !self.model_exchange) {
+                // Co-Simulation: a rate input is the rate of its speed input over the coming step,
+                // as fmi2SetRealInputDerivatives gives it (FMI 3.0 has no such call); a step
+                // without it takes the rate of the last interval
+                self.rates[rate.of as usize] = Some(value);
+            }
             return Ok(false);
         }
         let i = vr

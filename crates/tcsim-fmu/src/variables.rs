@@ -285,13 +285,13 @@ pub const RATES: [RateDef; 2] = [
         vr: vr::PUMP_ACCEL,
         name: "pump_accel_rad_s2",
         of: vr::PUMP_SPEED,
-        description: "Rate of the pump speed input (Model Exchange; 0 if not connected)",
+        description: "Rate of the pump speed input (0 if not connected; Co-Simulation: over the coming step, else the last interval's)",
     },
     RateDef {
         vr: vr::TURBINE_ACCEL,
         name: "turbine_accel_rad_s2",
         of: vr::TURBINE_SPEED,
-        description: "Rate of the turbine speed input (Model Exchange; 0 if not connected)",
+        description: "Rate of the turbine speed input (0 if not connected; Co-Simulation: over the coming step, else the last interval's)",
     },
 ];
 
