@@ -118,7 +118,7 @@ def write_launch(result: Launch, out_dir: Path) -> list[Path]:
     paths = write_launch_files(result, out_dir)
     first_events = next(iter(result.runs.values())).events if result.runs else []
     release = result.scenario.brake_release_time_s
-    paths += plot_launch(result.frames, first_events, release, result.scenario.name, out_dir)
+    paths += plot_launch(result.frames, first_events, release, result.scenario.name, out_dir, result.summary)
     if result.sweep is not None:
         paths += plot_sweep(result.sweep, result.frames.get("table"), release, out_dir)
     return paths
