@@ -312,9 +312,9 @@ def plot_sweep(sweep: pd.DataFrame | None, steady: pd.DataFrame | None, release:
         model = str(key)
         for column, ylabel, what, figure in _SWEEP_FIGURES:
             fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-            for i, (label, run) in enumerate(g.groupby("label", sort=False)):
+            for label, run in g.groupby("label", sort=False):
                 w = _window(run, a, b)
-                ax.plot(w["time_s"], w[column], **model_line(f"S {label}", i, label=mpl_text(label)))
+                ax.plot(w["time_s"], w[column], lw=1.1, label=mpl_text(label))
             if steady is not None:
                 w = _window(steady, a, b)
                 ax.plot(w["time_s"], w[column], **model_line(REFERENCE_MODEL))
