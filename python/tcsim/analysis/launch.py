@@ -1,7 +1,9 @@
 """The launch comparison (Li & Sundén 2016, §3.2.2, §3.5.2.2, §4.1): the runs of every model and of
 the optional shape-effect sweep, and their summary metrics (times to 50 and 100 km/h measured from
 the brake release, peak acceleration, and over the first 0.5 s after it the mean acceleration and
-the smallest effective torque ratio; NaN where a speed is not reached)."""
+the smallest effective torque ratio; NaN where a speed is not reached; then the launch peak apart
+from the shift transients and the effective-TR dip and recovery against the table model,
+:mod:`tcsim.analysis.launch_metrics`, docs/launch_summary.md)."""
 
 from __future__ import annotations
 
@@ -25,6 +27,7 @@ from ..simulation.launch import (
     sweep_scenario,
 )
 from ..simulation.scenarios import SPEED_50_KM_H_M_S, SPEED_100_KM_H_M_S, Scenario
+from .launch_metrics import dip_metrics, phase_metrics, recovery_time, shift_windows
 
 #: Width of the window after the brake release of the "first 0.5 s" metrics, s.
 FIRST_WINDOW_S = 0.5
@@ -35,7 +38,18 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "peak_accel_m_s2",
     "mean_accel_first_0_5_s_m_s2",
     "min_effective_torque_ratio_first_0_5_s",
+    "launch_peak_accel_m_s2",
+    "launch_peak_accel_time_s",
+    "shift_count",
+    "shift_peak_accel_m_s2",
+    "max_shift_accel_ratio",
+    "effective_torque_ratio_dip_first_0_5_s",
+    "effective_torque_ratio_dip_time_s",
+    "mean_effective_torque_ratio_deficit_first_0_5_s",
+    "effective_torque_ratio_recovery_time_s",
 )
+#: The model whose effective TR the dip and recovery columns compare with.
+REFERENCE_MODEL = "table"
 EVENT_COLUMNS: tuple[str, ...] = ("model", "time_s", "kind", "detail")
 
 
@@ -124,10 +138,57 @@ def summary_row(frame: pd.DataFrame, release_s: float) -> dict[str, float]:
     }
 
 
+def _column(frame: pd.DataFrame, name: str) -> np.ndarray | None:
+    return frame[name].to_numpy(dtype=float) if name in frame.columns else None
+
+
+def _shifts(frame: pd.DataFrame):
+    return shift_windows(frame["time_s"].to_numpy(dtype=float), _column(frame, "shifting"), _column(frame, "gear"))
+
+
+def _first_shift_s(frame: pd.DataFrame, release_s: float) -> float:
+    """Start of the run's first shift at or after the release; infinity without one."""
+    t = frame["time_s"].to_numpy(dtype=float)
+    starts = [t[s.first] for s in _shifts(frame) if t[s.first] >= release_s]
+    return float(starts[0]) if starts else math.inf
+
+
+def comparison_row(frame: pd.DataFrame, reference: pd.DataFrame | None, release_s: float) -> dict[str, float]:
+    """The launch-phase, shift and effective-TR comparison metrics of one run against the
+    ``reference`` (table) run (docs/launch_summary.md); the comparison NaN without a reference."""
+    t = frame["time_s"].to_numpy(dtype=float)
+    a = frame["vehicle_accel_m_s2"].to_numpy(dtype=float)
+    row = phase_metrics(t, a, _shifts(frame), release_s)
+    names = (
+        "effective_torque_ratio_dip_first_0_5_s",
+        "effective_torque_ratio_dip_time_s",
+        "mean_effective_torque_ratio_deficit_first_0_5_s",
+    )
+    row.update(dict.fromkeys(names, math.nan), effective_torque_ratio_recovery_time_s=math.nan)
+    if reference is None:
+        return row
+    e, rt, re = (x.to_numpy(dtype=float) for x in (frame["effective_torque_ratio"], *_ref(reference)))
+    dip = dip_metrics(t, e, rt, re, release_s, FIRST_WINDOW_S)
+    row.update(zip(names, (dip["dip"], dip["dip_time_s"], dip["mean_deficit"])))
+    phase_end = min(_first_shift_s(frame, release_s), _first_shift_s(reference, release_s))
+    row["effective_torque_ratio_recovery_time_s"] = recovery_time(t, e, rt, re, release_s, phase_end)
+    return row
+
+
+def _ref(reference: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
+    return reference["time_s"], reference["effective_torque_ratio"]
+
+
 def launch_summary(frames: Mapping[str, pd.DataFrame], release_s: float) -> pd.DataFrame:
-    """One row per run: ``model`` and the metrics of :func:`summary_row`."""
-    rows = [{"model": name, **summary_row(f, release_s)} for name, f in frames.items()]
-    return pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
+    """One row per run: ``model``, the metrics of :func:`summary_row`, then those of
+    :func:`comparison_row` against the :data:`REFERENCE_MODEL` run (when it was run)."""
+    reference = frames.get(REFERENCE_MODEL)
+    rows = [
+        {"model": name, **summary_row(f, release_s), **comparison_row(f, reference, release_s)}
+        for name, f in frames.items()
+    ]
+    df = pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
+    return df.astype({"shift_count": int})
 
 
 def events_table(runs: Mapping[str, LaunchRun]) -> pd.DataFrame:

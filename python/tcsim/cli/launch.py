@@ -40,6 +40,8 @@ Outputs (in DIR, default ``launch``; written all at once, nothing on error)
 ---------------------------------------------------------------------------
 * ``summary.csv``: one row per model, :data:`tcsim.analysis.launch.SUMMARY_COLUMNS`. Times are
   measured from the brake release; "first 0.5 s" is the 0.5 s after it; NaN where a speed is not reached.
+  The launch peak apart from the shift transients, the effective-TR dip and recovery against the
+  table model: docs/launch_summary.md, which defines every column.
 * ``<model>.csv``: each model's time series; ``timeseries.csv``: all of them with a ``model`` column.
 * ``events.csv``: ``model, time_s, kind, detail``; ``scenario.csv``: the pedal inputs.
 * Plots like thesis figures 3.5, 3.6 and 3.20 (:mod:`tcsim.plots.launch`).
@@ -118,7 +120,7 @@ def write_launch(result: Launch, out_dir: Path) -> list[Path]:
     paths = write_launch_files(result, out_dir)
     first_events = next(iter(result.runs.values())).events if result.runs else []
     release = result.scenario.brake_release_time_s
-    paths += plot_launch(result.frames, first_events, release, result.scenario.name, out_dir)
+    paths += plot_launch(result.frames, first_events, release, result.scenario.name, out_dir, result.summary)
     if result.sweep is not None:
         paths += plot_sweep(result.sweep, result.frames.get("table"), release, out_dir)
     return paths

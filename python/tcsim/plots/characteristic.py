@@ -1,4 +1,6 @@
-"""Figures: steady-state characteristics (thesis figures 3.3, 3.4, C.1, C.2)."""
+"""Figures: steady-state characteristics (thesis figures 3.3, 3.4, C.1, C.2). A curve named after a
+model (``"hrovat-tobler model"``) is drawn in that model's style, others in turn in the other
+styles of :mod:`tcsim.plots.styles`."""
 
 from __future__ import annotations
 
@@ -10,6 +12,7 @@ import pandas as pd
 from ..models.characteristic import Characteristic
 from ..models.steady import ratio_frame
 from .common import mpl_text, plt
+from .styles import model_line
 
 QUANTITIES = {
     "torque_ratio": ("Torque ratio [-]", "torque_ratio.png"),
@@ -36,9 +39,9 @@ def plot_characteristic(
     paths = []
     for column, (label, filename) in QUANTITIES.items():
         fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-        for name, df in curves.items():
-            y = df[column].to_numpy(dtype=float)
-            ax.plot(df["speed_ratio"], np.where(np.isfinite(y), y, np.nan), label=mpl_text(name))
+        for i, (name, df) in enumerate(curves.items()):
+            y = np.where(np.isfinite(df[column].to_numpy(dtype=float)), df[column].to_numpy(dtype=float), np.nan)
+            ax.plot(df["speed_ratio"], y, **model_line(name, i, label=mpl_text(name)))
         if ref is not None:
             y = ref[column].to_numpy(dtype=float)
             y = np.where(np.isfinite(y), y, np.nan)

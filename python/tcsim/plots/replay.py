@@ -1,6 +1,7 @@
 """Figures of ``tcsim replay``: models against the measurement over time (Li & Sundén 2016,
-figures 3.11–3.14, 3.16 and 3.17). The measurement is a black line, each model a coloured one;
-where the measurement lacks a channel only the model curves are drawn."""
+figures 3.11–3.14, 3.16 and 3.17). The measurement is a black line, each model in its own colour,
+line style and marker (:mod:`tcsim.plots.styles`); where the measurement lacks a channel only the
+model curves are drawn."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from .common import finish_figure, mpl_text, plt
+from .styles import model_line
 
 #: Signals by name (a measurement's channels, or a run's columns), each an array over time.
 Signals = Mapping[str, np.ndarray]
@@ -62,9 +64,9 @@ def plot_channel(
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
     if measured is not None:
         ax.plot(time_s, measured, color="k", lw=1.6, label="measurement")
-    for name, result in runs.items():
+    for i, (name, result) in enumerate(runs.items()):
         y = np.asarray(result[channel], dtype=float)
-        ax.plot(result["time_s"], y, lw=1.1, label=mpl_text(f"{name} model"))
+        ax.plot(result["time_s"], y, **model_line(name, i, label=mpl_text(f"{name} model")))
     ax.set_ylabel(label)
     title = f"{label.split(' [')[0]} ({note})" + ("" if measured is not None else ", not measured")
     return finish_figure(fig, ax, out_dir / filename, title)

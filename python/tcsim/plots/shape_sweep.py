@@ -8,6 +8,7 @@ from pathlib import Path
 import pandas as pd
 
 from .common import mpl_text, plt
+from .styles import model_line
 
 _PLOTS = (
     ("time_s", "effective_torque_ratio", "Time [s]", "Effective torque ratio [-]", "effective_torque_ratio_time.png"),
@@ -41,7 +42,7 @@ def plot_shape_effect_sweep(
     extra = [
         (d, style)
         for d, style in (
-            (steady, dict(color="0.4", ls="--", label="SS model")),
+            (steady, model_line("table", label="SS model")),
             (measured, dict(color="k", lw=1.2, label="Measurement")),
         )
         if d is not None
