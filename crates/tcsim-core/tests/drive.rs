@@ -29,6 +29,11 @@ fn trace() -> Trace {
     Trace::new(t, v, None).unwrap()
 }
 
+/// The solver options of a drive (the binding's default tolerance).
+fn options() -> SolverOptions {
+    SolverOptions { rtol: DRIVE_RTOL, ..SolverOptions::default() }
+}
+
 fn models() -> Vec<(&'static str, Box<dyn ConverterDynamics>)> {
     vec![
         ("table", Box::new(table())),
@@ -40,7 +45,7 @@ fn models() -> Vec<(&'static str, Box<dyn ConverterDynamics>)> {
 #[test]
 fn driver_follows_a_trace_and_the_energy_balances() {
     for (name, m) in models() {
-        let traj = simulate_drive(m.as_ref(), &sedan(), &trace(), &Driver::default(), &SolverOptions::default())
+        let traj = simulate_drive(m.as_ref(), &sedan(), &trace(), &Driver::default(), &options())
             .unwrap_or_else(|e| panic!("{name}: {e}"));
         let s = &traj.run.samples;
         let err: Vec<f64> = traj.target_m_s.iter().zip(s).map(|(t, s)| t - s.u[SPEED]).collect();

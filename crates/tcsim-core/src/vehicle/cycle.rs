@@ -7,7 +7,8 @@
 //! events exactly as in a launch ([`super::launch`]). At each control instant `t_k` with the
 //! vehicle speed `v` and the trace `v*(t)`:
 //!
-//! * `a_ff = (v*(t_k + Δt) − v*(t_k)) / Δt`, the trace's acceleration over the coming step;
+//! * `a_ff = (v*(t_k + τ + Δt) − v*(t_k + τ)) / Δt`, the trace's acceleration one step long, read
+//!   [`Driver::preview_s`] `τ` ahead (the engine's torque builds up with a lag);
 //! * `e = v*(t_k) − v`, `I ← I + e Δt` (not while the pedal or the brake is saturated the same
 //!   way), `a = a_ff + k_p e + k_i I`;
 //! * the force at the tyres `F = m a + F_res`, with `F_res = ΣF_tyre − m v̇` the resistance the plant
@@ -16,13 +17,14 @@
 //!   torque ratio (1 when the lock-up is locked), and the pedal whose engine target gives it;
 //! * when even the closed pedal (engine braking) gives more force than `F`, the brake supplies the
 //!   rest: engine braking first;
-//! * at a stop of the trace (`v*` below [`STOP_SPEED_M_S`] now and one step ahead) and the vehicle
+//! * at a stop of the trace (`v*` below [`STOP_SPEED_M_S`] now and `τ + Δt` ahead) and the vehicle
 //!   slower than [`Driver::hold_speed_m_s`]: pedal 0, brake [`Driver::hold_brake`], `I = 0`; the
 //!   creep torque of the idling engine through the stalled converter is held by the brake.
 //!
 //! Energy: the engine's work, the losses (all, and those of the converter, the lock-up clutch and
 //! the brakes) are integrated (trapezoidal rule) over samples every [`ENERGY_STEP_S`] within each
-//! smooth segment, whose ends are samples too; the kinetic energy removed at a closing link is
+//! smooth segment ([`FINE_ENERGY_STEP_S`] while a shift or lock-up clutch slips), whose ends are
+//! samples too; the kinetic energy removed at a closing link is
 //! booked at its event as in a launch.
 
 use super::components::brake_torque_nm;
@@ -43,6 +45,11 @@ use crate::interp::linear_held;
 pub const STOP_SPEED_M_S: f64 = 0.05;
 /// Step of the samples the energies are integrated over, s.
 pub const ENERGY_STEP_S: f64 = 0.01;
+/// The step while a clutch slips (a shift, a lock-up engagement): their synchronisation is fast, s.
+pub const FINE_ENERGY_STEP_S: f64 = 0.0005;
+/// Relative tolerance of a drive's solver unless the options give one: the energy balance of a
+/// whole cycle closes to about 1e-5 of the engine's work with it.
+pub const DRIVE_RTOL: f64 = 1e-7;
 /// More events than this in one control step is reported as chattering.
 pub const MAX_EVENTS_PER_STEP: usize = 1000;
 /// Largest grade of a trace, percent.
@@ -118,6 +125,8 @@ pub struct Driver {
     pub ki_per_s2: f64,
     /// Control step (pedals held between control instants), s; also the output step.
     pub control_step_s: f64,
+    /// Preview of the feed-forward: the driver reads the trace's acceleration this far ahead, s.
+    pub preview_s: f64,
     /// Brake pedal that holds the vehicle at a stop, 0–1.
     pub hold_brake: f64,
     /// Below this speed the vehicle is held at a stop of the trace, m/s.
@@ -132,6 +141,7 @@ impl Default for Driver {
             kp_per_s: 2.0,
             ki_per_s2: 0.5,
             control_step_s: 0.1,
+            preview_s: 0.5,
             hold_brake: 0.3,
             hold_speed_m_s: 0.5,
             max_integral_m_s2: 2.0,
@@ -157,6 +167,9 @@ impl Driver {
                 "a control step of at least 0.01 and at most 1 s",
             );
         }
+        if !(self.preview_s.is_finite() && (0.0..=2.0).contains(&self.preview_s)) {
+            return bad("driver_preview_s", self.preview_s, "a preview of at least 0 and at most 2 s");
+        }
         if !(self.hold_brake.is_finite() && self.hold_brake > 0.0 && self.hold_brake <= 1.0) {
             return bad("driver_hold_brake", self.hold_brake, "a brake pedal above 0 and at most 1");
         }
@@ -174,7 +187,7 @@ impl Driver {
         integral: &mut f64,
     ) -> (f64, f64) {
         let dt = self.control_step_s;
-        let (target, ahead) = (trace.speed(t), trace.speed(t + dt));
+        let (target, ahead) = (trace.speed(t), trace.speed(t + self.preview_s + dt));
         let speed = s.u[SPEED];
         if target <= STOP_SPEED_M_S && ahead <= STOP_SPEED_M_S && speed < self.hold_speed_m_s {
             *integral = 0.0;
@@ -183,7 +196,8 @@ impl Driver {
         let m = v.body.mass_kg;
         let e = target - speed;
         let ki_i = (self.ki_per_s2 * *integral).clamp(-self.max_integral_m_s2, self.max_integral_m_s2);
-        let accel = (ahead - target) / dt + self.kp_per_s * e + ki_i;
+        let preview = trace.speed(t + self.preview_s);
+        let accel = (ahead - preview) / dt + self.kp_per_s * e + ki_i;
         let resistance = s.tyre_force_n[0] + s.tyre_force_n[1] - m * s.u_dot[SPEED];
         let force = m * accel + resistance;
         let (pedal, brake) = self.pedals(v, s, force);
@@ -305,13 +319,13 @@ fn held_scenario(pedal: f64, brake: f64, end_time_s: f64) -> Scenario {
     }
 }
 
-/// The sampling times of a segment from `t0` to `t1`: `t0`, the multiples of [`ENERGY_STEP_S`]
-/// between, and `t1`.
-fn segment_times(t0: f64, t1: f64) -> Vec<f64> {
+/// The sampling times of a segment from `t0` to `t1`: `t0`, the multiples of `step` between, and
+/// `t1`.
+fn segment_times(t0: f64, t1: f64, step: f64) -> Vec<f64> {
     let mut times = vec![t0];
-    let mut k = (t0 / ENERGY_STEP_S).floor() + 1.0;
-    while k * ENERGY_STEP_S < t1 - 1e-9 {
-        times.push(k * ENERGY_STEP_S);
+    let mut k = (t0 / step).floor() + 1.0;
+    while k * step < t1 - 1e-9 {
+        times.push(k * step);
         k += 1.0;
     }
     times.push(t1);
@@ -355,7 +369,8 @@ fn run_step(
         let end = match pending_switch(&plant, &plant.full(&x0), c.t) {
             Some(root) => Some((c.t, root, x0)),
             None => {
-                let times = segment_times(c.t, t_end);
+                let slipping = c.mode.shift.is_some() || matches!(c.mode.lockup, LockupState::Engaging { .. });
+                let times = segment_times(c.t, t_end, if slipping { FINE_ENERGY_STEP_S } else { ENERGY_STEP_S });
                 let mut samples = Vec::new();
                 let end = run_segment(&plant, x0, c.t, t_end, &times, options, &mut samples, &mut traj.steps)?;
                 if let Some((t_root, _, x)) = &end {
