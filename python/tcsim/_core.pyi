@@ -189,7 +189,6 @@ def launch_runs(
     options: dict[str, Any] | None = None,
     threads: int = 0,
 ) -> list[LaunchRun]: ...
-
 def drive_columns() -> list[str]: ...
 def drive_runs(
     models: list[dict[str, Any]],
