@@ -189,6 +189,14 @@ def launch_runs(
     options: dict[str, Any] | None = None,
     threads: int = 0,
 ) -> list[LaunchRun]: ...
+def drive_columns() -> list[str]: ...
+def drive_runs(
+    models: list[dict[str, Any]],
+    vehicle: Vehicle,
+    cycle: dict[str, Any],
+    options: dict[str, Any] | None = None,
+    threads: int = 0,
+) -> list[LaunchRun]: ...
 
 # physics owned by the core (one owner per fact)
 def default_flow_time_constant_s(geometry: _ArrayLike, fluid_length_m: float) -> float: ...

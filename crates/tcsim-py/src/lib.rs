@@ -1173,6 +1173,89 @@ fn launch_runs<'py>(
 }
 
 // ---------------------------------------------------------------------------------------------
+// Drive cycles
+
+/// Output column names of a drive run: the launch's, then the driver's and the energies.
+#[pyfunction]
+fn drive_columns() -> Vec<&'static str> {
+    tcsim_core::vehicle::cycle::drive_column_names()
+}
+
+/// The driver's gains from `options` (`driver_kp_per_s`, `driver_ki_per_s2`,
+/// `driver_control_step_s`, `driver_hold_brake`, `driver_preview_s`), defaults otherwise.
+fn driver_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<tcsim_core::vehicle::cycle::Driver> {
+    let mut g = tcsim_core::vehicle::cycle::Driver::default();
+    if let Some(d) = d {
+        g.kp_per_s = opt_item(d, "driver_kp_per_s")?.unwrap_or(g.kp_per_s);
+        g.ki_per_s2 = opt_item(d, "driver_ki_per_s2")?.unwrap_or(g.ki_per_s2);
+        g.control_step_s = opt_item(d, "driver_control_step_s")?.unwrap_or(g.control_step_s);
+        g.hold_brake = opt_item(d, "driver_hold_brake")?.unwrap_or(g.hold_brake);
+        g.preview_s = opt_item(d, "driver_preview_s")?.unwrap_or(g.preview_s);
+    }
+    g.validate().map_err(input_error)?;
+    Ok(g)
+}
+
+/// Drive runs: each model dict (as for transient_runs) in the same vehicle follows the trace
+/// `cycle` (`time_s`, `vehicle_speed_m_s`, optional `grade_percent`; errors about it name the
+/// scenario), GIL released, `threads` workers. `options` takes the solver options (`rtol` by default
+/// `DRIVE_RTOL`) and the driver's gains (`driver_*`). Returns one [`LaunchRun`] per model with the columns of `drive_columns`.
+#[pyfunction]
+#[pyo3(signature = (models, vehicle, cycle, options=None, threads=0))]
+fn drive_runs<'py>(
+    py: Python<'py>,
+    models: Vec<Bound<'py, PyDict>>,
+    vehicle: Bound<'py, PyVehicle>,
+    cycle: Bound<'py, PyDict>,
+    options: Option<Bound<'py, PyDict>>,
+    threads: usize,
+) -> PyResult<Vec<LaunchRun>> {
+    use tcsim_core::vehicle::cycle::{drive_column_names, drive_columns as columns, simulate_drive, Trace};
+    guard(|| {
+        let v = vehicle.get().doc.vehicle.clone();
+        let trace =
+            Trace::new(item(&cycle, "time_s")?, item(&cycle, "vehicle_speed_m_s")?, opt_item(&cycle, "grade_percent")?)
+                .map_err(input_error)?;
+        let mut solver = options_from(options.as_ref())?;
+        if options.as_ref().map_or(Ok(None), |o| opt_item::<f64>(o, "rtol"))?.is_none() {
+            solver.rtol = tcsim_core::vehicle::cycle::DRIVE_RTOL;
+        }
+        let driver = driver_from(options.as_ref())?;
+        let parsed = models.iter().map(|m| model_from(m)).collect::<PyResult<Vec<_>>>()?;
+        let results = cancellable(py, |cancel| {
+            tcsim_core::batch::parallel_map_cancellable(&parsed, threads, cancel, |m| {
+                tcsim_core::batch::catch_panic(|| {
+                    let traj = simulate_drive(m.as_ref(), &v, &trace, &driver, &solver)?;
+                    Ok((columns(m.as_ref(), &traj)?, traj.run.events))
+                })
+            })
+            .into_iter()
+            .collect::<Option<Vec<_>>>()
+        })?;
+        results
+            .into_iter()
+            .map(|r| {
+                Ok(match r {
+                    Ok((cols, events)) => LaunchRun {
+                        columns: column_dict(py, &drive_column_names(), cols)?,
+                        events: events
+                            .iter()
+                            .map(|e| Py::new(py, LaunchEvent::new(e.time_s, e.kind.into(), e.gear)))
+                            .collect::<PyResult<_>>()?,
+                        error: None,
+                    },
+                    Err(e) => LaunchRun {
+                        columns: PyDict::new(py).unbind(),
+                        events: vec![],
+                        error: Some(Py::new(py, RunError::from_core(e))?),
+                    },
+                })
+            })
+            .collect()
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
 // Physics owned by the core that the Python layer needs (one owner per fact)
 
 fn one_geometry(geometry: &PyReadonlyArray2<'_, f64>) -> PyResult<HtGeometry<f64>> {
@@ -1342,6 +1425,8 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(smoothed_rate, m)?)?;
     m.add_function(wrap_pyfunction!(launch_columns, m)?)?;
     m.add_function(wrap_pyfunction!(launch_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(drive_columns, m)?)?;
+    m.add_function(wrap_pyfunction!(drive_runs, m)?)?;
     m.add_function(wrap_pyfunction!(read_vehicle, m)?)?;
     m.add_function(wrap_pyfunction!(vehicle_sections, m)?)?;
     m.add_class::<PyVehicle>()?;

@@ -24,6 +24,12 @@ pub fn engine_drag_nm(w: f64, drag_torque_nm: f64, drag_nm_s_per_rad: f64) -> f6
     drag_torque_nm * (w / 1.0).tanh() + drag_nm_s_per_rad * w
 }
 
+/// The torque of a brake of capacity `capacity_nm` on an axle turning at `axle_speed_rad_s`,
+/// opposing its rotation (smoothed over [`BRAKE_SPEED_RAD_S`]), N·m.
+pub fn brake_torque_nm(capacity_nm: f64, axle_speed_rad_s: f64) -> f64 {
+    capacity_nm * (axle_speed_rad_s / BRAKE_SPEED_RAD_S).tanh()
+}
+
 impl Curve {
     /// The value at `x`: linear between points, ends held.
     pub fn at(&self, x: f64) -> f64 {

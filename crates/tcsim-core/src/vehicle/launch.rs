@@ -77,7 +77,7 @@ pub fn initial_state(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario) 
 }
 
 /// The mode after `root`, and the sign of the slip to synchronise (shifts, lock-up).
-fn switch(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (VehicleMode, f64) {
+pub(super) fn switch(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (VehicleMode, f64) {
     let mut m = plant.mode;
     let mut sync = plant.sync_sign;
     let gb = &plant.v.gearbox;
@@ -136,6 +136,16 @@ fn switch(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (VehicleMode, f6
     (m, sync)
 }
 
+/// The name of the event `root` fired, given the mode it switched to (a handover that
+/// synchronised at once ends the shift; a ramp or an arming that locked locks).
+pub(super) fn event_kind(root: Root, new_mode: &VehicleMode) -> &'static str {
+    match root {
+        Root::ShiftHandover if new_mode.shift.is_none() => "shift-end",
+        Root::LockupRamped | Root::LockupArm if new_mode.lockup == LockupState::Locked => "lockup-lock",
+        _ => event_name(root),
+    }
+}
+
 fn flow_sign_at_zero(plant: &Plant, u: &Coords, t: f64) -> f64 {
     let mode = VehicleMode { converter: ConverterMode { flow_sign: 0.0, ..plant.mode.converter }, ..plant.mode };
     let held = Plant::new(plant.model, plant.v, plant.sc, mode, plant.sync_sign);
@@ -145,7 +155,7 @@ fn flow_sign_at_zero(plant: &Plant, u: &Coords, t: f64) -> f64 {
 
 /// A switch whose condition already holds when a mode starts (root functions only see
 /// crossings): the stop speed, a due shift, a due lock-up engagement.
-fn pending_switch(plant: &Plant, u: &Coords, t: f64) -> Option<Root> {
+pub(super) fn pending_switch(plant: &Plant, u: &Coords, t: f64) -> Option<Root> {
     let m = &plant.mode;
     let p = plant.sc.accelerator_pedal.value(t);
     let gb = &plant.v.gearbox;
@@ -232,7 +242,7 @@ fn output_times(v: &Vehicle, sc: &Scenario, output_step_s: f64, options: &Solver
 /// The mode of the braked standstill: first gear, lock-up open, the wheels held while the brake
 /// pedal is pressed, the stator locked (stalled turbine) and the flow forwards. A model without a
 /// flow sign ignores the sign; it is +1 for all models.
-fn initial_mode(model: &dyn ConverterDynamics, sc: &Scenario) -> VehicleMode {
+pub(super) fn initial_mode(model: &dyn ConverterDynamics, sc: &Scenario) -> VehicleMode {
     VehicleMode {
         converter: ConverterMode {
             stator_locked: model.has_stator_clutch(),
@@ -285,11 +295,7 @@ pub fn simulate_launch(
                 }
                 let (new_mode, new_sync) = switch(&plant, root, &mut next, t_root);
                 energy_before = Some(kinetic_energy(&plant, &next));
-                let kind = match root {
-                    Root::ShiftHandover if new_mode.shift.is_none() => "shift-end",
-                    Root::LockupRamped | Root::LockupArm if new_mode.lockup == LockupState::Locked => "lockup-lock",
-                    _ => event_name(root),
-                };
+                let kind = event_kind(root, &new_mode);
                 traj.events.push(VehicleEvent { time_s: t_root, kind, gear: new_mode.gear + 1 });
                 if traj.events.len() > options.max_events {
                     return Err(TransientError::Solver {

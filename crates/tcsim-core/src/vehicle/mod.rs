@@ -29,8 +29,10 @@
 //! * [`plant`]: the plant in one mode (mass matrix, generalised coordinates, forces, roots).
 //! * [`launch`]: the run loop of a launch, its initial state and its switches.
 //! * [`outputs`]: the output columns of a launch.
+//! * [`cycle`]: drive cycles, a driver following a speed trace with the same plant.
 
 pub mod components;
+pub mod cycle;
 pub mod file;
 pub mod launch;
 pub mod modes;

@@ -1,7 +1,7 @@
 //! The vehicle plant in one mode: the mass matrix, the generalised coordinates of the mode
 //! (`u = P x`), the forces `F(u, t)` with the power terms, the root functions, and the sample.
 
-use super::components::{BRAKE_SPEED_RAD_S, CLUTCH_SLIP_RAD_S, ROLL_SPEED_M_S, SLIP_SPEED_M_S};
+use super::components::{brake_torque_nm, CLUTCH_SLIP_RAD_S, ROLL_SPEED_M_S, SLIP_SPEED_M_S};
 use super::modes::{
     LockupState, Root, VehicleMode, HOLD_SPEED_RAD_S, LOCKUP_RELEASE_FRACTION, REARM_DELAY_S, SYNC_SLIP_RAD_S,
 };
@@ -185,7 +185,7 @@ impl<'a> Plant<'a> {
         (0..self.n_states).map(|i| (0..self.n_states).map(|k| self.reduced_inv[i][k] * b[k]).sum()).collect()
     }
 
-    fn lockup_capacity(&self, t: f64) -> f64 {
+    pub(super) fn lockup_capacity(&self, t: f64) -> f64 {
         match self.mode.lockup {
             LockupState::Engaging { since_s, .. } => {
                 self.v.lockup.capacity_nm * ((t - since_s) / self.v.lockup.engage_time_s).clamp(0.0, 1.0)
@@ -308,7 +308,7 @@ impl<'a> Plant<'a> {
             f[SPEED] += force;
             *loss += force * slip_speed;
             if !self.mode.wheels_held {
-                let t_b = brake * share * (u[axle] / BRAKE_SPEED_RAD_S).tanh();
+                let t_b = brake_torque_nm(brake * share, u[axle]);
                 f[axle] -= t_b;
                 *loss += t_b * u[axle];
             }

@@ -1,0 +1,210 @@
+"""Drive cycles: every converter model in one vehicle follows a speed trace (``tcsim drive``).
+
+The driver, the plant and the energies are the core's (``tcsim._core.drive_runs``,
+``crates/tcsim-core/src/vehicle/cycle.rs``; equations in ``docs/drive.md``). This module runs
+them and summarises each run: speed tracking, the energies of the cycle and the energy balance.
+
+Summary columns (:data:`SUMMARY_COLUMNS`, one row per model):
+
+* ``rms_speed_error_km_h``, ``max_speed_error_km_h``: trace minus vehicle speed over every output
+  sample (every control step), km/h;
+* ``engine_work_kj``: the engine's indicated work; ``converter_loss_kj``,
+  ``lockup_loss_kj`` (slipping lock-up clutch), ``event_loss_kj`` (kinetic energy removed where a
+  clutch closes: lock-up, shifts), ``brake_energy_kj`` (friction brakes);
+* ``heat_to_fluid_kj``: converter plus lock-up clutch losses, the heat into the transmission fluid
+  over the cycle; ``engine_braking_kj``: the work the engine absorbed, ∫ max(0, −T_e ω_e) dt;
+* ``energy_residual``: (engine work − change of stored energy − losses − event losses) / engine work;
+* ``lockup_time_fraction``: the share of the cycle's time with the lock-up clutch locked.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from .. import _core
+from ..errors import TcsimWarning, core_input_error, from_core
+from ..models.dynamic import DynamicModel, select_models
+from ..models.vehicle import Vehicle
+from ..simulation.transient import SolverError
+from ..units import KM_H
+
+#: The bundled cycles: ``tcsim drive --cycle NAME`` → file in ``tcsim/data/cycles`` (sources in
+#: each file's header).
+BUNDLED_CYCLES: dict[str, str] = {
+    "us06": "us06.csv",
+    "udds": "udds.csv",
+    "hwfet": "hwfet.csv",
+    "wltc-3b": "wltc-3b.csv",
+}
+
+#: Columns of ``summary.csv``.
+SUMMARY_COLUMNS: tuple[str, ...] = (
+    "model",
+    "cycle",
+    "duration_s",
+    "distance_km",
+    "rms_speed_error_km_h",
+    "max_speed_error_km_h",
+    "engine_work_kj",
+    "converter_loss_kj",
+    "lockup_loss_kj",
+    "event_loss_kj",
+    "brake_energy_kj",
+    "heat_to_fluid_kj",
+    "engine_braking_kj",
+    "energy_residual",
+    "lockup_time_fraction",
+)
+
+
+@dataclass(frozen=True)
+class Cycle:
+    """A speed trace: ``time_s`` from 0, ``vehicle_speed_m_s`` (m/s), ``grade_percent`` (%, None for a
+    level road), its ``name`` and ``source`` (the file it came from)."""
+
+    name: str
+    source: str
+    time_s: np.ndarray
+    vehicle_speed_m_s: np.ndarray
+    grade_percent: np.ndarray | None = None
+
+    def core_spec(self) -> dict[str, Any]:
+        """The trace as ``tcsim._core.drive_runs`` takes it."""
+        spec: dict[str, Any] = {
+            "time_s": np.asarray(self.time_s, float).tolist(),
+            "vehicle_speed_m_s": np.asarray(self.vehicle_speed_m_s, float).tolist(),
+        }
+        if self.grade_percent is not None:
+            spec["grade_percent"] = np.asarray(self.grade_percent, float).tolist()
+        return spec
+
+
+@dataclass(frozen=True)
+class DriveRun:
+    """One model's drive: its time series (columns ``tcsim._core.drive_columns()``, the all-NaN
+    columns of coordinates the model lacks left out) and its events ``(time_s, kind, gear)``."""
+
+    frame: pd.DataFrame
+    events: list[tuple[Any, ...]] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class Drive:
+    """A drive cycle run with every model: the vehicle, the cycle, ``{model: run}`` and the summary."""
+
+    vehicle: Vehicle
+    cycle: Cycle
+    runs: dict[str, DriveRun]
+    summary: pd.DataFrame
+
+    def events(self) -> pd.DataFrame:
+        """``model, time_s, kind, gear`` of every run."""
+        rows = [(name, *e) for name, run in self.runs.items() for e in run.events]
+        return pd.DataFrame(rows, columns=["model", "time_s", "kind", "gear"])
+
+
+def _unpack(run: _core.LaunchRun, name: str, files: dict[str, str]) -> DriveRun | Exception:
+    err = run.error
+    if err is None:
+        df = pd.DataFrame({k: np.asarray(v) for k, v in run.columns.items()})
+        keep = df.notna().any() | (df.columns == "time_s")
+        return DriveRun(df.loc[:, keep], [(e.time_s, e.kind, e.gear) for e in run.events])
+    if err.kind == "input":
+        assert err.source is not None and err.field is not None and err.expected is not None
+        return core_input_error(err.source, err.field, err.value, err.expected, files)
+    return SolverError(f"{name}: {err.message}")
+
+
+def run_drive(
+    vehicle: Vehicle,
+    cycle: Cycle,
+    models: Sequence[DynamicModel],
+    options: dict[str, Any] | None = None,
+    threads: int = 0,
+) -> dict[str, DriveRun]:
+    """Every model follows ``cycle`` in ``vehicle``, in one core call (GIL released, ``threads``
+    workers, 0 for all cores). ``options``: the solver options of a launch and the driver's gains
+    ``driver_kp_per_s`` (1/s), ``driver_ki_per_s2`` (1/s²), ``driver_control_step_s`` (s),
+    ``driver_hold_brake`` (0–1). The first failed run raises :class:`~tcsim.errors.InputError`
+    (naming the cycle file for the trace's values) or :class:`SolverError`."""
+    converters = {m.source for m in models}
+    files = {"vehicle": vehicle.path, "scenario": cycle.source, "converter": converters.pop()}
+    try:
+        raw = _core.drive_runs([m.spec for m in models], vehicle.core, cycle.core_spec(), options, threads)
+    except _core.CoreInputError as e:
+        raise from_core(e, files) from None
+    out: dict[str, DriveRun] = {}
+    for model, run in zip(models, raw):
+        result = _unpack(run, model.name, files)
+        if not isinstance(result, DriveRun):
+            raise result
+        model.warn_if_extended({str(k): v for k, v in result.frame.items()}, f"the drive run {model.name!r}")
+        out[model.name] = result
+    return out
+
+
+def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:
+    return float(np.sum(0.5 * (y[1:] + y[:-1]) * np.diff(t)))
+
+
+def summary_row(name: str, cycle: Cycle, f: pd.DataFrame) -> dict[str, Any]:
+    """The :data:`SUMMARY_COLUMNS` of one run's frame ``f``."""
+    t = f.time_s.to_numpy()
+    err = f.speed_error_m_s.to_numpy() / KM_H
+    last = f.iloc[-1]
+    engine = float(last.engine_work_j)
+    stored = float(last.vehicle_stored_energy_j - f.vehicle_stored_energy_j.iloc[0])
+    residual = engine - stored - float(last.vehicle_loss_j) - float(last.booked_event_loss_j)
+    absorbed = np.maximum(0.0, -f.engine_torque_nm.to_numpy() * f.pump_speed_rad_s.to_numpy())
+    locked = (f.lockup_state.to_numpy() == 2).astype(float)
+    return {
+        "model": name,
+        "cycle": cycle.name,
+        "duration_s": float(t[-1] - t[0]),
+        "distance_km": _trapezoid(f.vehicle_speed_m_s.to_numpy(), t) / 1000.0,
+        "rms_speed_error_km_h": float(np.sqrt(np.mean(err**2))),
+        "max_speed_error_km_h": float(np.max(np.abs(err))),
+        "engine_work_kj": engine / 1000.0,
+        "converter_loss_kj": float(last.converter_loss_j) / 1000.0,
+        "lockup_loss_kj": float(last.lockup_loss_j) / 1000.0,
+        "event_loss_kj": float(last.booked_event_loss_j) / 1000.0,
+        "brake_energy_kj": float(last.brake_energy_j) / 1000.0,
+        "heat_to_fluid_kj": float(last.converter_loss_j + last.lockup_loss_j) / 1000.0,
+        "engine_braking_kj": _trapezoid(absorbed, t) / 1000.0,
+        "energy_residual": residual / engine if engine > 0 else float("nan"),
+        "lockup_time_fraction": _trapezoid(locked, t) / max(float(t[-1] - t[0]), 1e-12),
+    }
+
+
+def summarise(cycle: Cycle, runs: dict[str, DriveRun]) -> pd.DataFrame:
+    """One row of :data:`SUMMARY_COLUMNS` per run; a :class:`~tcsim.errors.TcsimWarning` per model
+    whose RMS speed error exceeds 2 km/h (the driver could not follow the trace: check the vehicle)."""
+    rows = [summary_row(name, cycle, run.frame) for name, run in runs.items()]
+    for r in rows:
+        if r["rms_speed_error_km_h"] > 2.0:
+            warnings.warn(
+                f"{r['model']}: RMS speed error {r['rms_speed_error_km_h']:.2f} km/h over {cycle.name}: "
+                "the vehicle does not follow the trace",
+                TcsimWarning,
+                stacklevel=2,
+            )
+    return pd.DataFrame(rows, columns=list(SUMMARY_COLUMNS))
+
+
+def drive(
+    vehicle: Vehicle,
+    cycle: Cycle,
+    requested: Sequence[str] = (),
+    options: dict[str, Any] | None = None,
+    threads: int = 0,
+) -> Drive:
+    """Every requested model (default: all of the vehicle's converter) follows ``cycle``."""
+    models = select_models(vehicle.converter, requested)
+    runs = run_drive(vehicle, cycle, models, options, threads)
+    return Drive(vehicle, cycle, runs, summarise(cycle, runs))

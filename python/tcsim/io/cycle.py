@@ -1,0 +1,102 @@
+"""Speed traces for ``tcsim drive --cycle NAME|FILE``: the bundled cycles and a user's trace file
+(CSV, Parquet, ``.mat`` or MDF4, read by the readers of :mod:`tcsim.io.measurement`), and the
+files of a drive.
+
+A trace file has ``time_s`` (s, strictly increasing; shifted so that the first sample is time 0),
+``vehicle_speed_m_s`` (m/s, starting at rest) and optionally ``grade_percent`` (%, positive
+uphill); linear between samples. The core checks the ranges (speed 0–250 km/h, grade ±30 %, the
+first speed at rest) and names the file, the column and the row index of a value outside them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from ..analysis.drive import BUNDLED_CYCLES, Cycle, Drive
+from ..errors import InputError
+from .measurement import check_finite, check_increasing, check_numeric, reader_for, refuse_duplicates
+from .results import write_frames
+
+_REQUIRED = ("time_s", "vehicle_speed_m_s")
+_OPTIONAL = ("grade_percent",)
+
+
+def bundled_cycle_path(name: str) -> Path:
+    """The file of the bundled cycle ``name`` (a key of :data:`BUNDLED_CYCLES`)."""
+    return Path(str(resources.files("tcsim") / "data" / "cycles" / BUNDLED_CYCLES[name]))
+
+
+class _CyclePicker:
+    """Picks the trace's columns from a file's column names."""
+
+    def __init__(self, path: Path):
+        self.path = path
+        self.found: list[str] = []
+
+    def __call__(self, names: Sequence[str]) -> list[str]:
+        for column in _REQUIRED:
+            if column not in names:
+                shown = ", ".join(list(names)[:12]) + (" ..." if len(names) > 12 else "")
+                raise InputError(
+                    str(self.path), column, "missing", f"a column named {column}; columns found: {shown or '(none)'}"
+                )
+        self.found = [c for c in (*_REQUIRED, *_OPTIONAL) if c in names]
+        refuse_duplicates(self.path, names, self.found)
+        return self.found
+
+
+def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
+    """A speed trace from a file: each problem (missing column, fewer than 2 rows, a value that is
+    not a finite number, times not strictly increasing) an :class:`InputError` naming the file, the
+    column and the value."""
+    path = Path(path)
+    reader = reader_for(path, "cycle")
+    picker = _CyclePicker(path)
+    raw, _units = reader(path, picker)
+    n = len(raw["time_s"])
+    if n < 2:
+        raise InputError(str(path), "time_s", f"{n} rows", "at least 2 data rows")
+    out: dict[str, np.ndarray] = {}
+    time_s = None
+    for column in picker.found:
+        values = np.asarray(raw[column])
+        if len(values) != n:
+            raise InputError(str(path), column, f"{len(values)} samples", f"as many as time_s ({n})")
+        values = check_numeric(path, column, values, time_s)
+        check_finite(path, column, values, time_s)
+        if column == "time_s":
+            check_increasing(path, column, values)
+            time_s = values
+        out[column] = values
+    return Cycle(
+        name or path.stem,
+        str(path),
+        out["time_s"] - out["time_s"][0],
+        out["vehicle_speed_m_s"],
+        out.get("grade_percent"),
+    )
+
+
+def cycle_from_option(option: str) -> Cycle:
+    """``--cycle``: a bundled name (:data:`BUNDLED_CYCLES`) or a trace file."""
+    if option in BUNDLED_CYCLES:
+        return read_cycle(bundled_cycle_path(option), option)
+    if not Path(option).suffix:
+        raise InputError("command line", "--cycle", option, f"one of {', '.join(BUNDLED_CYCLES)} or a trace file")
+    return read_cycle(option)
+
+
+def write_drive_files(result: Drive, out_dir: Path) -> list[Path]:
+    """The CSV files of a drive: ``<model>.csv``, ``summary.csv``, ``events.csv``, ``cycle.csv``."""
+    c = result.cycle
+    trace = {"time_s": c.time_s, "vehicle_speed_m_s": c.vehicle_speed_m_s}
+    if c.grade_percent is not None:
+        trace["grade_percent"] = c.grade_percent
+    files: dict[str, pd.DataFrame] = {f"{name}.csv": run.frame for name, run in result.runs.items()}
+    files.update({"summary.csv": result.summary, "events.csv": result.events(), "cycle.csv": pd.DataFrame(trace)})
+    return write_frames(files, out_dir)
