@@ -217,6 +217,7 @@ def provenance(
         lines.append(
             f"[quasi_dynamic]: taken from the start converter {start.name} on purpose: its shape effects are the "
             "quasi-dynamic model's calibration constants (fit them to a take-off measurement with tcsim "
-            "fit-shapes, thesis §4.1), not geometry"
+            "fit-shapes, thesis §4.1), not geometry; its density and pump radius, where it does not set them, "
+            "follow the fitted [geometry]"
         )
     return lines

@@ -362,7 +362,12 @@ def _correlation(jac: np.ndarray, cost: float) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class FitResult:
-    """A fit of Hrovat & Tobler parameters to a table (user units: angles in degrees)."""
+    """A fit of Hrovat & Tobler parameters to a table (user units: angles in degrees).
+
+    ``geometry`` is the fitted geometry with its fluid length and shape effects derived from the
+    fitted radii and angles (:func:`.fit_derived.derive_geometry`); ``warnings`` has one line per
+    free parameter at a bound or outside its measured range (:func:`.fit_derived.parameter_warnings`).
+    """
 
     geometry: GeometrySection
     start: GeometrySection
