@@ -16,11 +16,20 @@ import pytest
 import tomli_w
 
 from tcsim import _core
-from tcsim.analysis.fitting import DEFAULT_FREE, LOSSES, PUMP_SPEED_RAD_S, RADII, fit_hrovat_tobler, target_table
+from tcsim.analysis.fitting import (
+    ANGLES,
+    DEFAULT_FREE,
+    LOSSES,
+    PUMP_SPEED_RAD_S,
+    RADII,
+    fit_hrovat_tobler,
+    target_table,
+)
 from tcsim.cli import main
 from tcsim.errors import InputError, TcsimWarning
 from tcsim.models.characteristic import Characteristic
 from tcsim.models.converter import load_converter
+from tcsim.models.design_ranges import DESIGN_RANGES
 
 SHARED_TABLES = Path(__file__).resolve().parents[1] / "data" / "converters"
 
@@ -232,7 +241,7 @@ def shared_tables() -> list[Path]:
 
 
 @pytest.mark.parametrize("path", shared_tables(), ids=lambda p: p.stem)
-def test_fit_runs_on_every_shared_table(path, bundled):
+def test_fit_runs_on_every_shared_table(path, bundled, tmp_path, cli):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TcsimWarning)  # e.g. the Allison TC-521 is a truck converter
         table = target_table(str(path))
@@ -240,15 +249,38 @@ def test_fit_runs_on_every_shared_table(path, bundled):
     ratio = table.capacity_factor_nm_s2[np.searchsorted(table.speed_ratio, 0.0)] / start_cf
     resized = not 0.5 < ratio < 2.0  # another size of converter: free the radii and the flow area
     free = DEFAULT_FREE + (RADII + ("flow_area_m2",) if resized else ())
-    r = fit_hrovat_tobler(bundled.geometry, table, free)
-    assert np.isfinite(r.torque_ratio_model).all() and np.isfinite(r.capacity_factor_model).all()
+    out = tmp_path / "fit"
+    run = cli("fit", "li-sunden-2016", "--target", path, "--out", out, "--free", ",".join(free))
+    assert run.code == 0, run.stderr
+    report = json.loads((out / "fit_report.json").read_text())
+    sr, e = np.array(report["points"]["speed_ratio"]), report["errors"]
     # the fit improves on the start in both quantities
-    tr0, cf0, _, _ = _core.ht_ratio_gradients(bundled.core_geometry(), PUMP_SPEED_RAD_S, r.speed_ratio, [])
-    assert r.rms_tr < np.sqrt(np.mean((tr0 / r.torque_ratio_table - 1) ** 2))
-    assert r.rms_cf < np.sqrt(np.mean((cf0 / r.capacity_factor_table - 1) ** 2))
+    tr0, cf0, _, _ = _core.ht_ratio_gradients(bundled.core_geometry(), PUMP_SPEED_RAD_S, sr, [])
+    assert e["rms_torque_ratio"] < np.sqrt(np.mean((tr0 / report["points"]["torque_ratio_table"] - 1) ** 2))
+    assert e["rms_capacity_factor"] < np.sqrt(np.mean((cf0 / report["points"]["capacity_factor_table"] - 1) ** 2))
     if resized:  # the size is the whole difference: radii and area close it (measured 0.03–0.6 %)
-        assert r.rms_tr < 0.01 and r.rms_cf < 0.01
+        assert e["rms_torque_ratio"] < 0.01 and e["rms_capacity_factor"] < 0.01
+    # every free parameter at a bound or outside its measured range (thesis §4.1.1) is warned about in
+    # one line, on stderr and in the report; the others are not
+    warned = [line for line in run.stderr.splitlines() if ": fitted " in line]
+    assert all(line.startswith("warning: ") for line in warned)
+    assert [line.removeprefix("warning: ") for line in warned] == [w for w in report["warnings"] if ": fitted " in w]
+    for name, p in report["parameters"].items():
+        lo, hi, x = p["lower"], p["upper"], p["fitted"]
+        assert p["active"] is not None or min(x - lo, hi - x) > 1e-9 * (hi - lo), name
+        outside = name in DESIGN_RANGES and not DESIGN_RANGES[name].contains(x)
+        lines = [line for line in warned if f": fitted {name} = " in line]
+        assert len(lines) == (p["active"] is not None or outside), (name, lines)
+        if p["active"] is not None:
+            assert f"ends at its {p['active']} bound" in lines[0]
+        if outside:
+            assert "outside the measured range" in lines[0] and "§4.1.1" in lines[0]
+    # the fitted converter is usable: it characterises (test_fit_derived.py runs the other commands)
+    assert cli("characterise", out / "fitted.toml", "--out", tmp_path / "char").code == 0
+    angles = ", ".join(f"{n.removesuffix('_angle_deg')} {report['parameters'][n]['fitted']:.1f}" for n in ANGLES)
     print(
-        f"\n{path.name}: SR 0–{r.speed_ratio_max:g}, {len(r.free)} free, CF(0) ratio {ratio:.2f}: "
-        f"RMS TR {100 * r.rms_tr:.2f} %, CF {100 * r.rms_cf:.2f} %; max {100 * r.max_tr:.2f} %, {100 * r.max_cf:.2f} %"
+        f"\n{path.name}: SR 0–{report['speed_ratio_max']:g}, {len(free)} free, CF(0) ratio {ratio:.2f}: "
+        f"RMS TR {100 * e['rms_torque_ratio']:.2f} %, CF {100 * e['rms_capacity_factor']:.2f} %; "
+        f"max {100 * e['max_torque_ratio']:.2f} %, {100 * e['max_capacity_factor']:.2f} %\n  angles: {angles}\n  "
+        + "\n  ".join(warned)
     )

@@ -38,9 +38,20 @@ from scipy.optimize import least_squares
 from .. import _core
 from ..errors import InputError
 from ..models.characteristic import Characteristic
-from ..models.converter import STEADY_KEYS, STEADY_SCALE, Converter, GeometrySection, load_converter
+from ..models.converter import STEADY_KEYS, STEADY_SCALE, Converter, GeometrySection, InertiaSection, load_converter
 from ..models.steady import characterise_hrovat_tobler, ratio_frame
 from ..units import DEFAULT_PUMP_SPEED_RAD_S, RAD_S_PER_RPM
+from .fit_derived import (
+    DERIVATION,
+    DERIVED_KEYS,
+    RADII_ORDER,
+    check_usable,
+    derive_geometry,
+    derive_inertia,
+    parameter_warnings,
+    provenance,
+    radii_ordered,
+)
 
 PUMP_SPEED_RAD_S = DEFAULT_PUMP_SPEED_RAD_S
 CORE_NAMES = tuple(_core.ht_parameter_names())
@@ -220,6 +231,7 @@ class _Problem:
         self.sr, self.tr, self.cf = (np.ascontiguousarray(a, dtype=float) for a in (sr, tr, cf))
         self.base = geometry.core_row()
         self.index = np.array([STEADY_KEYS.index(n) for n in self.free])
+        self.radii = [STEADY_KEYS.index(n) for n in RADII]  # pump, turbine, stator
         self.core_free = [CORE_NAMES[i] for i in self.index]
         self.lo = np.array([bounds[n][0] for n in self.free])
         self.span = np.array([bounds[n][1] - bounds[n][0] for n in self.free])
@@ -241,12 +253,14 @@ class _Problem:
             row = self.base.copy()
             row[self.index] = self.to_x(u) * STEADY_SCALE[self.index]
             self.nfev += 1
-            try:
-                tr, cf, dtr, dcf = _core.ht_ratio_gradients(row[None, :], PUMP_SPEED_RAD_S, self.sr, self.core_free)
-                out = (tr, cf, dtr * self.scale, dcf * self.scale)
-            except _core.CoreInputError:  # e.g. no losses at all: no steady state anywhere
-                nan, dnan = np.full(self.sr.shape, np.nan), np.full((len(self.sr), len(self.free)), np.nan)
-                out = (nan, nan, dnan, dnan)
+            nan, dnan = np.full(self.sr.shape, np.nan), np.full((len(self.sr), len(self.free)), np.nan)
+            out = (nan, nan, dnan, dnan)  # infeasible: radii without a torus (fit_derived), no steady state
+            if radii_ordered(*row[self.radii]):
+                try:
+                    tr, cf, dtr, dcf = _core.ht_ratio_gradients(row[None, :], PUMP_SPEED_RAD_S, self.sr, self.core_free)
+                    out = (tr, cf, dtr * self.scale, dcf * self.scale)
+                except _core.CoreInputError:  # e.g. no losses at all: no steady state anywhere
+                    pass
             self._cache = (key, out)
         return self._cache[1]
 
@@ -348,7 +362,12 @@ def _correlation(jac: np.ndarray, cost: float) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class FitResult:
-    """A fit of Hrovat & Tobler parameters to a table (user units: angles in degrees)."""
+    """A fit of Hrovat & Tobler parameters to a table (user units: angles in degrees).
+
+    ``geometry`` is the fitted geometry with its fluid length and shape effects derived from the
+    fitted radii and angles (:func:`.fit_derived.derive_geometry`); ``warnings`` has one line per
+    free parameter at a bound or outside its measured range (:func:`.fit_derived.parameter_warnings`).
+    """
 
     geometry: GeometrySection
     start: GeometrySection
@@ -373,6 +392,8 @@ class FitResult:
     message: str
     table_source: str = ""
     notes: tuple[str, ...] = field(default_factory=tuple)
+    #: One line per free parameter at a bound or outside its measured range (:mod:`.fit_derived`).
+    warnings: tuple[str, ...] = field(default_factory=tuple)
 
     @property
     def values(self) -> dict[str, float]:
@@ -461,6 +482,9 @@ class FitResult:
                 "message": self.message,
                 "elapsed_s": self.elapsed_s,
             },
+            "derived": {k: getattr(self.geometry, k) for k in DERIVED_KEYS},
+            "derivation": DERIVATION,
+            "warnings": list(self.warnings),
             "notes": list(self.notes),
         }
 
@@ -499,6 +523,14 @@ def fit_hrovat_tobler(
     """
     t0 = time.perf_counter()
     free = check_free(free)
+    radii = [getattr(geometry, n) for n in RADII]
+    if not radii_ordered(*radii):
+        raise InputError(
+            "start converter",
+            "[geometry] radii",
+            ", ".join(f"{n} {r:g}" for n, r in zip(RADII, radii)),
+            f"{RADII_ORDER} (the fit derives the fluid length and shape effects from a circular torus through them)",
+        )
     start = {n: float(getattr(geometry, n)) for n in free}
     resolved = resolve_bounds(free, bounds, start)
     srmax, sr, tr, cf = fit_points(table, speed_ratio_max)
@@ -533,6 +565,8 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
     fitted = GeometrySection(**values)
     tr, cf, _, _ = problem.evaluate(res.x)
     stats = _correlation(problem.jacobian(res.x), float(res.cost))
+    active = _active(problem, res.x, res.active_mask)
+    warned = parameter_warnings(table.source, {n: getattr(fitted, n) for n in problem.free}, bounds, active)
     notes = []
     if stats["rank"] < len(problem.free):
         notes.append(
@@ -547,17 +581,12 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
             "flow area and a common radius scale are interchangeable: free only one of density, flow area "
             "and the set of radii for a unique size"
         )
-    if set(problem.free) & set(RADII):
-        notes.append(
-            "fluid_length_m and the shape effects are kept from the start converter; re-derive them "
-            "for the fitted radii before dynamic use"
-        )
     return FitResult(
-        geometry=fitted,
+        geometry=derive_geometry(fitted),
         start=geometry,
         free=problem.free,
         bounds=bounds,
-        active=_active(problem, res.x, res.active_mask),
+        active=active,
         speed_ratio_max=srmax,
         speed_ratio=problem.sr,
         torque_ratio_table=problem.tr,
@@ -576,6 +605,7 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
         message=str(res.message),
         table_source=table.source,
         notes=tuple(notes),
+        warnings=tuple(warned),
     )
 
 
@@ -609,23 +639,36 @@ def fitted_converter(start: Converter, result: FitResult, table: Characteristic,
     """The start converter with the fitted [geometry] and the target table as its [characteristic].
 
     The fitted converter describes the converter of the target table: its table and quasi-dynamic
-    models use that table, its Hrovat & Tobler model the fitted geometry.
+    models use that table, its Hrovat & Tobler model the fitted geometry. The fluid length and shape
+    effects are derived from the fitted radii and angles (:data:`.fit_derived.DERIVATION`), the fluid
+    part of [inertia] too when a size parameter is free (:func:`.fit_derived.derive_inertia`);
+    [sources] says which values were fitted, derived or taken from the start converter.
     """
+    assert start.geometry is not None  # the fit needs one
+    inertia, inertia_derived = derive_inertia(start.inertia, start.geometry, result.geometry)
     sources = dict(start.sources)
     for n in result.free:
         sources[f"geometry.{n}"] = (
             f"fitted by tcsim fit to {label} over SR 0–{result.speed_ratio_max:g} "
             f"(start value {result.start_values[n]:g}; see fit_report.md)"
         )
-    if set(result.free) & set(RADII):
-        for n in ("fluid_length_m", "pump_shape_effect_m2", "turbine_shape_effect_m2", "stator_shape_effect_m2"):
-            sources[f"geometry.{n}"] = sources.get(f"geometry.{n}", "start converter") + " (start radii, not refitted)"
+    for n in DERIVED_KEYS:
+        sources[f"geometry.{n}"] = f"derived by tcsim fit: {DERIVATION}"
+    kept = "derived by tcsim fit: the start's metal part plus the fitted torus's fluid ρA∫R²dl; start: "
+    for key in InertiaSection.model_fields if inertia is not None else ():
+        was = start.sources.get(f"inertia.{key}", "start converter")
+        sources[f"inertia.{key}"] = (kept + was) if inertia_derived else f"{was} (taken from the start by tcsim fit)"
+    if start.quasi_dynamic is not None:
+        for key in start.quasi_dynamic.model_dump(exclude_none=True):
+            was = start.sources.get(f"quasi_dynamic.{key}", "start converter")
+            sources[f"quasi_dynamic.{key}"] = f"{was} (taken from the start by tcsim fit: not geometry)"
     for col in ("speed_ratio", "torque_ratio", "capacity_factor_nm_s2"):
         sources[f"characteristic.{col}"] = f"fitting target {table.source}"
     return dataclasses.replace(
         start,
         name=f"{start.name}-fit-{label}",
         characteristic=table,
+        inertia=inertia,
         geometry=result.geometry,
         description=(
             f"{start.name} with [geometry] fitted to {label}: RMS error TR {100 * result.rms_tr:.3g} %, "
@@ -634,6 +677,26 @@ def fitted_converter(start: Converter, result: FitResult, table: Characteristic,
         source=f"{start.source}; [geometry] fitted by tcsim fit to {table.source}",
         sources=sources,
     )
+
+
+@dataclass(frozen=True)
+class FitOutcome:
+    """What ``tcsim fit`` writes: the checked fitted converter, where its values come from, and every
+    warning (one line each: the parameters' of :attr:`FitResult.warnings`, then the checks')."""
+
+    converter: Converter
+    provenance: tuple[str, ...]
+    warnings: tuple[str, ...]
+
+
+def fit_outcome(start: Converter, result: FitResult, table: Characteristic, label: str) -> FitOutcome:
+    """The fitted converter of ``result``, checked by :func:`.fit_derived.check_usable` (an
+    :class:`InputError` on the target table if a command would refuse it), with its provenance."""
+    conv = fitted_converter(start, result, table, label)
+    checks = check_usable(conv, table.source, result.speed_ratio_max)
+    derived = start.inertia is not None and conv.inertia != start.inertia
+    lines = provenance(start, result.free, derived, label, start.quasi_dynamic is not None)
+    return FitOutcome(conv, tuple(lines), (*result.warnings, *checks))
 
 
 def model_curve(conv: Converter) -> pd.DataFrame:

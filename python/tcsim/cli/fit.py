@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -15,12 +16,12 @@ def fit_command(
 ) -> str:
     """Fit ``converter``'s [geometry] to the table of ``target``; write ``out``; the line to print."""
     from ..analysis import fitting
-    from ..errors import InputError
+    from ..errors import InputError, TcsimWarning
     from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_fit_files
     from ..models.converter import load_converter
     from ..models.steady import coupling_point
-    from ..plots.characteristic import plot_characteristic
+    from ..plots.fit import plot_fit
     from ..reports.fit import report_markdown
 
     check_output_dir(out, [converter, target])
@@ -38,18 +39,27 @@ def fit_command(
         if e.source == "start converter":
             raise InputError(start.path, e.field, e.value, e.expected) from None
         raise
-    fitted = fitting.fitted_converter(start, result, table, fitting.target_label(target))
+    outcome = fitting.fit_outcome(start, result, table, fitting.target_label(target))
+    for line in outcome.warnings:  # only once the fitted converter passed its checks
+        warnings.warn(line, TcsimWarning, stacklevel=1)
+    fitted = outcome.converter
+    report = report_markdown(result, start, outcome.provenance, outcome.warnings)
     with output_dir(out, inputs) as stage:
-        write_fit_files(stage, start, fitted, result, table, report_markdown(result, start, []))
+        write_fit_files(stage, start, fitted, result, table, report, outcome.provenance)
         curves = {
             "fitted Hrovat & Tobler": fitting.model_curve(fitted),
             "start Hrovat & Tobler": fitting.model_curve(start),
         }
         title = f"Fit to {Path(table.source).name or table.source} (SR 0–{result.speed_ratio_max:g})"
-        plot_characteristic(
-            curves, stage, title, table=table, table_label="Target table", coupling_point=coupling_point(fitted)
-        )
-    return f"{result.one_line()}. Written to {out}/: fitted.toml, fit_report.md, fit_report.json and plots."
+        plot_fit(curves, stage, title, table, result.speed_ratio_max, coupling_point(fitted))
+    kept = [p for p in outcome.provenance if p.startswith(("[inertia]", "[quasi_dynamic]"))]
+    return "\n".join(
+        [
+            f"{result.one_line()}.",
+            *kept,
+            f"Written to {out}/: fitted.toml, fit_report.md, fit_report.json and plots.",
+        ]
+    )
 
 
 def fit(

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
@@ -109,15 +110,23 @@ def write_replay_files(replay: Replay, out_dir: Path) -> list[Path]:
 
 
 def write_fit_files(
-    stage: Path, start: Converter, fitted: Converter, result: FitResult, table: Characteristic, report_md: str
+    stage: Path,
+    start: Converter,
+    fitted: Converter,
+    result: FitResult,
+    table: Characteristic,
+    report_md: str,
+    provenance: Sequence[str] = (),
 ) -> None:
-    """``fitted.toml`` (validated as every other command will read it back), ``fit_report.json`` and
-    ``fit_report.md`` (``report_md``)."""
+    """``fitted.toml`` (validated as every other command will read it back; its header comment says
+    where the values come from, ``provenance``), ``fit_report.json`` and ``fit_report.md`` (``report_md``)."""
     doc = fitted.to_toml_dict()
     parse_converter(doc, "fitted.toml")  # what every other command will read back
     header = (
         f"# Written by tcsim fit: [geometry] of {start.name} fitted to {table.source}\n"
-        f"# over SR 0-{result.speed_ratio_max:g}. See fit_report.md.\n\n"
+        f"# over SR 0-{result.speed_ratio_max:g}. See fit_report.md.\n"
+        + "".join(f"# - {line}\n" for line in provenance)
+        + "\n"
     )
     (stage / "fitted.toml").write_text(header + tomli_w.dumps(doc), encoding="utf-8")
     (stage / "fit_report.json").write_text(

@@ -6,6 +6,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..analysis.fit_derived import DERIVED_KEYS
 from ..analysis.fitting import SEED, FitResult
 from ..models.converter import Converter
 from .format import fmt_number
@@ -21,6 +22,13 @@ def _parameter_table(r: FitResult) -> list[str]:
             f"{fmt_number(lo)} | {fmt_number(hi)} | "
             f"{r.active.get(n, '')} | {shown[bool(r.identifiable[i])](r.std_error[i])} |"
         )
+    return lines
+
+
+def _derived_table(r: FitResult) -> list[str]:
+    lines = ["| derived | start | fitted |", "|---|---|---|"]
+    for k in DERIVED_KEYS:
+        lines.append(f"| {k} | {fmt_number(getattr(r.start, k))} | {fmt_number(getattr(r.geometry, k))} |")
     return lines
 
 
@@ -49,8 +57,16 @@ def _correlation_table(r: FitResult) -> list[str]:
     return lines
 
 
-def report_markdown(r: FitResult, start: Converter, notes: Sequence[str] = ()) -> str:
-    """``fit_report.md``: values, bounds, errors, correlations, optimiser statistics."""
+def report_markdown(
+    r: FitResult,
+    start: Converter,
+    provenance: Sequence[str] = (),
+    warnings: Sequence[str] = (),
+    notes: Sequence[str] = (),
+) -> str:
+    """``fit_report.md``: values, bounds, errors, warnings (one line per parameter at a bound or outside
+    its measured range, and the checks'), where each value of ``fitted.toml`` comes from
+    (``provenance``), the derived geometry, correlations and optimiser statistics."""
     active = ", ".join(f"{n} ({side})" for n, side in r.active.items()) or "none"
     singular = (
         f"singular, rank {r.jacobian_rank} of {len(r.free)} (correlations from the pseudo-inverse)"
@@ -72,6 +88,16 @@ def report_markdown(r: FitResult, start: Converter, notes: Sequence[str] = ()) -
         f"- optimiser: scipy least_squares (trf, analytic Jacobian), {r.starts} starts (seed {SEED}), "
         f"{r.nfev} function evaluations, {r.njev} Jacobian evaluations in the best run, {r.elapsed_s:.2f} s; "
         f"{r.message}",
+        "",
+        "## Warnings",
+        "",
+        *([f"- {w}" for w in warnings] or ["- none: every free parameter ends inside its bounds and measured range"]),
+        "",
+        "## Where the values of fitted.toml come from",
+        "",
+        *[f"- {p}" for p in provenance],
+        "",
+        *_derived_table(r),
         "",
         "## Parameters",
         "",
