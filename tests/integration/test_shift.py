@@ -59,6 +59,7 @@ def _edited(tmp_path: Path, edit) -> Path:
 
 def _without_shift_control(text: str) -> str:
     text = re.sub(r"(?m)^upshift_torque_reduction = .*\n", "upshift_torque_reduction = 0.0\n", text)
+    text = re.sub(r'(?m)^"gearbox.upshift_inertia_phase_s" = .*\n', "", text)
     return re.sub(r"(?m)^upshift_inertia_phase_s = .*\n", "", text)
 
 

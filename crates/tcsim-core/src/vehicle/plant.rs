@@ -231,7 +231,8 @@ impl<'a> Plant<'a> {
             Some(s) => {
                 let w = ((t - s.since_s) / gb.shift_handover_s).clamp(0.0, 1.0);
                 let c = gb.shift_clutch_capacity_nm;
-                let controlled = if s.to > s.from {
+                // power-on upshifts only: a coast upshift keeps the constant capacity
+                let controlled = if s.to > s.from && s.start_input_nm > 0.0 {
                     let phase = s.handed_over.then(|| InertiaPhase {
                         start_nm: s.start_input_nm,
                         step: gb.ratios[s.from] * gb.efficiencies[s.from] / gb.ratios[s.to],
@@ -270,7 +271,9 @@ impl<'a> Plant<'a> {
     fn engine_factor(&self, u: &Coords, t: f64) -> f64 {
         let gb = &self.v.gearbox;
         match self.mode.shift {
-            Some(s) if s.handed_over && s.to > s.from && self.sc.engine_torque_nm.is_none() => {
+            Some(s)
+                if s.handed_over && s.to > s.from && s.start_input_nm > 0.0 && self.sc.engine_torque_nm.is_none() =>
+            {
                 let whole = (gb.ratios[s.from] - gb.ratios[s.to]) * u[GEARBOX_OUT];
                 let slip = u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT];
                 let remaining = if whole > 0.0 { slip / whole } else { 0.0 };

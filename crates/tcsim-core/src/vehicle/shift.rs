@@ -22,9 +22,10 @@
 //!     over [`TORQUE_REDUCTION_RAMP_S`] and restored over the last [`TORQUE_RESTORE_SLIP`] of the
 //!     slip.
 //!
-//!   Without `upshift_inertia_phase_s` the on-coming capacity ramps to `shift_clutch_capacity_nm`
-//!   and stays there (the behaviour before shift control). Downshifts keep that constant capacity
-//!   and no torque reduction.
+//!   This is for power-on upshifts (input torque above 0 at the shift command). Without
+//!   `upshift_inertia_phase_s` the on-coming capacity ramps to `shift_clutch_capacity_nm` and stays
+//!   there (the behaviour before shift control). Coast upshifts and downshifts keep that constant
+//!   capacity and no torque reduction.
 
 use super::parameters::{field, Range};
 use crate::error::CoreResult;
