@@ -226,7 +226,8 @@ def test_a_tip_out_launch_brakes_the_engine_through_the_open_converter():
     for name, run in runs.items():
         f = run.frame
         assert (f["lockup_state"] == 0).all()
-        coast = f[(f["time_s"] > 6.1) & (f["speed_ratio"] > 1.0)]
+        # outside the upshifts the tip-out sets off (their on-coming clutch pulls the turbine down)
+        coast = f[(f["time_s"] > 6.1) & (f["speed_ratio"] > 1.0) & (f["shifting"] == 0)]
         assert len(coast) > 100, name  # the turbine overruns the engine after the tip-out
         # the engine is braked through the converter: until issue 11 the table still drove it on
         assert (coast["pump_torque_nm"] < 0).all(), (name, coast["pump_torque_nm"].max())

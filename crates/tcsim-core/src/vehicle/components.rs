@@ -157,6 +157,7 @@ mod tests {
             upshift_speed_full_pedal_m_s: vec![12.0, 24.0],
             downshift_speed_zero_pedal_m_s: vec![2.0, 5.0],
             downshift_speed_full_pedal_m_s: vec![8.0, 16.0],
+            shift_control: Default::default(),
         };
         g.validate().unwrap();
         assert_eq!((g.upshift_speed(0, 0.5), g.upshift_speed(1, 1.0), g.downshift_speed(2, 0.0)), (8.0, 24.0, 5.0));

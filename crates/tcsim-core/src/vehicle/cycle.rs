@@ -28,7 +28,7 @@
 //! booked at its event as in a launch.
 
 use super::components::brake_torque_nm;
-use super::launch::{event_kind, initial_mode, initial_state, pending_switch, switch, LaunchTrajectory};
+use super::launch::{event_kind, initial_mode, initial_state, pending_switch, switch_and_booking, LaunchTrajectory};
 use super::modes::{LockupState, VehicleEvent};
 use super::parameters::{Scenario, Vehicle};
 use super::plant::{kinetic_energy, LaunchSample, Plant};
@@ -388,8 +388,8 @@ fn run_step(
         };
         let Some((t_root, root, x)) = end else { unreachable!("handled above") };
         let mut next = plant.full(&x);
-        let (new_mode, new_sync) = switch(&plant, root, &mut next, t_root);
-        booked_before = Some(kinetic_energy(&plant, &next));
+        let (new_mode, new_sync, booked) = switch_and_booking(&plant, root, &mut next, t_root);
+        booked_before = Some(booked);
         traj.events.push(VehicleEvent { time_s: t_root, kind: event_kind(root, &new_mode), gear: new_mode.gear + 1 });
         events_in_step += 1;
         if events_in_step > options.max_events.min(MAX_EVENTS_PER_STEP) {

@@ -19,6 +19,7 @@ use serde::de::{self, DeserializeSeed, Deserializer, MapAccess, SeqAccess, Unexp
 use serde::{Deserialize, Serialize};
 
 use super::parameters::{field, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Tyres, Vehicle};
+use super::shift::ShiftControl;
 use crate::error::{CoreError, CoreResult};
 
 /// The sections of a vehicle file that hold the vehicle's values, in file order.
@@ -99,6 +100,14 @@ pub struct GearboxSection {
     pub shift_clutch_capacity_nm: f64,
     /// Torque handover time of a shift, s, > 0.
     pub shift_handover_s: f64,
+    /// Fraction of the engine's torque withheld in the inertia phase of an upshift, 0–0.9
+    /// ([`super::shift::TORQUE_REDUCTION`]); absent: 0.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upshift_torque_reduction: Option<f64>,
+    /// Target inertia phase of an upshift, s, 0.05–2 ([`super::shift::INERTIA_PHASE`]); absent: the
+    /// on-coming clutch keeps `shift_clutch_capacity_nm` ([`super::shift`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upshift_inertia_phase_s: Option<f64>,
     /// Vehicle speed of the upshift from gear k at zero pedal, m/s, > 0, gears − 1 values,
     /// strictly increasing.
     pub upshift_speed_zero_pedal_m_s: Vec<f64>,
@@ -243,6 +252,10 @@ impl VehicleFile {
                 upshift_speed_full_pedal_m_s: g.upshift_speed_full_pedal_m_s.clone(),
                 downshift_speed_zero_pedal_m_s: g.downshift_speed_zero_pedal_m_s.clone(),
                 downshift_speed_full_pedal_m_s: g.downshift_speed_full_pedal_m_s.clone(),
+                shift_control: ShiftControl {
+                    torque_reduction: g.upshift_torque_reduction.unwrap_or(0.0),
+                    inertia_phase_s: g.upshift_inertia_phase_s,
+                },
             },
             lockup: Lockup {
                 capacity_nm: l.capacity_nm,

@@ -89,7 +89,8 @@ pub(super) fn switch(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (Vehi
         Root::BrakeHold => m.wheels_held = true,
         Root::Upshift | Root::Downshift => {
             let to = if root == Root::Upshift { m.gear + 1 } else { m.gear - 1 };
-            m.shift = Some(Shift { from: m.gear, to, since_s: t, handed_over: false });
+            let start_input_nm = plant.gearbox_input_nm(u, t);
+            m.shift = Some(Shift { from: m.gear, to, since_s: t, handed_over: false, start_input_nm });
             // an engaging clutch restarts after an upshift; a downshift opens it
             if m.lockup != LockupState::Locked || root == Root::Downshift {
                 m.lockup = LockupState::Open;
@@ -99,6 +100,7 @@ pub(super) fn switch(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (Vehi
             let to = m.shift.map_or(m.gear, |s| s.to);
             let slip = u[TURBINE] - gb.ratios[to] * u[GEARBOX_OUT];
             if slip.abs() <= SYNC_SLIP_RAD_S {
+                *u = plant.lock_shift_clutch(u, gb.ratios[to]);
                 m.gear = to;
                 m.shift = None;
             } else {
@@ -108,6 +110,7 @@ pub(super) fn switch(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (Vehi
         }
         Root::ShiftSync => {
             if let Some(s) = m.shift {
+                *u = plant.lock_shift_clutch(u, gb.ratios[s.to]);
                 m.gear = s.to;
             }
             m.shift = None;
@@ -138,6 +141,17 @@ pub(super) fn switch(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (Vehi
 
 /// The name of the event `root` fired, given the mode it switched to (a handover that
 /// synchronised at once ends the shift; a ramp or an arming that locked locks).
+/// [`switch`] at `root`, and the kinetic energy from which the next mode's event loss is booked:
+/// a shift clutch's lock moves the state (its impulse), so the energy before it is booked; any
+/// other switch books from the energy after it.
+pub(super) fn switch_and_booking(plant: &Plant, root: Root, u: &mut Coords, t: f64) -> (VehicleMode, f64, f64) {
+    let before_switch = kinetic_energy(plant, u);
+    let (new_mode, new_sync) = switch(plant, root, u, t);
+    let shift_locks = matches!(root, Root::ShiftSync | Root::ShiftHandover) && new_mode.shift.is_none();
+    let booked = if shift_locks { before_switch } else { kinetic_energy(plant, u) };
+    (new_mode, new_sync, booked)
+}
+
 pub(super) fn event_kind(root: Root, new_mode: &VehicleMode) -> &'static str {
     match root {
         Root::ShiftHandover if new_mode.shift.is_none() => "shift-end",
@@ -276,8 +290,8 @@ pub fn simulate_launch(
         let plant = Plant::new(model, v, sc, mode, sync);
         let x0 = plant.state_of(&u);
         if let Some(before) = energy_before {
-            // a closing link removes kinetic energy (momentum is conserved); a change of the
-            // gearbox's inertia with the gear changes it too: both are booked here
+            // a closing link removes kinetic energy (momentum is conserved): the clutch's last slip,
+            // booked here; the gearbox's inertia is continuous through a shift (super::shift)
             traj.event_loss_j.push((t, before - kinetic_energy(&plant, &plant.full(&x0))));
         }
         let end = match pending_switch(&plant, &plant.full(&x0), t) {
@@ -293,8 +307,8 @@ pub fn simulate_launch(
                     traj.samples.push(plant.sample(&x, t_root));
                     return Ok(traj);
                 }
-                let (new_mode, new_sync) = switch(&plant, root, &mut next, t_root);
-                energy_before = Some(kinetic_energy(&plant, &next));
+                let (new_mode, new_sync, booked) = switch_and_booking(&plant, root, &mut next, t_root);
+                energy_before = Some(booked);
                 let kind = event_kind(root, &new_mode);
                 traj.events.push(VehicleEvent { time_s: t_root, kind, gear: new_mode.gear + 1 });
                 if traj.events.len() > options.max_events {

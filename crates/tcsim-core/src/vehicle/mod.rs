@@ -27,6 +27,7 @@
 //! * [`components`]: the physics of engine, gearbox, lock-up, driveline, tyres, body and brake.
 //! * [`modes`]: the discrete state (gear, shift, lock-up, brake hold) and the event kinds.
 //! * [`plant`]: the plant in one mode (mass matrix, generalised coordinates, forces, roots).
+//! * [`shift`]: the gearbox's inertia during a shift and the shift control of upshifts.
 //! * [`launch`]: the run loop of a launch, its initial state and its switches.
 //! * [`outputs`]: the output columns of a launch.
 //! * [`cycle`]: drive cycles, a driver following a speed trace with the same plant.
@@ -39,6 +40,7 @@ pub mod modes;
 pub mod outputs;
 pub mod parameters;
 pub mod plant;
+pub mod shift;
 
 /// Number of coordinates of the vehicle plant.
 pub const N_COORDS: usize = 12;

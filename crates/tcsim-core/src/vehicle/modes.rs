@@ -26,6 +26,9 @@ pub struct Shift {
     pub since_s: f64,
     /// The torque handover is over: the on-coming clutch has its full capacity.
     pub handed_over: bool,
+    /// The torque into the gearbox when the shift started, N·m (the on-coming clutch's feed-forward
+    /// in an upshift's inertia phase, [`super::shift`]).
+    pub start_input_nm: f64,
 }
 
 /// The discrete state of the vehicle in one smooth segment.

@@ -3,6 +3,7 @@
 //! checked here once; every error names the field as the file writes it (`[body].grade_percent`,
 //! `[gearbox].ratios[3]`). The physics that uses them is in [`super::components`].
 
+use super::shift::ShiftControl;
 use crate::engine::signal::Signal;
 use crate::error::{CoreError, CoreResult};
 
@@ -321,6 +322,8 @@ pub struct Gearbox {
     pub upshift_speed_full_pedal_m_s: Vec<f64>,
     pub downshift_speed_zero_pedal_m_s: Vec<f64>,
     pub downshift_speed_full_pedal_m_s: Vec<f64>,
+    /// Shift control of upshifts (torque reduction, on-coming clutch profile): [`super::shift`].
+    pub shift_control: ShiftControl,
 }
 
 impl Gearbox {
@@ -369,7 +372,7 @@ impl Gearbox {
         GEARBOX_OUTPUT_INERTIA.check(&f("output_inertia_kg_m2"), self.output_inertia_kg_m2)?;
         CLUTCH_CAPACITY.check(&f("shift_clutch_capacity_nm"), self.shift_clutch_capacity_nm)?;
         Range::POSITIVE.check(&f("shift_handover_s"), self.shift_handover_s)?;
-        Ok(())
+        self.shift_control.validate()
     }
 }
 

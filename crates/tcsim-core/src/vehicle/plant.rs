@@ -6,6 +6,7 @@ use super::modes::{
     LockupState, Root, VehicleMode, HOLD_SPEED_RAD_S, LOCKUP_RELEASE_FRACTION, REARM_DELAY_S, SYNC_SLIP_RAD_S,
 };
 use super::parameters::{Scenario, Vehicle};
+use super::shift::{shift_inertia_form, InertiaPhase};
 use super::{FRONT, GEARBOX_OUT, N_COORDS, REAR, SPEED, TORQUE_BOOST, TORQUE_FAST, TWIST_F, TWIST_R};
 use crate::converter::dynamics::{ConverterDynamics, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::{self, Sample as ConverterSample};
@@ -47,7 +48,8 @@ pub(super) struct Powers {
 }
 
 /// The full mass matrix of `mode`: the converter's, the engine on the pump, the gearbox input
-/// inertia of the (off-going) gear on the turbine, the driveline, the body, and unit rows for the
+/// inertia of the gear on the turbine (during a shift the form of [`shift_inertia_form`] on turbine
+/// and output), the driveline, the body, and unit rows for the
 /// first-order coordinates.
 fn mass_matrix(model: &dyn ConverterDynamics, v: &Vehicle, mode: VehicleMode) -> [[f64; N_COORDS]; N_COORDS] {
     let conv_mass = model.mass();
@@ -57,13 +59,22 @@ fn mass_matrix(model: &dyn ConverterDynamics, v: &Vehicle, mode: VehicleMode) ->
             mass[r][c] = conv_mass[r][c];
         }
     }
-    let gear_inertia = match mode.shift {
-        Some(s) => v.gearbox.input_inertia_kg_m2[s.from],
-        None => v.gearbox.input_inertia_kg_m2[mode.gear],
+    let gb = &v.gearbox;
+    // in gear: the gear's inertia at the input; shifting: the form that is each gear's on its line
+    let [a, b, c] = match mode.shift {
+        Some(s) => shift_inertia_form(
+            gb.input_inertia_kg_m2[s.from],
+            gb.ratios[s.from],
+            gb.input_inertia_kg_m2[s.to],
+            gb.ratios[s.to],
+        ),
+        None => [gb.input_inertia_kg_m2[mode.gear], 0.0, 0.0],
     };
     mass[PUMP][PUMP] += v.engine.inertia_kg_m2;
-    mass[TURBINE][TURBINE] += gear_inertia;
-    mass[GEARBOX_OUT][GEARBOX_OUT] = v.gearbox.output_inertia_kg_m2;
+    mass[TURBINE][TURBINE] += a;
+    mass[TURBINE][GEARBOX_OUT] = b;
+    mass[GEARBOX_OUT][TURBINE] = b;
+    mass[GEARBOX_OUT][GEARBOX_OUT] = gb.output_inertia_kg_m2 + c;
     mass[FRONT][FRONT] = v.driveline.axle_inertia_kg_m2[0];
     mass[REAR][REAR] = v.driveline.axle_inertia_kg_m2[1];
     mass[SPEED][SPEED] = v.body.mass_kg;
@@ -185,6 +196,24 @@ impl<'a> Plant<'a> {
         (0..self.n_states).map(|i| (0..self.n_states).map(|k| self.reduced_inv[i][k] * b[k]).sum()).collect()
     }
 
+    /// The coordinates once the on-coming clutch of a shift into `ratio` locks at the small slip
+    /// the sync threshold leaves: the clutch's impulse (back on the turbine, `ratio` times forward
+    /// on the output) with this mode's inertia, so the gearbox's momentum is conserved and the state
+    /// lands on the gear's line, where this mode's kinetic energy is the next mode's.
+    pub(super) fn lock_shift_clutch(&self, u: &Coords, ratio: f64) -> Coords {
+        let x = self.state_of(u);
+        let mut g = [0.0; N_COORDS];
+        g[TURBINE] = -1.0;
+        g[GEARBOX_OUT] = ratio;
+        let r = self.reduced_rhs(&g);
+        let dx: Vec<f64> =
+            (0..self.n_states).map(|i| (0..self.n_states).map(|k| self.reduced_inv[i][k] * r[k]).sum()).collect();
+        let (now, du) = (self.full(&x), self.full(&dx));
+        let per_impulse = du[TURBINE] - ratio * du[GEARBOX_OUT];
+        let impulse = -(now[TURBINE] - ratio * now[GEARBOX_OUT]) / per_impulse;
+        std::array::from_fn(|c| if self.links[c].is_some() { now[c] + impulse * du[c] } else { u[c] })
+    }
+
     pub(super) fn lockup_capacity(&self, t: f64) -> f64 {
         match self.mode.lockup {
             LockupState::Engaging { since_s, .. } => {
@@ -194,18 +223,78 @@ impl<'a> Plant<'a> {
         }
     }
 
-    fn shift_capacities(&self, t: f64) -> (f64, f64) {
+    /// Capacities of the off-going and on-coming clutches at `t`, N·m at the input, with the input
+    /// torque `input_nm` (the on-coming clutch's feed-forward in an upshift, [`super::shift`]).
+    fn shift_capacities(&self, u: &Coords, t: f64, input_nm: f64) -> (f64, f64) {
+        let gb = &self.v.gearbox;
         match self.mode.shift {
             Some(s) => {
-                let w = ((t - s.since_s) / self.v.gearbox.shift_handover_s).clamp(0.0, 1.0);
-                let c = self.v.gearbox.shift_clutch_capacity_nm;
-                (c * (1.0 - w), c * w)
+                let w = ((t - s.since_s) / gb.shift_handover_s).clamp(0.0, 1.0);
+                let c = gb.shift_clutch_capacity_nm;
+                // power-on upshifts only: a coast upshift keeps the constant capacity
+                let controlled = if s.to > s.from && s.start_input_nm > 0.0 {
+                    let phase = s.handed_over.then(|| InertiaPhase {
+                        start_nm: s.start_input_nm,
+                        step: gb.ratios[s.from] * gb.efficiencies[s.from] / gb.ratios[s.to],
+                        inertia_kg_m2: self.input_inertia(),
+                        slip_rad_s: (gb.ratios[s.from] - gb.ratios[s.to]) * u[GEARBOX_OUT],
+                        since_s: t - s.since_s - gb.shift_handover_s,
+                    });
+                    gb.shift_control.oncoming_capacity_nm(input_nm, phase.as_ref(), w, c)
+                } else {
+                    None
+                };
+                (c * (1.0 - w), controlled.unwrap_or(c * w))
             }
             None => (0.0, 0.0),
         }
     }
 
-    /// Forces `F(u, t)` and the power terms.
+    /// The torque into the gearbox at (u, t), N·m: the converter's turbine torque plus the lock-up
+    /// clutch's, or the engine's net torque when locked up (as the gear loss's `T_in`).
+    pub(super) fn gearbox_input_nm(&self, u: &Coords, t: f64) -> f64 {
+        if self.mode.lockup == LockupState::Locked {
+            return self.engine(u, t).0;
+        }
+        let fc = self.model.forces(&[u[0], u[1], u[2], u[3]], self.mode.converter.flow_sign);
+        fc[TURBINE] + lockup::slipping_torque_nm(self.lockup_capacity(t), u[PUMP] - u[TURBINE])
+    }
+
+    /// The input side's inertia in a shift (the turbine's own diagonal of `PᵀMP`: turbine, gear
+    /// input, and engine and pump when locked up), kg·m².
+    fn input_inertia(&self) -> f64 {
+        self.links[TURBINE].map_or(0.0, |(col, _)| self.reduced_mass[col][col])
+    }
+
+    /// The fraction of the engine's torque delivered at (u, t): less than 1 only in the inertia
+    /// phase of an upshift with torque reduction ([`super::shift`]).
+    fn engine_factor(&self, u: &Coords, t: f64) -> f64 {
+        let gb = &self.v.gearbox;
+        match self.mode.shift {
+            Some(s)
+                if s.handed_over && s.to > s.from && s.start_input_nm > 0.0 && self.sc.engine_torque_nm.is_none() =>
+            {
+                let whole = (gb.ratios[s.from] - gb.ratios[s.to]) * u[GEARBOX_OUT];
+                let slip = u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT];
+                let remaining = if whole > 0.0 { slip / whole } else { 0.0 };
+                gb.shift_control.engine_factor(t - s.since_s - gb.shift_handover_s, remaining)
+            }
+            _ => 1.0,
+        }
+    }
+
+    /// Net crank torque, the engine's power and its drag loss at (u, t), with the shift's torque
+    /// reduction ([`Scenario::engine`] otherwise).
+    fn engine(&self, u: &Coords, t: f64) -> (f64, f64, f64) {
+        let (net, power, drag_loss) = self.sc.engine(&self.v.engine, u, t);
+        let factor = self.engine_factor(u, t);
+        if factor == 1.0 {
+            return (net, power, drag_loss);
+        }
+        let withheld = (1.0 - factor) * (u[TORQUE_FAST] + u[TORQUE_BOOST]);
+        (net - withheld, power - withheld * u[PUMP], drag_loss)
+    }
+
     /// Forces `F(u, t)` and the power terms.
     fn forces(&self, u: &Coords, t: f64) -> (Coords, Powers) {
         let mut f = [0.0; N_COORDS];
@@ -230,7 +319,7 @@ impl<'a> Plant<'a> {
         }
         let wp = u[PUMP];
         let p = self.sc.accelerator_pedal.value(t);
-        let (net, engine_power, drag_loss) = self.sc.engine(&v.engine, u, t);
+        let (net, engine_power, drag_loss) = self.engine(u, t);
         f[PUMP] += net;
         *loss += drag_loss;
         let (fast, boost) = v.engine.targets(p, wp);
@@ -263,7 +352,8 @@ impl<'a> Plant<'a> {
                 *loss += t_loss * u[TURBINE];
             }
             Some(s) => {
-                let (c_off, c_on) = self.shift_capacities(t);
+                let input = if self.mode.lockup == LockupState::Locked { net } else { converter_output };
+                let (c_off, c_on) = self.shift_capacities(u, t, input);
                 let s_off = u[TURBINE] - gb.ratios[s.from] * u[GEARBOX_OUT];
                 let s_on = u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT];
                 let t_off = c_off * (s_off / CLUTCH_SLIP_RAD_S).tanh();
@@ -529,7 +619,7 @@ impl SmoothSegment for Plant<'_> {
             u_dot: ud,
             mode: self.mode,
             converter,
-            engine_torque_nm: self.sc.engine(&self.v.engine, &u, t).0,
+            engine_torque_nm: self.engine(&u, t).0,
             engine_power_w: powers.engine_w,
             loss_power_w: powers.loss_w,
             stored_energy_j: kinetic + spring,
