@@ -40,6 +40,7 @@ pub mod modes;
 pub mod outputs;
 pub mod parameters;
 pub mod plant;
+pub mod range;
 pub mod shift;
 
 /// Number of coordinates of the vehicle plant.

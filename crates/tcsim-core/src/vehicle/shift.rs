@@ -27,7 +27,7 @@
 //!   there (the behaviour before shift control). Coast upshifts and downshifts keep that constant
 //!   capacity and no torque reduction.
 
-use super::parameters::{field, Range};
+use super::range::{field, Range};
 use crate::error::CoreResult;
 
 /// `[gearbox].upshift_torque_reduction`: fraction of the engine's torque withheld in the inertia
