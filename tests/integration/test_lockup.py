@@ -202,7 +202,8 @@ def test_replay_bad_capacity_exits_2_with_one_line(cli, tmp_path, measurement, v
 LAUNCH_LOCKUP_EVENTS = {
     "table": [("lockup-engage", 10.507412218249746), ("lockup-lock", 11.007412218249746)],
     "hrovat-tobler": [("lockup-engage", 10.428803809532377), ("lockup-lock", 10.928803809532377)],
-    "quasi-dynamic": [("lockup-engage", 10.50814759154966), ("lockup-lock", 11.00814759154966)],
+    # issue 14: the vehicle's quasi-dynamic model has the thesis's shape effects (0.4/0.3 m², was 10.508/11.008 s)
+    "quasi-dynamic": [("lockup-engage", 10.56390945117239), ("lockup-lock", 11.06390945117239)],
 }
 
 
