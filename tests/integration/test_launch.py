@@ -297,7 +297,9 @@ def test_launch_summary_columns_and_values():
 
 def fake_launch_runs(models, vehicle, scenario, options, threads):
     """Results like the core's (``_core.LaunchRun``): a first-order acceleration whose lag grows with
-    the shape effect; ``fail_input`` in a model spec is the (source, field) of an input error."""
+    the shape effect; ``fail_input`` in a model spec is the (source, field) of an input error;
+    ``fail_solver`` in a model spec, or shape effects above 0.5 m² in all in a sweep (a scenario
+    shorter than 10 s: the bundled quasi-dynamic model's own 0.4 + 0.3 m² runs), a solver failure."""
     assert {"engine", "gearbox", "lockup", "driveline", "tyres", "body", "brake"} <= set(vehicle.to_dict())
     t = np.round(np.arange(0.0, scenario["end_time_s"] + 1e-9, 0.01), 9)
     acc_pedal = np.interp(t, scenario["time_s"], scenario["accelerator_pedal"])
@@ -306,7 +308,7 @@ def fake_launch_runs(models, vehicle, scenario, options, threads):
     out = []
     for m in models:
         shape = sum(abs(s) for s in m.get("shape_effect_m2", []))
-        if shape > 0.5:
+        if m.get("fail_solver") or (shape > 0.5 and scenario["end_time_s"] < 10.0):
             out.append(_core.LaunchRun(error=_core.RunError("solver", "step size too small at t = 5.12 s")))
             continue
         if m.get("fail_input"):
@@ -380,7 +382,8 @@ def test_run_launch_errors(fake_core, vehicle, monkeypatch):
     with pytest.raises(InputError) as err:
         run_launch(vehicle, scen, [bad_model])
     assert err.value.source == table.source
-    qd = dynamic_model(vehicle.converter, "quasi-dynamic").with_shape_effects(0.4, 0.3)
+    qd = dynamic_model(vehicle.converter, "quasi-dynamic")
+    qd = type(qd)(qd.name, {**qd.spec, "fail_solver": True}, qd.source)
     with pytest.raises(SolverError, match="t = 5.12 s"):
         run_launch(vehicle, scen, [table, qd])
     with pytest.warns(TcsimWarning, match="left out"):
@@ -593,13 +596,21 @@ def test_cli_launch_scenario_file(cli, tmp_path):
     assert f.vehicle_speed_m_s[f.time_s < 1.0].abs().max() < 1e-3
 
 
-def test_models_rejoin_in_torque_ratio_and_energy_balances(flip_flop_runs):
-    """Thesis §3.2.2: after the dip the three models come within 5 % in TR within about 1 s; and the
-    engine's work is the kinetic and spring energy plus every modelled loss (1e-3)."""
+@pytest.mark.xfail(
+    strict=True,
+    reason="issue 14: with the thesis's S_p = 0.4, S_t = 0.3 m² the quasi-dynamic model's effective TR overshoots "
+    "the table's by up to 0.19 near the coupling point (docs/models.md, 'Shape effects near the coupling point')",
+)
+def test_models_rejoin_in_torque_ratio(flip_flop_runs):
+    """Thesis §3.2.2: after the dip the three models come within 5 % in TR within about 1 s."""
     release = 5.0
     for dt in (1.0, 1.2, 1.5):
         tr = [np.interp(release + dt, f.time_s, f.effective_torque_ratio) for f in flip_flop_runs.values()]
         assert (max(tr) - min(tr)) / abs(tr[0]) < 0.05, (dt, tr)
+
+
+def test_energy_balances(flip_flop_runs):
+    """The engine's work is the kinetic and spring energy plus every modelled loss (1e-3)."""
     for name, f in flip_flop_runs.items():
         t = f.time_s.to_numpy()
         engine = np.trapezoid(f.engine_power_w, t)

@@ -202,8 +202,10 @@ def test_replay_bad_capacity_exits_2_with_one_line(cli, tmp_path, measurement, v
 # control, whose longer upshifts (0.73-0.77 s) move the engagement after the 2-3 upshift by 0.38 s.
 LAUNCH_LOCKUP_EVENTS = {
     "table": [("lockup-engage", 10.890870033058132), ("lockup-lock", 11.390870033058132)],
-    "hrovat-tobler": [("lockup-engage", 10.826745429756809), ("lockup-lock", 11.326745429756809)],
-    "quasi-dynamic": [("lockup-engage", 10.891168693272322), ("lockup-lock", 11.391168693272322)],
+    # issue 14: the fitted converter's derived geometry recomputed from its angles (was 10.8267/11.3267 s)
+    "hrovat-tobler": [("lockup-engage", 10.827781611592133), ("lockup-lock", 11.327781611592133)],
+    # issue 14: the vehicle's quasi-dynamic model has the thesis's shape effects (0.4/0.3 m², was 10.891/11.391 s)
+    "quasi-dynamic": [("lockup-engage", 10.90043232587722), ("lockup-lock", 11.40043232587722)],
 }
 
 

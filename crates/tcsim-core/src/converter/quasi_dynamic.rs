@@ -3,8 +3,10 @@
 use super::dynamics::{
     table_steady, table_torques, ConverterDynamics, Inertias, Mat4, SteadyPoint, Vec4, FLOW, PUMP, TURBINE,
 };
+use super::table::{Characteristic, Region};
 use super::torque_capacity::TorqueCharacteristic;
 use crate::error::{CoreError, CoreResult};
+use crate::interp;
 
 /// tcsim's quasi-dynamic model: the steady-state tables plus fluid inertia (physics notes §5;
 /// derivation in docs/models.md). States ω_p, ω_t, Q:
@@ -23,6 +25,12 @@ use crate::error::{CoreError, CoreResult};
 /// `Q_ss` is the Euler-equation flow that carries the table's pump torque with the fluid leaving
 /// the pump at `R_p` and entering it with no swirl. At steady state Q̇ = 0, so the torques are the
 /// table's whatever the shape effects; with S = 0 the flow does not act on the speeds at all.
+///
+/// Within a single table's rows `Q_ss` uses the C¹ monotone cubic (Fritsch–Carlson) interpolant of
+/// CF through the rows ([`smooth_capacity`]), not the table's piecewise-linear CF: `Q̇` follows the
+/// slope of CF, so a slope that jumps at a row (5× at the coupling point of Table C.1) steps the
+/// fluid torques `ρS Q̇` and rings the driveline (docs/models.md, "Steady flow: a C¹ interpolation of CF").
+/// The torques stay the table's; at steady state nothing changes.
 #[derive(Debug, Clone)]
 pub struct QuasiDynamics {
     /// One table, or several measured at different input torques (the pump torque solved).
@@ -62,13 +70,61 @@ impl QuasiDynamics {
         1.0 / (self.fluid_density_kg_m3 * self.pump_radius_m * self.pump_radius_m)
     }
 
-    /// Steady flow Q_ss and its gradient with respect to (ω_p, ω_t).
+    /// Steady flow Q_ss and its gradient with respect to (ω_p, ω_t): the table's flow, with CF
+    /// from [`smooth_capacity`] where a single table is pump-referred within its rows.
     fn steady_flow(&self, wp: f64, wt: f64) -> (f64, [f64; 2]) {
         let t = self.characteristic.torques(wp, wt);
         let k = self.flow_scale();
+        if t.region == Region::Pump {
+            if let Some((cf, dcf)) = self.characteristic.single().and_then(|c| smooth_capacity(c, wt / wp)) {
+                let (speed, dsr) = (wp.abs(), [-wt / (wp * wp), 1.0 / wp]);
+                let d_flow = [dcf * dsr[0] * speed + cf * wp.signum(), dcf * dsr[1] * speed];
+                return (k * cf * speed, [k * d_flow[0], k * d_flow[1]]);
+            }
+        }
         // (k·factor)·speed, the arithmetic of the drive-only model before issue 11, bit for bit
         (k * t.flow_factor * t.flow_speed, [k * t.d_flow[0], k * t.d_flow[1]])
     }
+}
+
+/// CF and dCF/dSR at `sr` from the monotone piecewise-cubic Hermite interpolant of the table's
+/// rows (Fritsch & Carlson 1980, with the Fritsch–Butland weighted harmonic mean of the adjacent
+/// secants as the slope at an interior row, zero where they differ in sign, and the end secant at
+/// the first and last rows): C¹, equal to CF at every row, monotone where the rows are. None
+/// outside the rows (the table's held or turbine-referred values apply there).
+pub fn smooth_capacity(c: &Characteristic, sr: f64) -> Option<(f64, f64)> {
+    let (x, y) = (c.speed_ratio(), c.capacity_factor_nm_s2());
+    let n = x.len();
+    if !(sr >= x[0] && sr <= x[n - 1]) {
+        return None;
+    }
+    let secant = |j: usize| (y[j] - y[j - 1]) / (x[j] - x[j - 1]);
+    let slope = |j: usize| {
+        if j == 0 {
+            return secant(1);
+        }
+        if j == n - 1 {
+            return secant(n - 1);
+        }
+        let (d0, d1) = (secant(j), secant(j + 1));
+        if d0 * d1 <= 0.0 {
+            return 0.0;
+        }
+        let (h0, h1) = (x[j] - x[j - 1], x[j + 1] - x[j]);
+        let (w0, w1) = (2.0 * h1 + h0, h1 + 2.0 * h0);
+        (w0 + w1) / (w0 / d0 + w1 / d1)
+    };
+    let (i, t) = interp::segment(x, sr);
+    let h = x[i] - x[i - 1];
+    let (m0, m1) = (slope(i - 1) * h, slope(i) * h);
+    let (t2, t3) = (t * t, t * t * t);
+    let cf = (2.0 * t3 - 3.0 * t2 + 1.0) * y[i - 1]
+        + (t3 - 2.0 * t2 + t) * m0
+        + (3.0 * t2 - 2.0 * t3) * y[i]
+        + (t3 - t2) * m1;
+    let dcf =
+        ((6.0 * t2 - 6.0 * t) * (y[i - 1] - y[i]) + (3.0 * t2 - 4.0 * t + 1.0) * m0 + (3.0 * t2 - 2.0 * t) * m1) / h;
+    Some((cf, dcf))
 }
 
 impl ConverterDynamics for QuasiDynamics {
@@ -122,5 +178,74 @@ impl ConverterDynamics for QuasiDynamics {
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         let tp = table_steady(&self.characteristic, wp, wt)?;
         Ok(SteadyPoint { u: [wp, wt, 0.0, self.steady_flow(wp, wt).0], pump_torque_nm: tp })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn c1() -> Characteristic {
+        Characteristic::new(
+            vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
+            vec![2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
+            vec![
+                3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3,
+                1.842e-3, 1.237e-3, 0.187e-3,
+            ],
+        )
+        .unwrap()
+    }
+
+    fn qd(characteristic: TorqueCharacteristic) -> QuasiDynamics {
+        QuasiDynamics {
+            characteristic,
+            inertia: Inertias::new(0.109, 0.056, 0.01).unwrap(),
+            fluid_density_kg_m3: 840.0,
+            pump_radius_m: 0.12,
+            pump_shape_effect_m2: 0.4,
+            turbine_shape_effect_m2: 0.3,
+            flow_time_constant_s: 0.0029,
+        }
+    }
+
+    /// The smooth CF is the table's at every row, monotone between rows where the rows are, and
+    /// its slope is continuous at every interior row.
+    #[test]
+    fn smooth_capacity_passes_the_rows_monotone_and_c1() {
+        let c = c1();
+        let (x, y) = (c.speed_ratio().to_vec(), c.capacity_factor_nm_s2().to_vec());
+        for (xi, yi) in x.iter().zip(&y) {
+            assert_eq!(smooth_capacity(&c, *xi).unwrap().0, *yi, "row SR {xi}");
+        }
+        for i in 1..x.len() {
+            let (lo, hi) = (y[i - 1].min(y[i]), y[i - 1].max(y[i]));
+            for k in 1..50 {
+                let cf = smooth_capacity(&c, x[i - 1] + (x[i] - x[i - 1]) * k as f64 / 50.0).unwrap().0;
+                assert!(cf >= lo - 1e-15 && cf <= hi + 1e-15, "CF {cf} outside [{lo}, {hi}] in segment {i}");
+            }
+        }
+        for xi in &x[1..x.len() - 1] {
+            let (left, right) = (smooth_capacity(&c, xi - 1e-9).unwrap().1, smooth_capacity(&c, xi + 1e-9).unwrap().1);
+            assert!((left - right).abs() <= 1e-6 * left.abs().max(1e-6), "dCF/dSR jumps at SR {xi}: {left} {right}");
+        }
+        assert!(smooth_capacity(&c, -1e-9).is_none() && smooth_capacity(&c, 1.0 + 1e-9).is_none());
+    }
+
+    /// The gradient of the steady flow, which sets Q̇ and the fluid torques, is continuous across
+    /// the coupling point of Table C.1 (SR 0.85), where the table's CF slope jumps from −2.2e-3 to
+    /// −10.6e-3: it jumped by that factor with the linear CF (the ringing of issue 14).
+    #[test]
+    fn steady_flow_gradient_is_continuous_at_the_table_kink() {
+        let m = qd(c1().into());
+        let wp = 360.0;
+        let (_, left) = m.steady_flow(wp, wp * (0.85 - 1e-9));
+        let (_, right) = m.steady_flow(wp, wp * (0.85 + 1e-9));
+        for j in 0..2 {
+            assert!((left[j] - right[j]).abs() <= 1e-6 * left[j].abs(), "dQ_ss/dω[{j}]: {} vs {}", left[j], right[j]);
+        }
+        // and the flow is the table's at the rows (steady state unchanged)
+        let t = c1().torques(wp, wp * 0.85);
+        assert_eq!(m.steady_flow(wp, wp * 0.85).0, m.flow_scale() * t.flow_factor * t.flow_speed);
     }
 }
