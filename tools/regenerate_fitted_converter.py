@@ -28,14 +28,7 @@ TARGET = "tests/data/converters/li_sunden_2016_table_c1.csv"
 OUT = ROOT / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016-fitted.toml"
 TABLE_SOURCE = f"Li & Sundén (2016) Table C.1 (tcsim repository: {TARGET})"
 NAME = "li-sunden-2016-fitted"
-#: The quasi-dynamic model's shape effects that matched the thesis's take-off measurements best
-#: (calibration constants, not geometry: m² by eqs 2.16-2.17), set over what the fit takes from
-#: the start converter, so that the bundled launch compares the models as the thesis did.
-THESIS_QUASI_DYNAMIC = {"pump_shape_effect_m2": 0.4, "turbine_shape_effect_m2": 0.3}
-THESIS_QUASI_DYNAMIC_SOURCE = (
-    "Li & Sundén (2016), §4.1 (p. 43) and figures 4.1, 4.3: {name} = {value}, the best match of the Drenth "
-    "(quasi-dynamic) model to the take-off measurements (set by tools/regenerate_fitted_converter.py)"
-)
+
 
 
 def _replace(value, old: str, new: str):
@@ -54,17 +47,6 @@ def main() -> int:
     provenance = [ln for ln in text.splitlines() if ln.startswith("# - ")]
     doc = _replace(tomllib.loads(text), TARGET, TABLE_SOURCE)
     doc["name"] = NAME
-    doc["quasi_dynamic"].update(THESIS_QUASI_DYNAMIC)
-    for key, value in THESIS_QUASI_DYNAMIC.items():
-        name = {"pump_shape_effect_m2": "Sp", "turbine_shape_effect_m2": "St"}[key]
-        doc["sources"][f"quasi_dynamic.{key}"] = THESIS_QUASI_DYNAMIC_SOURCE.format(name=name, value=value)
-    provenance = [
-        "# - [quasi_dynamic]: the thesis's best-match shape effects Sp = 0.4, St = 0.3 m² (§4.1, p. 43, figs 4.1 "
-        "and 4.3), set by this tool over the start converter's"
-        if ln.startswith("# - [quasi_dynamic]")
-        else ln
-        for ln in provenance
-    ]
     header = [
         "# The li-sunden-2016 converter with its Hrovat & Tobler [geometry] angles and losses fitted to its",
         f"# own characteristic (Table C.1) by `tcsim fit li-sunden-2016 --target {TARGET}`,",
