@@ -41,7 +41,7 @@ def plot_characteristic(
         fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
         for i, (name, df) in enumerate(curves.items()):
             y = np.where(np.isfinite(df[column].to_numpy(dtype=float)), df[column].to_numpy(dtype=float), np.nan)
-            ax.plot(df["speed_ratio"], y, **model_line(name, i, label=mpl_text(name)))
+            ax.plot(df["speed_ratio"], y, **model_line(name, i, label=mpl_text(name), y=y))
         if ref is not None:
             y = ref[column].to_numpy(dtype=float)
             y = np.where(np.isfinite(y), y, np.nan)

@@ -66,7 +66,7 @@ def plot_channel(
         ax.plot(time_s, measured, color="k", lw=1.6, label="measurement")
     for i, (name, result) in enumerate(runs.items()):
         y = np.asarray(result[channel], dtype=float)
-        ax.plot(result["time_s"], y, **model_line(name, i, label=mpl_text(f"{name} model")))
+        ax.plot(result["time_s"], y, **model_line(name, i, label=mpl_text(f"{name} model"), y=y))
     ax.set_ylabel(label)
     title = f"{label.split(' [')[0]} ({note})" + ("" if measured is not None else ", not measured")
     return finish_figure(fig, ax, out_dir / filename, title)

@@ -26,6 +26,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 #: Okabe & Ito colours by name.
 OKABE_ITO = {
     "black": "#000000",
@@ -99,6 +101,13 @@ def model_style(name: str, index: int = 0) -> ModelStyle:
     )
 
 
-def model_line(name: str, index: int = 0, label: str | None = None) -> dict[str, Any]:
-    """``Axes.plot`` keyword arguments of the line named ``name`` (see :func:`model_style`)."""
-    return model_style(name, index).line_kwargs(label)
+def model_line(name: str, index: int = 0, label: str | None = None, y: Any = None) -> dict[str, Any]:
+    """``Axes.plot`` keyword arguments of the line named ``name`` (see :func:`model_style`). Given the
+    line's values ``y``, a line without a finite value has no markers: matplotlib (3.10) fails to draw
+    a fractional ``markevery`` on it (an IndexError that ended ``tcsim characterise`` of a fitted
+    converter whose Hrovat & Tobler characteristic has no steady state)."""
+    kw = model_style(name, index).line_kwargs(label)
+    if y is not None and not np.isfinite(np.asarray(y, dtype=float)).any():
+        for key in ("marker", "markevery", "ms", "mfc", "mew"):
+            kw.pop(key, None)
+    return kw
