@@ -30,7 +30,6 @@ TABLE_SOURCE = f"Li & Sundén (2016) Table C.1 (tcsim repository: {TARGET})"
 NAME = "li-sunden-2016-fitted"
 
 
-
 def _replace(value, old: str, new: str):
     if isinstance(value, str):
         return value.replace(old, new)
