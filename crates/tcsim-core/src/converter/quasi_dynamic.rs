@@ -184,18 +184,7 @@ impl ConverterDynamics for QuasiDynamics {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn c1() -> Characteristic {
-        Characteristic::new(
-            vec![0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.85, 0.9, 0.95, 1.0],
-            vec![2.14, 1.99, 1.84, 1.70, 1.56, 1.43, 1.30, 1.18, 1.06, 1.00, 1.00, 1.00, 1.00],
-            vec![
-                3.272e-3, 3.257e-3, 3.228e-3, 3.181e-3, 3.112e-3, 3.017e-3, 2.887e-3, 2.713e-3, 2.481e-3, 2.370e-3,
-                1.842e-3, 1.237e-3, 0.187e-3,
-            ],
-        )
-        .unwrap()
-    }
+    use crate::converter::dynamics::tests::c1;
 
     fn qd(characteristic: TorqueCharacteristic) -> QuasiDynamics {
         QuasiDynamics {
