@@ -596,11 +596,6 @@ def test_cli_launch_scenario_file(cli, tmp_path):
     assert f.vehicle_speed_m_s[f.time_s < 1.0].abs().max() < 1e-3
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 14: with the thesis's S_p = 0.4, S_t = 0.3 m² the quasi-dynamic model's effective TR overshoots "
-    "the table's by up to 0.19 near the coupling point (docs/models.md, 'Shape effects near the coupling point')",
-)
 def test_models_rejoin_in_torque_ratio(flip_flop_runs):
     """Thesis §3.2.2: after the dip the three models come within 5 % in TR within about 1 s."""
     release = 5.0
