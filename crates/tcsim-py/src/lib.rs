@@ -1107,11 +1107,12 @@ fn scenario_from(d: &Bound<'_, PyDict>) -> PyResult<Scenario> {
 
 fn launch_run(
     py: Python<'_>,
+    names: &[&'static str],
     r: tcsim_core::engine::options::TransientResult<(Vec<Vec<f64>>, Vec<tcsim_core::vehicle::modes::VehicleEvent>)>,
 ) -> PyResult<LaunchRun> {
     Ok(match r {
         Ok((cols, events)) => LaunchRun {
-            columns: column_dict(py, &launch_column_names(), cols)?,
+            columns: column_dict(py, names, cols)?,
             events: events
                 .iter()
                 .map(|e| Py::new(py, LaunchEvent::new(e.time_s, e.kind.into(), e.gear)))
@@ -1168,7 +1169,8 @@ fn launch_runs<'py>(
             .into_iter()
             .collect::<Option<Vec<_>>>()
         })?;
-        results.into_iter().map(|r| launch_run(py, r)).collect()
+        let names = launch_column_names();
+        results.into_iter().map(|r| launch_run(py, &names, r)).collect()
     })
 }
 
@@ -1232,26 +1234,8 @@ fn drive_runs<'py>(
             .into_iter()
             .collect::<Option<Vec<_>>>()
         })?;
-        results
-            .into_iter()
-            .map(|r| {
-                Ok(match r {
-                    Ok((cols, events)) => LaunchRun {
-                        columns: column_dict(py, &drive_column_names(), cols)?,
-                        events: events
-                            .iter()
-                            .map(|e| Py::new(py, LaunchEvent::new(e.time_s, e.kind.into(), e.gear)))
-                            .collect::<PyResult<_>>()?,
-                        error: None,
-                    },
-                    Err(e) => LaunchRun {
-                        columns: PyDict::new(py).unbind(),
-                        events: vec![],
-                        error: Some(Py::new(py, RunError::from_core(e))?),
-                    },
-                })
-            })
-            .collect()
+        let names = drive_column_names();
+        results.into_iter().map(|r| launch_run(py, &names, r)).collect()
     })
 }
 

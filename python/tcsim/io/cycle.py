@@ -19,7 +19,7 @@ import pandas as pd
 
 from ..analysis.drive import BUNDLED_CYCLES, Cycle, Drive
 from ..errors import InputError
-from .measurement import check_finite, check_increasing, check_numeric, reader_for, refuse_duplicates
+from .measurement import check_column, reader_for, refuse_duplicates
 from .results import write_frames
 
 _REQUIRED = ("time_s", "vehicle_speed_m_s")
@@ -64,13 +64,8 @@ def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
     out: dict[str, np.ndarray] = {}
     time_s = None
     for column in picker.found:
-        values = np.asarray(raw[column])
-        if len(values) != n:
-            raise InputError(str(path), column, f"{len(values)} samples", f"as many as time_s ({n})")
-        values = check_numeric(path, column, values, time_s)
-        check_finite(path, column, values, time_s)
+        values = check_column(path, column, raw[column], n, "time_s", time_s, column == "time_s")
         if column == "time_s":
-            check_increasing(path, column, values)
             time_s = values
         out[column] = values
     return Cycle(

@@ -470,6 +470,22 @@ def _at(row: int, time_s: np.ndarray | None) -> str:
     return f"row {row + 1}" + (f" (time_s {time_s[row]:g})" if time_s is not None else "")
 
 
+def check_column(
+    path: Path, column: str, values, n: int, time_column: str, time_s: np.ndarray | None, is_time: bool
+) -> np.ndarray:
+    """One column of a time table as float64: ``n`` samples (as many as ``time_column``), real
+    numbers, finite, and strictly increasing if it is the time; else an InputError naming the first
+    bad value (the one check of measurements, scenarios and drive cycles)."""
+    values = np.asarray(values)
+    if len(values) != n:
+        raise InputError(str(path), column, f"{len(values)} samples", f"as many as {time_column} ({n})")
+    values = check_numeric(path, column, values, time_s)
+    check_finite(path, column, values, time_s)
+    if is_time:
+        check_increasing(path, column, values)
+    return values
+
+
 def check_numeric(path: Path, column: str, values: np.ndarray, time_s: np.ndarray | None) -> np.ndarray:
     """``values`` as float64, or an InputError naming the first value that is not a real number
     (text, a boolean, a date, a list or a structure of a Parquet column, a complex number)."""
@@ -605,14 +621,8 @@ def read_measurement(
         raise InputError(str(path), time_column, f"{n} rows", "at least 2 data rows")
     out: dict[str, np.ndarray] = {}
     for p in picker.picks:  # time first
-        values = np.asarray(raw[p.column])
-        if len(values) != n:
-            raise InputError(str(path), p.column, f"{len(values)} samples", f"as many as {time_column} ({n})")
         time_s = out.get("time_s")
-        values = check_numeric(path, p.column, values, time_s)
-        check_finite(path, p.column, values, time_s)
-        if p.canonical == "time_s":
-            check_increasing(path, p.column, values)
+        values = check_column(path, p.column, raw[p.column], n, time_column, time_s, p.canonical == "time_s")
         unit = units.get(p.column, "").strip()
         factor = _unit_factor(path, p.column, unit, p.canonical) if unit else p.name_factor
         if factor != 1.0:

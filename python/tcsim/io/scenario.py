@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import InputError
 from ..models.plausibility import check_plausible
 from ..simulation.scenarios import Scenario, brake_release_time, flip_flop, part_pedal
-from .measurement import check_finite, check_increasing, check_numeric, reader_for, refuse_duplicates
+from .measurement import check_column, reader_for, refuse_duplicates
 
 _PEDALS = ("accelerator_pedal", "brake_pedal")
 _TIME_COLUMNS = {"time_s": 1.0, "time_ms": 1e-3}
@@ -93,13 +93,7 @@ def read_scenario(
     time_s = None
     for canonical in ("time_s", *_PEDALS, *(["engine_torque_nm"] if "engine_torque_nm" in picker.picks else [])):
         column, factor = picker.picks[canonical]
-        values = np.asarray(raw[column])
-        if len(values) != n:
-            raise InputError(str(path), column, f"{len(values)} samples", f"as many as {time_column} ({n})")
-        values = check_numeric(path, column, values, time_s)
-        check_finite(path, column, values, time_s)
-        if canonical == "time_s":
-            check_increasing(path, column, values)
+        values = check_column(path, column, raw[column], n, time_column, time_s, canonical == "time_s")
         unit_factor = _unit_scale(path, column, units.get(column, ""), canonical == "time_s")
         scale = unit_factor if unit_factor is not None else factor
         if canonical == "engine_torque_nm":
