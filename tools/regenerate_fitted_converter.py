@@ -28,6 +28,24 @@ TARGET = "tests/data/converters/li_sunden_2016_table_c1.csv"
 OUT = ROOT / "python" / "tcsim" / "data" / "converters" / "li-sunden-2016-fitted.toml"
 TABLE_SOURCE = f"Li & Sundén (2016) Table C.1 (tcsim repository: {TARGET})"
 NAME = "li-sunden-2016-fitted"
+#: The quasi-dynamic model's shape effects that matched the thesis's take-off measurements best
+#: (calibration constants, not geometry: m² by eqs 2.16-2.17), set over what the fit takes from
+#: the start converter, so that the bundled launch compares the models as the thesis did.
+THESIS_QUASI_DYNAMIC = {"pump_shape_effect_m2": 0.4, "turbine_shape_effect_m2": 0.3}
+THESIS_QUASI_DYNAMIC_SOURCE = (
+    "Li & Sundén (2016), §4.1 (p. 43) and figures 4.1, 4.3: {name} = {value}, the best match of the Drenth "
+    "(quasi-dynamic) model to the take-off measurements (set by tools/regenerate_fitted_converter.py)"
+)
+#: The flow time constant that goes with them (the thesis gives none): calibrated so that the
+#: effective TR recovers to the table's within about a second (physics notes §5, property 4); the
+#: bundled launch meets the issue-14 criteria for 0.23-0.44 s (docs/models.md, "Shape effects:
+#: the thesis's best match").
+FLOW_TIME_CONSTANT_S = 0.35
+FLOW_TIME_CONSTANT_SOURCE = (
+    "assumed, calibrated: with the thesis's shape effects the effective TR dips at least 0.15 below the table's in "
+    "the first 0.5 s of the bundled launch and rejoins it within 0.05 from 1.2 s for 0.23-0.44 s (docs/models.md; "
+    "set by tools/regenerate_fitted_converter.py); the torus estimate at stall and 2000 rpm is 2.9 ms"
+)
 
 
 def _replace(value, old: str, new: str):
@@ -46,6 +64,19 @@ def main() -> int:
     provenance = [ln for ln in text.splitlines() if ln.startswith("# - ")]
     doc = _replace(tomllib.loads(text), TARGET, TABLE_SOURCE)
     doc["name"] = NAME
+    doc["quasi_dynamic"].update(THESIS_QUASI_DYNAMIC)
+    for key, value in THESIS_QUASI_DYNAMIC.items():
+        name = {"pump_shape_effect_m2": "Sp", "turbine_shape_effect_m2": "St"}[key]
+        doc["sources"][f"quasi_dynamic.{key}"] = THESIS_QUASI_DYNAMIC_SOURCE.format(name=name, value=value)
+    doc["quasi_dynamic"]["flow_time_constant_s"] = FLOW_TIME_CONSTANT_S
+    doc["sources"]["quasi_dynamic.flow_time_constant_s"] = FLOW_TIME_CONSTANT_SOURCE
+    provenance = [
+        "# - [quasi_dynamic]: the thesis's best-match shape effects Sp = 0.4, St = 0.3 m² (§4.1, p. 43, figs 4.1 "
+        "and 4.3) and a calibrated flow time constant of 0.35 s, set by this tool over the start converter's"
+        if ln.startswith("# - [quasi_dynamic]")
+        else ln
+        for ln in provenance
+    ]
     header = [
         "# The li-sunden-2016 converter with its Hrovat & Tobler [geometry] angles and losses fitted to its",
         f"# own characteristic (Table C.1) by `tcsim fit li-sunden-2016 --target {TARGET}`,",

@@ -527,7 +527,7 @@ const SCALAR_DESCRIPTIONS: [(&str, &str); 4] = [
     ("fluid_length_m", "Mean length L_f of the fluid path around the torus"),
     ("fluid_density_kg_m3", "Fluid density (flow estimate of the quasi-dynamic model)"),
     ("pump_exit_radius_m", "Pump exit radius (flow estimate of the quasi-dynamic model)"),
-    ("flow_time_constant_s", "Time constant tau_Q of the flow lag (quasi-dynamic model)"),
+    ("flow_time_constant_s", "Time constant tau_Q of the flow lag at stall and 2000 rpm (quasi-dynamic model)"),
 ];
 
 fn lookup(table: &[(&'static str, &'static str)], key: &str) -> Option<&'static str> {

@@ -1330,6 +1330,18 @@ fn mass_matrix_bound<'py>(
     })
 }
 
+/// The quasi-dynamic model's turbine stability bound on τ_Q, s, for a model spec dict (kind
+/// `quasi-dynamic`; `QuasiDynamics::coupling_time_constant_bound_s`): the smallest
+/// `flow_time_constant_s` for which the turbine alone keeps a positive effective inertia through the
+/// flow's lag near coupling (0: none needed; infinite: none suffices).
+#[pyfunction]
+fn qd_coupling_time_constant_bound_s(spec: &Bound<'_, PyDict>) -> PyResult<f64> {
+    guard(|| {
+        let m = tcsim_core::converter::spec::quasi_dynamic_model(&DictSpec(spec)).map_err(input_error)?;
+        Ok(m.coupling_time_constant_bound_s())
+    })
+}
+
 /// Codes of the `stator_mode` column of `ht_steady_states` and their names: `{0: "locked",
 /// 1: "free-wheeling", 2: "no-flow", -1: "no-steady-state"}`. Replaces the former Python `STATOR_MODES` table
 /// and the bare `mode == 2` of `steady.py` and `study.py`.
@@ -1383,6 +1395,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(input_sources, m)?)?;
     m.add_function(wrap_pyfunction!(capacity_conventions, m)?)?;
     m.add_function(wrap_pyfunction!(default_flow_time_constant_s, m)?)?;
+    m.add_function(wrap_pyfunction!(qd_coupling_time_constant_bound_s, m)?)?;
     m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
     m.add_function(wrap_pyfunction!(lockup_limits, m)?)?;
     m.add_function(wrap_pyfunction!(plausibility_ranges, m)?)?;

@@ -144,7 +144,7 @@ def run_drive(
         result = _unpack(run, model.name, files)
         if not isinstance(result, DriveRun):
             raise result
-        model.warn_if_extended({str(k): v for k, v in result.frame.items()}, f"the drive run {model.name!r}")
+        model.warn_about_run({str(k): v for k, v in result.frame.items()}, f"the drive run {model.name!r}")
         out[model.name] = result
     return out
 

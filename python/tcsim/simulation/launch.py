@@ -118,7 +118,7 @@ def run_launch(
     out: dict[str, LaunchRun] = {}
     for name, model, run, result in zip(names, models, raw, results):
         if isinstance(result, LaunchRun):
-            model.warn_if_extended({str(k): v for k, v in result.frame.items()}, f"the launch run {name!r}")
+            model.warn_about_run({str(k): v for k, v in result.frame.items()}, f"the launch run {name!r}")
             out[name] = result
             continue
         text = f"solver: {run.error.message}" if isinstance(result, SolverError) and run.error else str(result)

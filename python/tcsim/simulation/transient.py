@@ -116,7 +116,7 @@ def _unpack(
                 f"a drive whose run stays finite (it overflows at t = {t:.6g} s: check the drive's values and units)",
                 core_source="drive",
             )
-        model.warn_if_extended(run.columns, "the run" + where)
+        model.warn_about_run(run.columns, "the run" + where)
         return TransientResult(model.name, dict(run.columns), events)
     if err.kind == "input":
         assert err.source is not None and err.field is not None and err.expected is not None

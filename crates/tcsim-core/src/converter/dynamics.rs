@@ -793,15 +793,11 @@ pub(crate) mod tests {
     }
 
     fn qd() -> QuasiDynamics {
-        QuasiDynamics {
-            characteristic: c1().into(),
-            inertia: inertia(),
-            fluid_density_kg_m3: 840.0,
-            pump_radius_m: 0.12,
-            pump_shape_effect_m2: 0.006,
-            turbine_shape_effect_m2: 0.002,
-            flow_time_constant_s: 0.05,
-        }
+        qd_with(c1().into())
+    }
+
+    fn qd_with(characteristic: TorqueCharacteristic) -> QuasiDynamics {
+        QuasiDynamics::new(characteristic, inertia(), 840.0, 0.12, [0.006, 0.002], 0.05).unwrap()
     }
 
     fn check_jacobian(m: &dyn ConverterDynamics, u: Vec4, sigma: f64) {
@@ -882,7 +878,7 @@ pub(crate) mod tests {
         ];
         for t in tables {
             let table = TableDynamics { characteristic: t.clone(), inertia: inertia(), lag: None };
-            let q = QuasiDynamics { characteristic: t, ..qd() };
+            let q = qd_with(t.clone());
             for [wp, wt] in points {
                 check_jacobian(&table, [wp, wt, 0.0, 0.0], 1.0);
                 check_jacobian(&q, [wp, wt, 0.0, 0.01], 1.0);

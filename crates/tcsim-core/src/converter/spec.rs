@@ -106,20 +106,7 @@ fn build_unchecked(spec: &dyn ModelSpec) -> CoreResult<Box<dyn ConverterDynamics
     }
     Ok(match kind.as_str() {
         "table" => Box::new(TableDynamics { characteristic: table()?, inertia, lag: lag(spec)? }),
-        "quasi-dynamic" => {
-            let shape = numbers(spec, "shape_effect_m2", Some(2))?;
-            let m = QuasiDynamics {
-                characteristic: table()?,
-                inertia,
-                fluid_density_kg_m3: number(spec, "fluid_density_kg_m3")?,
-                pump_radius_m: number(spec, "pump_exit_radius_m")?,
-                pump_shape_effect_m2: shape[0],
-                turbine_shape_effect_m2: shape[1],
-                flow_time_constant_s: number(spec, "flow_time_constant_s")?,
-            };
-            m.validate()?;
-            Box::new(m)
-        }
+        "quasi-dynamic" => Box::new(quasi_dynamic(spec, inertia)?),
         "hrovat-tobler" => {
             let g = numbers(spec, "geometry", Some(N_PARAMS))?;
             let mut values = [0.0; N_PARAMS];
@@ -163,6 +150,26 @@ pub fn characteristic(spec: &dyn ModelSpec) -> CoreResult<TorqueCharacteristic> 
             )
         }
     }
+}
+
+/// The quasi-dynamic model of a specification whose `kind` is `quasi-dynamic`, with `inertia`
+/// (read by the caller from `inertia_kg_m2`).
+pub fn quasi_dynamic(spec: &dyn ModelSpec, inertia: Inertias) -> CoreResult<QuasiDynamics> {
+    let shape = numbers(spec, "shape_effect_m2", Some(2))?;
+    QuasiDynamics::new(
+        characteristic(spec)?,
+        inertia,
+        number(spec, "fluid_density_kg_m3")?,
+        number(spec, "pump_exit_radius_m")?,
+        [shape[0], shape[1]],
+        number(spec, "flow_time_constant_s")?,
+    )
+}
+
+/// The quasi-dynamic model of a full specification (its `inertia_kg_m2` read here).
+pub fn quasi_dynamic_model(spec: &dyn ModelSpec) -> CoreResult<QuasiDynamics> {
+    let i = numbers(spec, "inertia_kg_m2", Some(3))?;
+    quasi_dynamic(spec, Inertias::new(i[0], i[1], i[2])?)
 }
 
 /// The default flow time constant τ_Q of the quasi-dynamic model, s: the fluid's inertance over the

@@ -38,15 +38,7 @@ pub fn table() -> TableDynamics {
 }
 
 pub fn qd(sp: f64, st: f64) -> QuasiDynamics {
-    QuasiDynamics {
-        characteristic: c1().into(),
-        inertia: inertia(),
-        fluid_density_kg_m3: 840.0,
-        pump_radius_m: 0.12,
-        pump_shape_effect_m2: sp,
-        turbine_shape_effect_m2: st,
-        flow_time_constant_s: 0.03,
-    }
+    QuasiDynamics::new(c1().into(), inertia(), 840.0, 0.12, [sp, st], 0.03).unwrap()
 }
 
 pub fn signal(name: &str, points: &[(f64, f64)]) -> Signal {
