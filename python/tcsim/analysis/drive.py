@@ -129,7 +129,9 @@ def run_drive(
     threads: int = 0,
 ) -> dict[str, DriveRun]:
     """Every model follows ``cycle`` in ``vehicle``, in one core call (GIL released, ``threads``
-    workers, 0 for all cores). ``options``: the solver options of a launch and the driver's gains
+    workers, 0 for all cores). ``options``: the solver options of a launch (``max_output_bytes``, bytes,
+    default 2e9: the estimated size of all runs' outputs is refused above it before anything runs,
+    an :class:`~tcsim.errors.InputError` naming the cycle file) and the driver's gains
     ``driver_kp_per_s`` (1/s), ``driver_ki_per_s2`` (1/s²), ``driver_control_step_s`` (s),
     ``driver_hold_brake`` (0–1). The first failed run raises :class:`~tcsim.errors.InputError`
     (naming the cycle file for the trace's values) or :class:`SolverError`."""

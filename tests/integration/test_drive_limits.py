@@ -1,0 +1,45 @@
+"""``tcsim drive`` as a new user meets it (issue 14): the output-size guard of ``tcsim launch``
+(the core's ``OutputSize``, docs/guarantees.md) refuses a trace too long for the memory before
+anything runs, and every bad command line is one line, exit 2, nothing written."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from tcsim.analysis.drive import Cycle, run_drive
+from tcsim.errors import InputError
+from tcsim.models.dynamic import select_models
+from tcsim.models.vehicle import load_vehicle
+
+
+def standstill(hours: float, source: str = "standstill.csv") -> Cycle:
+    """A trace that stands still for ``hours`` (two samples)."""
+    return Cycle("standstill", source, np.array([0.0, hours * 3600.0]), np.zeros(2))
+
+
+def test_a_drive_whose_output_exceeds_max_output_bytes_is_refused_before_running():
+    # a small limit, so that a regression drives one hour instead of filling the memory
+    v = load_vehicle()
+    models = select_models(v.converter, ["table"])
+    with pytest.raises(InputError) as e:
+        run_drive(v, standstill(1.0), models, options={"max_output_bytes": 1e6})
+    assert (e.value.source, e.value.core_source, e.value.field) == ("standstill.csv", "scenario", "output_samples")
+    assert e.value.value == 36001.0 and "max_output_bytes = 1e6 bytes" in e.value.expected
+    # a control step finer than the default makes the output: the options are at fault
+    with pytest.raises(InputError) as e:
+        run_drive(v, standstill(0.5), models, options={"max_output_bytes": 1e6, "driver_control_step_s": 0.01})
+    assert (e.value.core_source, e.value.field) == ("options", "output_samples")
+
+
+def test_a_trace_of_weeks_is_refused_in_one_line_by_the_cli(cli, tmp_path):
+    trace = tmp_path / "weeks.csv"
+    pd.DataFrame({"time_s": [0.0, 3e6], "vehicle_speed_m_s": [0.0, 0.0]}).to_csv(trace, index=False)
+    before = trace.read_bytes()
+    r = cli("drive", "--cycle", trace, "--out", tmp_path / "o")
+    assert r.code == 2, (r.stdout, r.stderr)
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith(f"error: {trace}: output_samples = 3e+07: expected an output of at most"), line
+    assert "max_output_bytes = 2e9 bytes" in line and "3 run(s)" in line
+    assert not (tmp_path / "o").exists() and trace.read_bytes() == before
