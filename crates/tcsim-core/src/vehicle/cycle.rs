@@ -358,6 +358,8 @@ fn run_step(
     };
     let mut booked_before: Option<f64> = None;
     let mut events_in_step = 0;
+    // the solver's step budget (`options.max_steps`) holds for each control step, as the events'
+    let mut steps_in_step = 0;
     loop {
         let plant = Plant::new(model, v, sc, c.mode, c.sync);
         let x0 = plant.state_of(&c.u);
@@ -372,7 +374,7 @@ fn run_step(
                 let slipping = c.mode.shift.is_some() || matches!(c.mode.lockup, LockupState::Engaging { .. });
                 let times = segment_times(c.t, t_end, if slipping { FINE_ENERGY_STEP_S } else { ENERGY_STEP_S });
                 let mut samples = Vec::new();
-                let end = run_segment(&plant, x0, c.t, t_end, &times, options, &mut samples, &mut traj.steps)?;
+                let end = run_segment(&plant, x0, c.t, t_end, &times, options, &mut samples, &mut steps_in_step)?;
                 if let Some((t_root, _, x)) = &end {
                     samples.push(plant.sample(x, *t_root));
                 }
@@ -381,6 +383,7 @@ fn run_step(
                     let last = samples.last().expect("a segment to its end time samples its end");
                     c.u = last.u;
                     c.t = t_end;
+                    traj.steps += steps_in_step;
                     return Ok(first);
                 }
                 end
