@@ -43,3 +43,34 @@ def test_a_trace_of_weeks_is_refused_in_one_line_by_the_cli(cli, tmp_path):
     assert line.startswith(f"error: {trace}: output_samples = 3e+07: expected an output of at most"), line
     assert "max_output_bytes = 2e9 bytes" in line and "3 run(s)" in line
     assert not (tmp_path / "o").exists() and trace.read_bytes() == before
+
+
+def _must_not_run(*args, **kwargs):
+    raise AssertionError("the drive ran before its --out was checked")
+
+
+@pytest.mark.parametrize("where", ["under a file", "under a file's missing folder"])
+def test_an_out_that_cannot_be_created_is_refused_before_the_drive_runs(cli, tmp_path, monkeypatch, where):
+    """Before: the whole drive ran (minutes for a long trace, its warnings printed) and then the
+    output failed."""
+    monkeypatch.setattr("tcsim.analysis.drive.drive", _must_not_run)
+    blocker = tmp_path / "results.csv"
+    blocker.write_text("a file\n")
+    out = blocker / "run" if where == "under a file" else blocker / "a" / "run"
+    r = cli("drive", "--cycle", "udds", "--out", out)
+    assert r.code == 2, (r.stdout, r.stderr)
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith("error: command line: --out = '"), line  # the value is shortened when long
+    assert line.endswith(f": expected a directory that can be created ('{blocker}' is not a directory)"), line
+    assert blocker.read_text() == "a file\n" and sorted(p.name for p in tmp_path.iterdir()) == ["results.csv"]
+
+
+def test_a_directory_given_as_the_trace_is_named_a_directory(cli, tmp_path):
+    """Before: ``(file) = 'not found'`` for a directory that exists."""
+    folder = tmp_path / "traces.csv"
+    folder.mkdir()
+    r = cli("drive", "--cycle", folder, "--out", tmp_path / "o")
+    assert r.code == 2
+    expected = f"error: {folder}: (file) = 'a directory': expected an existing cycle file"
+    assert r.stderr.strip().splitlines() == [expected]
+    assert not (tmp_path / "o").exists()
