@@ -7,9 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+from asammdf import MDF, Signal
 
 from tcsim.analysis.drive import Cycle, run_drive
 from tcsim.errors import InputError
+from tcsim.io.cycle import read_cycle
 from tcsim.models.dynamic import select_models
 from tcsim.models.vehicle import load_vehicle
 
@@ -74,3 +76,31 @@ def test_a_directory_given_as_the_trace_is_named_a_directory(cli, tmp_path):
     expected = f"error: {folder}: (file) = 'a directory': expected an existing cycle file"
     assert r.stderr.strip().splitlines() == [expected]
     assert not (tmp_path / "o").exists()
+
+
+def _mdf_trace(path, units: dict[str, str]):
+    t = np.arange(0.0, 11.0)
+    columns = {"vehicle_speed_m_s": np.interp(t, [0, 5, 10], [0, 10, 0]), "grade_percent": np.full(t.size, 2.0)}
+    mdf = MDF(version="4.10")
+    mdf.append([Signal(v, t, name=name, unit=units.get(name, "")) for name, v in columns.items()])
+    mdf.save(path, overwrite=True)
+    mdf.close()
+    return path
+
+
+@pytest.mark.parametrize(
+    ("column", "unit"), [("vehicle_speed_m_s", "km/h"), ("vehicle_speed_m_s", "mph"), ("grade_percent", "deg")]
+)
+def test_a_unit_in_the_file_that_contradicts_the_column_name_is_refused(tmp_path, column, unit):
+    """Before: an MDF4 channel ``vehicle_speed_m_s`` in km/h was read as m/s (3.6 times too fast)."""
+    path = _mdf_trace(tmp_path / "trace.mf4", {column: unit})
+    with pytest.raises(InputError) as e:
+        read_cycle(path)
+    assert (e.value.source, e.value.field, e.value.value) == (str(path), f"{column} (unit)", unit)
+    assert "wrong units" in e.value.expected
+
+
+def test_units_that_agree_with_the_column_names_are_read(tmp_path):
+    path = _mdf_trace(tmp_path / "trace.mf4", {"vehicle_speed_m_s": "m/s", "grade_percent": "%"})
+    c = read_cycle(path)
+    assert c.vehicle_speed_m_s.max() == 10.0 and (c.grade_percent == 2.0).all()

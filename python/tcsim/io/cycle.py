@@ -24,6 +24,13 @@ from .results import write_frames
 
 _REQUIRED = ("time_s", "vehicle_speed_m_s")
 _OPTIONAL = ("grade_percent",)
+#: The unit each column's name states, as a file's unit metadata (MDF4 channels) may spell it
+#: (lower case, no spaces); any other unit there is refused, no unit is the name's.
+_UNITS: dict[str, tuple[str, ...]] = {
+    "time_s": ("s",),
+    "vehicle_speed_m_s": ("m/s",),
+    "grade_percent": ("%", "percent"),
+}
 
 
 def bundled_cycle_path(name: str) -> Path:
@@ -50,20 +57,30 @@ class _CyclePicker:
         return self.found
 
 
+def _check_unit(path: Path, column: str, unit: str) -> None:
+    """Refuse a unit in the file's metadata that is not the one ``column``'s name states."""
+    unit = unit.strip()
+    if unit and unit.lower().replace(" ", "") not in _UNITS[column]:
+        accepted = " or ".join(_UNITS[column])
+        expected = f"{accepted} (the unit its name states), or none: wrong units"
+        raise InputError(str(path), f"{column} (unit)", unit, expected)
+
+
 def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
-    """A speed trace from a file: each problem (missing column, fewer than 2 rows, a value that is
-    not a finite number, times not strictly increasing) an :class:`InputError` naming the file, the
-    column and the value."""
+    """A speed trace from a file: each problem (missing column, a unit in the file's metadata other
+    than the column name's, fewer than 2 rows, a value that is not a finite number, times not
+    strictly increasing) an :class:`InputError` naming the file, the column and the value."""
     path = Path(path)
     reader = reader_for(path, "cycle")
     picker = _CyclePicker(path)
-    raw, _units = reader(path, picker)
+    raw, units = reader(path, picker)
     n = len(raw["time_s"])
     if n < 2:
         raise InputError(str(path), "time_s", f"{n} rows", "at least 2 data rows")
     out: dict[str, np.ndarray] = {}
     time_s = None
     for column in picker.found:
+        _check_unit(path, column, units.get(column, ""))
         values = check_column(path, column, raw[column], n, "time_s", time_s, column == "time_s")
         if column == "time_s":
             time_s = values
