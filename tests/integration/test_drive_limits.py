@@ -104,3 +104,27 @@ def test_units_that_agree_with_the_column_names_are_read(tmp_path):
     path = _mdf_trace(tmp_path / "trace.mf4", {"vehicle_speed_m_s": "m/s", "grade_percent": "%"})
     c = read_cycle(path)
     assert c.vehicle_speed_m_s.max() == 10.0 and (c.grade_percent == 2.0).all()
+
+
+@pytest.mark.parametrize(
+    ("text", "field", "value"),
+    [
+        ("time_s,vehicle_speed_m_s\n100,0\n101,1\n102,-1\n103,0\n", "vehicle_speed_m_s", "-1 at row 3 (time_s 102)"),
+        ("time_s,vehicle_speed_m_s\n100,0.5\n101,1\n", "vehicle_speed_m_s", "0.5 at row 1 (time_s 100)"),
+        (
+            "time_s,vehicle_speed_m_s,grade_percent\n0,0,0\n0.5,1,31\n",
+            "grade_percent",
+            "31 at row 2 (time_s 0.5)",
+        ),
+    ],
+)
+def test_a_value_out_of_range_is_located_like_every_other_trace_error(cli, tmp_path, text, field, value):
+    """Before: ``vehicle_speed_m_s[2] = -1``, a 0-based sample index, where a NaN in the same file
+    is ``row 3 (time_s 102)``: the file's data row (1-based) and its own time stamp."""
+    path = tmp_path / "trace.csv"
+    path.write_text(text)
+    r = cli("drive", "--cycle", path, "--model", "table", "--out", tmp_path / "o")
+    assert r.code == 2, r.stderr
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith(f"error: {path}: {field} = '{value}': expected "), line
+    assert not (tmp_path / "o").exists() and path.read_text() == text

@@ -5,7 +5,8 @@ files of a drive.
 A trace file has ``time_s`` (s, strictly increasing; shifted so that the first sample is time 0),
 ``vehicle_speed_m_s`` (m/s, starting at rest) and optionally ``grade_percent`` (%, positive
 uphill); linear between samples. The core checks the ranges (speed 0–250 km/h, grade ±30 %, the
-first speed at rest) and names the file, the column and the row index of a value outside them.
+first speed at rest); :func:`tcsim.analysis.drive.located` names the file, the column, the value,
+its data row and time stamp, as for the other problems of the file.
 """
 
 from __future__ import annotations
@@ -91,6 +92,7 @@ def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
         out["time_s"] - out["time_s"][0],
         out["vehicle_speed_m_s"],
         out.get("grade_percent"),
+        float(out["time_s"][0]),
     )
 
 
