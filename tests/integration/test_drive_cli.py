@@ -128,3 +128,22 @@ def test_a_value_out_of_range_is_located_like_every_other_trace_error(cli, tmp_p
     (line,) = r.stderr.strip().splitlines()
     assert line.startswith(f"error: {path}: {field} = '{value}': expected "), line
     assert not (tmp_path / "o").exists() and path.read_text() == text
+
+
+def test_the_console_summary_is_a_table_of_metrics_with_a_column_per_model(cli, tmp_path):
+    """Before: ``summary.to_string()``, 15 columns that a terminal of 80 columns wrapped into an
+    unreadable block of numbers."""
+    path = tmp_path / "trace.csv"
+    path.write_text("time_s,vehicle_speed_m_s\n0,0\n1,1\n2,2\n3,3\n4,2\n5,0\n6,0\n")
+    r = cli("drive", "--cycle", path, "-m", "table", "-m", "hrovat-tobler", "--out", tmp_path / "o")
+    assert r.code == 0, r.stderr
+    summary = pd.read_csv(tmp_path / "o" / "summary.csv")
+    lines = r.stdout.splitlines()
+    header = next(line for line in lines if line.strip().startswith("metric"))
+    assert header.split() == ["metric", "table", "hrovat-tobler"]
+    rows = {line.split("[")[0].strip(): line.split("]")[-1].split() for line in lines if "] " in line}
+    assert rows["RMS speed error"] == [f"{v:.2f}" for v in summary.rms_speed_error_km_h]
+    assert rows["converter loss"] == [f"{v:.1f}" for v in summary.converter_loss_kj]
+    assert rows["energy residual"] == [f"{v:.1e}" for v in summary.energy_residual]
+    table = lines[lines.index(header) : lines.index(header) + 13]
+    assert max(len(line.rstrip()) for line in table) <= 80
