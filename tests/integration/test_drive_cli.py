@@ -147,3 +147,14 @@ def test_the_console_summary_is_a_table_of_metrics_with_a_column_per_model(cli, 
     assert rows["energy residual"] == [f"{v:.1e}" for v in summary.energy_residual]
     table = lines[lines.index(header) : lines.index(header) + 13]
     assert max(len(line.rstrip()) for line in table) <= 80
+
+
+def test_a_trace_file_without_an_extension_is_named_as_a_file(cli, tmp_path):
+    """Before: ``command line: --cycle = 'trace': expected one of us06, ... or a trace file`` for a
+    trace file that exists; now the file and the extensions tcsim reads."""
+    path = tmp_path / "trace"
+    path.write_text("time_s,vehicle_speed_m_s\n0,0\n1,1\n")
+    r = cli("drive", "--cycle", path, "--out", tmp_path / "o")
+    assert r.code == 2
+    expected = "a cycle file ending in one of .csv, .parquet, .mat, .mf4, .mdf"
+    assert r.stderr.strip().splitlines() == [f"error: {path}: (extension) = '(none)': expected {expected}"]

@@ -97,10 +97,11 @@ def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
 
 
 def cycle_from_option(option: str) -> Cycle:
-    """``--cycle``: a bundled name (:data:`BUNDLED_CYCLES`) or a trace file."""
+    """``--cycle``: a bundled name (:data:`BUNDLED_CYCLES`) or a trace file; a name that is neither
+    (no extension, no such file) is refused as a command-line value."""
     if option in BUNDLED_CYCLES:
         return read_cycle(bundled_cycle_path(option), option)
-    if not Path(option).suffix:
+    if not Path(option).suffix and not Path(option).exists():
         raise InputError("command line", "--cycle", option, f"one of {', '.join(BUNDLED_CYCLES)} or a trace file")
     return read_cycle(option)
 
