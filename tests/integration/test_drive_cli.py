@@ -4,6 +4,8 @@ anything runs, and every bad command line is one line, exit 2, nothing written."
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -158,3 +160,21 @@ def test_a_trace_file_without_an_extension_is_named_as_a_file(cli, tmp_path):
     assert r.code == 2
     expected = "a cycle file ending in one of .csv, .parquet, .mat, .mf4, .mdf"
     assert r.stderr.strip().splitlines() == [f"error: {path}: (extension) = '(none)': expected {expected}"]
+
+
+@pytest.mark.parametrize("where", ["a read-only file system", "an existing file"])
+def test_an_out_that_cannot_be_written_is_refused_before_the_drive_runs(cli, tmp_path, monkeypatch, where):
+    """/proc refuses new directories even to root (before: after the whole drive); an existing file
+    is never replaced by a directory."""
+    if where == "a read-only file system" and not Path("/proc/self").is_dir():
+        pytest.skip("needs Linux's /proc")
+    monkeypatch.setattr("tcsim.analysis.drive.drive", _must_not_run)
+    out = Path("/proc/tcsim-drive-out") if where == "a read-only file system" else tmp_path / "summary.csv"
+    if where == "an existing file":
+        out.write_text("kept\n")
+    r = cli("drive", "--cycle", "us06", "--out", out)
+    assert r.code == 2, r.stderr
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith(f"error: command line: --out = '{out}': expected a "), line
+    assert ("a writable directory (" if where == "a read-only file system" else "(a file of that name exists)") in line
+    assert not out.exists() if where == "a read-only file system" else out.read_text() == "kept\n"
