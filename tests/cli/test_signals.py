@@ -22,6 +22,7 @@ COMMANDS = {
     "launch": ["launch", "--sweep-shape-effects", "--out", "o"],
     "characterise": ["characterise", "li-sunden-2016", "--out", "o"],
     "study": ["study", "li-sunden-2016", "--out", "o"],
+    "drive": ["drive", "--cycle", "udds", "--model", "hrovat-tobler", "--out", "o"],  # no overrun warning
 }
 
 
@@ -78,6 +79,8 @@ CASES = [
     ("launch", signal.SIGTERM, "writing"),
     ("characterise", signal.SIGINT, "writing"),
     ("study", signal.SIGTERM, "writing"),
+    ("drive", signal.SIGINT, "start"),
+    ("drive", signal.SIGTERM, "writing"),
 ]
 
 

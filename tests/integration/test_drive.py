@@ -133,9 +133,14 @@ BAD_TRACES = [
     ("time not increasing", "time_s,vehicle_speed_m_s\n0,0\n2,1\n1,2\n", "time_s", "1 at row 3 after 2"),
     ("NaN speed", "time_s,vehicle_speed_m_s\n0,0\n1,\n2,1\n", "vehicle_speed_m_s", "NaN"),
     ("text", "time_s,vehicle_speed_m_s\n0,0\n1,fast\n", "vehicle_speed_m_s", "fast"),
-    ("negative speed", "time_s,vehicle_speed_m_s\n0,0\n1,-1\n", "vehicle_speed_m_s[1]", "-1"),
-    ("not at rest", "time_s,vehicle_speed_m_s\n0,5\n1,5\n", "vehicle_speed_m_s[0]", "5"),
-    ("steep grade", "time_s,vehicle_speed_m_s,grade_percent\n0,0,0\n1,1,45\n", "grade_percent[1]", "45"),
+    ("negative speed", "time_s,vehicle_speed_m_s\n0,0\n1,-1\n", "vehicle_speed_m_s", "-1 at row 2 (time_s 1)"),
+    ("not at rest", "time_s,vehicle_speed_m_s\n0,5\n1,5\n", "vehicle_speed_m_s", "5 at row 1 (time_s 0)"),
+    (
+        "steep grade",
+        "time_s,vehicle_speed_m_s,grade_percent\n0,0,0\n1,1,45\n",
+        "grade_percent",
+        "45 at row 2 (time_s 1)",
+    ),
 ]
 
 

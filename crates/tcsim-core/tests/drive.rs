@@ -61,3 +61,18 @@ fn driver_follows_a_trace_and_the_energy_balances() {
         println!("{name}: rms {rms:.4} m/s, residual {:.2e}, {e:?}", residual / e.engine_work_j);
     }
 }
+
+/// The solver's step budget (`max_steps`, sized for a launch of seconds) holds for each control
+/// step: over a whole drive it made any trace longer than about an hour a solver failure.
+#[test]
+fn the_step_limit_holds_for_each_control_step_not_the_whole_drive() {
+    let m = table();
+    let full = simulate_drive(&m, &sedan(), &trace(), &Driver::default(), &options()).unwrap();
+    let limited = SolverOptions { max_steps: full.run.steps / 4, ..options() };
+    let again = simulate_drive(&m, &sedan(), &trace(), &Driver::default(), &limited).unwrap_or_else(|e| {
+        panic!("{} steps in all, at most {} per control step: {e}", full.run.steps, limited.max_steps)
+    });
+    assert_eq!((again.run.steps, again.run.samples.len()), (full.run.steps, full.run.samples.len()));
+    let starved = SolverOptions { max_steps: 1, ..options() };
+    assert!(simulate_drive(&m, &sedan(), &trace(), &Driver::default(), &starved).is_err());
+}

@@ -1201,7 +1201,8 @@ fn driver_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<tcsim_core::vehicle::c
 /// Drive runs: each model dict (as for transient_runs) in the same vehicle follows the trace
 /// `cycle` (`time_s`, `vehicle_speed_m_s`, optional `grade_percent`; errors about it name the
 /// scenario), GIL released, `threads` workers. `options` takes the solver options (`rtol` by default
-/// `DRIVE_RTOL`) and the driver's gains (`driver_*`). Returns one [`LaunchRun`] per model with the columns of `drive_columns`.
+/// `DRIVE_RTOL`) and the driver's gains (`driver_*`); the output's size is estimated first and refused
+/// (CoreInputError) above `max_output_bytes`. Returns one [`LaunchRun`] per model with the columns of `drive_columns`.
 #[pyfunction]
 #[pyo3(signature = (models, vehicle, cycle, options=None, threads=0))]
 fn drive_runs<'py>(
@@ -1212,7 +1213,9 @@ fn drive_runs<'py>(
     options: Option<Bound<'py, PyDict>>,
     threads: usize,
 ) -> PyResult<Vec<LaunchRun>> {
-    use tcsim_core::vehicle::cycle::{drive_column_names, drive_columns as columns, simulate_drive, Trace};
+    use tcsim_core::vehicle::cycle::{
+        check_drive_output, drive_column_names, drive_columns as columns, simulate_drive, Trace,
+    };
     guard(|| {
         let v = vehicle.get().doc.vehicle.clone();
         let trace =
@@ -1224,6 +1227,7 @@ fn drive_runs<'py>(
         }
         let driver = driver_from(options.as_ref())?;
         let parsed = models.iter().map(|m| model_from(m)).collect::<PyResult<Vec<_>>>()?;
+        check_drive_output(&trace, &driver, parsed.len(), &solver).map_err(input_error)?;
         let results = cancellable(py, |cancel| {
             tcsim_core::batch::parallel_map_cancellable(&parsed, threads, cancel, |m| {
                 tcsim_core::batch::catch_panic(|| {

@@ -19,6 +19,7 @@ Summary columns (:data:`SUMMARY_COLUMNS`, one row per model):
 
 from __future__ import annotations
 
+import re
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -28,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import TcsimWarning, core_input_error, from_core
+from ..errors import InputError, TcsimWarning, core_input_error, from_core
 from ..models.dynamic import DynamicModel, select_models
 from ..models.vehicle import Vehicle
 from ..simulation.transient import SolverError
@@ -66,13 +67,16 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
 @dataclass(frozen=True)
 class Cycle:
     """A speed trace: ``time_s`` from 0, ``vehicle_speed_m_s`` (m/s), ``grade_percent`` (%, None for a
-    level road), its ``name`` and ``source`` (the file it came from)."""
+    level road), its ``name``, ``source`` (the file it came from) and ``start_time_s`` (s, the file's
+    first time stamp)."""
 
     name: str
     source: str
     time_s: np.ndarray
     vehicle_speed_m_s: np.ndarray
     grade_percent: np.ndarray | None = None
+    #: The file's first time stamp, s (``time_s`` starts at 0): errors name the file's own times.
+    start_time_s: float = 0.0
 
     def core_spec(self) -> dict[str, Any]:
         """The trace as ``tcsim._core.drive_runs`` takes it."""
@@ -121,6 +125,23 @@ def _unpack(run: _core.LaunchRun, name: str, files: dict[str, str]) -> DriveRun 
     return SolverError(f"{name}: {err.message}")
 
 
+#: A field the core names by a trace sample: ``column[i]`` (0-based).
+_SAMPLE_FIELD = re.compile(r"^(\w+)\[(\d+)\]$")
+
+
+def located(error: InputError, cycle: Cycle) -> InputError:
+    """An error the core raised about sample ``i`` of a trace column (field ``column[i]``) in the
+    terms of the trace file's other errors: the column, and the value at its 1-based data row with
+    the file's time stamp there (``-1 at row 3 (time_s 102)``); any other error unchanged."""
+    match = _SAMPLE_FIELD.match(error.field)
+    if error.core_source != "scenario" or match is None or int(match[2]) >= len(cycle.time_s):
+        return error
+    i = int(match[2])
+    value = f"{error.value:g}" if isinstance(error.value, float) else error.value
+    where = f"{value} at row {i + 1} (time_s {cycle.time_s[i] + cycle.start_time_s:g})"
+    return InputError(error.source, match[1], where, error.expected, core_source=error.core_source)
+
+
 def run_drive(
     vehicle: Vehicle,
     cycle: Cycle,
@@ -129,7 +150,9 @@ def run_drive(
     threads: int = 0,
 ) -> dict[str, DriveRun]:
     """Every model follows ``cycle`` in ``vehicle``, in one core call (GIL released, ``threads``
-    workers, 0 for all cores). ``options``: the solver options of a launch and the driver's gains
+    workers, 0 for all cores). ``options``: the solver options of a launch (``max_output_bytes``, bytes,
+    default 2e9: the estimated size of all runs' outputs is refused above it before anything runs,
+    an :class:`~tcsim.errors.InputError` naming the cycle file) and the driver's gains
     ``driver_kp_per_s`` (1/s), ``driver_ki_per_s2`` (1/s²), ``driver_control_step_s`` (s),
     ``driver_hold_brake`` (0–1). The first failed run raises :class:`~tcsim.errors.InputError`
     (naming the cycle file for the trace's values) or :class:`SolverError`."""
@@ -138,7 +161,7 @@ def run_drive(
     try:
         raw = _core.drive_runs([m.spec for m in models], vehicle.core, cycle.core_spec(), options, threads)
     except _core.CoreInputError as e:
-        raise from_core(e, files) from None
+        raise located(from_core(e, files), cycle) from None
     out: dict[str, DriveRun] = {}
     for model, run in zip(models, raw):
         result = _unpack(run, model.name, files)

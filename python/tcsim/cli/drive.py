@@ -14,7 +14,8 @@ trace file (CSV, Parquet, ``.mat``, MDF4) with ``time_s``, ``vehicle_speed_m_s``
 
 Outputs (in DIR, default ``drive``; written all at once, nothing on error): ``<model>.csv`` (time
 series every control step, 0.1 s), ``summary.csv`` (:data:`tcsim.analysis.drive.SUMMARY_COLUMNS`),
-``events.csv``, ``cycle.csv`` (the trace), ``speed.png`` and ``losses.png``.
+``events.csv``, ``cycle.csv`` (the trace), ``speed.png`` and ``losses.png``; on the console the
+summary as a table of metrics by model (:func:`tcsim.reports.drive.drive_report`).
 
 Errors: a bad vehicle file, trace file or option is an :class:`~tcsim.errors.InputError` (exit 2,
 nothing written); a solver failure exit 1.
@@ -58,6 +59,7 @@ def drive(
     from ..models.vehicle import load_vehicle
     from ..plots.drive import plot_drive
     from ..reports.console import progress_display
+    from ..reports.drive import drive_report
     from ..reports.format import rich_text
 
     trace_file = None if cycle in BUNDLED_CYCLES else cycle
@@ -71,5 +73,4 @@ def drive(
     with output_dir(out, inputs) as stage:
         write_drive_files(result, stage)
         plot_drive(result, stage)
-    stdout.print(rich_text(result.summary.to_string(index=False, float_format=lambda x: f"{x:.4g}")))
-    stdout.print(rich_text(f"written to {out}/"))
+    stdout.print(drive_report(result, out))

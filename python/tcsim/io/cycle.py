@@ -5,7 +5,8 @@ files of a drive.
 A trace file has ``time_s`` (s, strictly increasing; shifted so that the first sample is time 0),
 ``vehicle_speed_m_s`` (m/s, starting at rest) and optionally ``grade_percent`` (%, positive
 uphill); linear between samples. The core checks the ranges (speed 0–250 km/h, grade ±30 %, the
-first speed at rest) and names the file, the column and the row index of a value outside them.
+first speed at rest); :func:`tcsim.analysis.drive.located` names the file, the column, the value,
+its data row and time stamp, as for the other problems of the file.
 """
 
 from __future__ import annotations
@@ -24,6 +25,13 @@ from .results import write_frames
 
 _REQUIRED = ("time_s", "vehicle_speed_m_s")
 _OPTIONAL = ("grade_percent",)
+#: The unit each column's name states, as a file's unit metadata (MDF4 channels) may spell it
+#: (lower case, no spaces); any other unit there is refused, no unit is the name's.
+_UNITS: dict[str, tuple[str, ...]] = {
+    "time_s": ("s",),
+    "vehicle_speed_m_s": ("m/s",),
+    "grade_percent": ("%", "percent"),
+}
 
 
 def bundled_cycle_path(name: str) -> Path:
@@ -50,20 +58,30 @@ class _CyclePicker:
         return self.found
 
 
+def _check_unit(path: Path, column: str, unit: str) -> None:
+    """Refuse a unit in the file's metadata that is not the one ``column``'s name states."""
+    unit = unit.strip()
+    if unit and unit.lower().replace(" ", "") not in _UNITS[column]:
+        accepted = " or ".join(_UNITS[column])
+        expected = f"{accepted} (the unit its name states), or none: wrong units"
+        raise InputError(str(path), f"{column} (unit)", unit, expected)
+
+
 def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
-    """A speed trace from a file: each problem (missing column, fewer than 2 rows, a value that is
-    not a finite number, times not strictly increasing) an :class:`InputError` naming the file, the
-    column and the value."""
+    """A speed trace from a file: each problem (missing column, a unit in the file's metadata other
+    than the column name's, fewer than 2 rows, a value that is not a finite number, times not
+    strictly increasing) an :class:`InputError` naming the file, the column and the value."""
     path = Path(path)
     reader = reader_for(path, "cycle")
     picker = _CyclePicker(path)
-    raw, _units = reader(path, picker)
+    raw, units = reader(path, picker)
     n = len(raw["time_s"])
     if n < 2:
         raise InputError(str(path), "time_s", f"{n} rows", "at least 2 data rows")
     out: dict[str, np.ndarray] = {}
     time_s = None
     for column in picker.found:
+        _check_unit(path, column, units.get(column, ""))
         values = check_column(path, column, raw[column], n, "time_s", time_s, column == "time_s")
         if column == "time_s":
             time_s = values
@@ -74,14 +92,16 @@ def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
         out["time_s"] - out["time_s"][0],
         out["vehicle_speed_m_s"],
         out.get("grade_percent"),
+        float(out["time_s"][0]),
     )
 
 
 def cycle_from_option(option: str) -> Cycle:
-    """``--cycle``: a bundled name (:data:`BUNDLED_CYCLES`) or a trace file."""
+    """``--cycle``: a bundled name (:data:`BUNDLED_CYCLES`) or a trace file; a name that is neither
+    (no extension, no such file) is refused as a command-line value."""
     if option in BUNDLED_CYCLES:
         return read_cycle(bundled_cycle_path(option), option)
-    if not Path(option).suffix:
+    if not Path(option).suffix and not Path(option).exists():
         raise InputError("command line", "--cycle", option, f"one of {', '.join(BUNDLED_CYCLES)} or a trace file")
     return read_cycle(option)
 

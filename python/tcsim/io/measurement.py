@@ -461,7 +461,8 @@ def reader_for(path: Path, what: str) -> Callable[[Path, _Chooser], _Loaded]:
             str(path), "(extension)", path.suffix or "(none)", f"a {what} file ending in one of {', '.join(READERS)}"
         )
     if not path.is_file():
-        raise InputError(str(path), "(file)", "not found", f"an existing {what} file")
+        found = "a directory" if path.is_dir() else "not found"
+        raise InputError(str(path), "(file)", found, f"an existing {what} file")
     return reader
 
 

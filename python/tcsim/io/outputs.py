@@ -115,14 +115,31 @@ def _contained_inputs(out: Path, inputs: Iterable[str | Path]) -> list[str]:
     return inside
 
 
+def _check_creatable(out: Path) -> None:
+    """Refuse an ``out`` that could not be made (before a run, not after it): its nearest existing
+    ancestor is not a directory, or no directory can be created in it (probed with an empty
+    directory, removed at once)."""
+    ancestor = next(p for p in (out.parent, *out.parent.parents) if p.exists() or p == p.parent)
+    if not ancestor.is_dir():
+        raise _refuse(out, f"a directory that can be created ({str(ancestor)!r} is not a directory)")
+    where = Path(os.path.abspath(out)).resolve().parent if out.is_symlink() else ancestor
+    with _blocked():
+        try:
+            os.rmdir(tempfile.mkdtemp(prefix=".tcsim-probe.", dir=where))
+        except OSError as e:
+            raise _refuse(out, f"a writable directory ({e.strerror})") from None
+
+
 def check_output_dir(out: str | Path, inputs: Iterable[str | Path] = ()) -> None:
-    """Refuse an ``out`` the rule of this module does not allow (:class:`InputError`)."""
+    """Refuse an ``out`` the rule of this module does not allow, or one that cannot be created
+    (:class:`InputError`)."""
     out = Path(out)
     contained = _contained_inputs(out, inputs)
     if any(out.resolve() == Path(c).resolve() for c in contained):
         raise _refuse(out, "a directory, not an input file of this run")
     if contained:
         raise _refuse(out, f"a directory that holds no input of this run (it holds {_listing(contained)})")
+    _check_creatable(out)
     if not out.exists() and not out.is_symlink():
         return
     if not out.is_dir():

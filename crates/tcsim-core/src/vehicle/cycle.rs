@@ -35,7 +35,7 @@ use super::plant::{kinetic_energy, LaunchSample, Plant};
 use super::{FRONT, REAR, SPEED};
 use crate::converter::dynamics::{ConverterDynamics, PUMP, TURBINE};
 use crate::engine::lockup;
-use crate::engine::options::{try_reserve, TransientError, TransientResult};
+use crate::engine::options::{try_reserve, OutputSize, SolverOptions, TransientError, TransientResult};
 use crate::engine::segment::{run_segment, SmoothSegment};
 use crate::engine::signal::Signal;
 use crate::error::{CoreError, CoreResult, InputSource};
@@ -358,6 +358,8 @@ fn run_step(
     };
     let mut booked_before: Option<f64> = None;
     let mut events_in_step = 0;
+    // the solver's step budget (`options.max_steps`) holds for each control step, as the events'
+    let mut steps_in_step = 0;
     loop {
         let plant = Plant::new(model, v, sc, c.mode, c.sync);
         let x0 = plant.state_of(&c.u);
@@ -372,7 +374,7 @@ fn run_step(
                 let slipping = c.mode.shift.is_some() || matches!(c.mode.lockup, LockupState::Engaging { .. });
                 let times = segment_times(c.t, t_end, if slipping { FINE_ENERGY_STEP_S } else { ENERGY_STEP_S });
                 let mut samples = Vec::new();
-                let end = run_segment(&plant, x0, c.t, t_end, &times, options, &mut samples, &mut traj.steps)?;
+                let end = run_segment(&plant, x0, c.t, t_end, &times, options, &mut samples, &mut steps_in_step)?;
                 if let Some((t_root, _, x)) = &end {
                     samples.push(plant.sample(x, *t_root));
                 }
@@ -381,6 +383,7 @@ fn run_step(
                     let last = samples.last().expect("a segment to its end time samples its end");
                     c.u = last.u;
                     c.t = t_end;
+                    traj.steps += steps_in_step;
                     return Ok(first);
                 }
                 end
@@ -403,6 +406,33 @@ fn run_step(
     }
 }
 
+/// The number of output samples of a drive of `trace` with the control step `control_step_s` (one
+/// per control instant, the trace's end included).
+pub fn drive_output_samples(trace: &Trace, control_step_s: f64) -> f64 {
+    (trace.end_time_s() / control_step_s).ceil() + 1.0
+}
+
+/// The size of the output of `runs` drives of `trace` with `driver`, checked against the limit of
+/// `options` before anything runs (the launch's [`OutputSize`]): an error about the trace (its
+/// length), or about the options when the control step is finer than the default.
+pub fn check_drive_output(trace: &Trace, driver: &Driver, runs: usize, options: &SolverOptions) -> CoreResult<()> {
+    driver.validate()?;
+    let per_sample = std::mem::size_of::<LaunchSample>()
+        + std::mem::size_of::<(f64, f64)>()
+        + std::mem::size_of::<Energies>()
+        + 2 * std::mem::size_of::<f64>();
+    let size = OutputSize {
+        runs,
+        samples: drive_output_samples(trace, driver.control_step_s),
+        columns: drive_column_names().len(),
+        state_bytes: per_sample,
+        max_events: options.max_events,
+        event_bytes: std::mem::size_of::<VehicleEvent>() + std::mem::size_of::<(f64, f64)>(),
+    };
+    let finer = driver.control_step_s < Driver::default().control_step_s;
+    size.check(if finer { InputSource::Options } else { InputSource::Scenario }, options.max_output_bytes)
+}
+
 /// Follow `trace` with `driver` in vehicle `v` (its grade replaced by the trace's at each control
 /// step) and converter `model`, from the braked standstill in first gear at idle.
 pub fn simulate_drive(
@@ -410,10 +440,10 @@ pub fn simulate_drive(
     v: &Vehicle,
     trace: &Trace,
     driver: &Driver,
-    options: &crate::engine::options::SolverOptions,
+    options: &SolverOptions,
 ) -> TransientResult<DriveTrajectory> {
     v.validate().map_err(|e| e.about(InputSource::Vehicle))?;
-    driver.validate()?;
+    check_drive_output(trace, driver, 1, options)?;
     let end = trace.end_time_s();
     let dt = driver.control_step_s;
     let n_steps = (end / dt).ceil() as usize;
@@ -512,6 +542,24 @@ pub fn drive_columns(model: &dyn ConverterDynamics, traj: &DriveTrajectory) -> T
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_drive_output_above_the_limit_is_refused_before_running() {
+        let (driver, options) = (Driver::default(), SolverOptions::default());
+        let day = Trace::new(vec![0.0, 1e6], vec![0.0, 0.0], None).unwrap();
+        let e = check_drive_output(&day, &driver, 3, &options).unwrap_err();
+        assert_eq!(
+            (e.source, e.field.as_str(), e.value.as_str()),
+            (InputSource::Scenario, "output_samples", "10000001")
+        );
+        assert!(e.expected.contains("max_output_bytes = 2e9 bytes"), "{}", e.expected);
+        let fine = Driver { control_step_s: 0.01, ..driver };
+        let hour = Trace::new(vec![0.0, 3600.0], vec![0.0, 0.0], None).unwrap();
+        assert!(check_drive_output(&hour, &driver, 3, &options).is_ok());
+        let small = SolverOptions { max_output_bytes: 1e6, ..options };
+        assert_eq!(check_drive_output(&hour, &fine, 1, &small).unwrap_err().source, InputSource::Options);
+        assert_eq!(drive_output_samples(&hour, 0.1), 36001.0);
+    }
 
     #[test]
     fn trace_edges_are_refused() {
