@@ -110,6 +110,81 @@ pub struct DesignGeometry {
     pub fluid_mass_kg: f64,
 }
 
+/// The names of the profiles ([`Profile`]) in a design's `profile` field.
+pub const PROFILE_KINDS: [&str; 3] = ["circular", "elliptic", "polyline"];
+
+impl Profile {
+    /// The profile named `kind` ([`PROFILE_KINDS`]); `squash_ratio` belongs to `elliptic` only and
+    /// the element paths (pump, turbine, stator) to `polyline` only. The values are checked by
+    /// [`check_design`].
+    pub fn from_parts(kind: &str, squash_ratio: Option<f64>, paths: Option<[Vec<[f64; 2]>; 3]>) -> CoreResult<Self> {
+        match (kind, squash_ratio, paths) {
+            ("circular", None, None) => Ok(Profile::Circular),
+            ("elliptic", Some(s), None) => Ok(Profile::Elliptic { squash_ratio: s }),
+            ("elliptic", None, _) => Err(err("squash_ratio", "missing", "a squash ratio for the elliptic profile")),
+            ("polyline", None, Some([pump, turbine, stator])) => Ok(Profile::Polyline { pump, turbine, stator }),
+            ("polyline", _, None) => Err(err(
+                "pump_path_m",
+                "missing",
+                "the (r, z) paths of pump, turbine and stator for a polyline profile",
+            )),
+            ("circular" | "polyline", Some(s), _) => {
+                Err(err("squash_ratio", s, "no squash ratio: it belongs to the elliptic profile"))
+            }
+            ("circular" | "elliptic", _, Some(_)) => {
+                Err(err("pump_path_m", "given", "no element paths: they belong to the polyline profile"))
+            }
+            _ => Err(err("profile", kind, "circular, elliptic or polyline")),
+        }
+    }
+}
+
+/// The quantities of each element in [`DesignGeometry::values`], after the element's name.
+pub const ELEMENT_QUANTITIES: [&str; 8] = [
+    "shape_effect_m2",
+    "arc_shape_effect_m2",
+    "path_length_m",
+    "axial_length_m",
+    "axial_extent_m",
+    "fluid_length_m",
+    "fluid_mass_kg",
+    "fluid_inertia_kg_m2",
+];
+/// The quantities of the whole torus in [`DesignGeometry::values`], after the elements'.
+pub const TORUS_QUANTITIES: [&str; 3] = ["fluid_length_m", "path_length_m", "fluid_mass_kg"];
+
+/// The column names of [`DesignGeometry::values`]: `pump_shape_effect_m2`, …, `stator_fluid_inertia_kg_m2`,
+/// then `fluid_length_m`, `path_length_m`, `fluid_mass_kg`.
+pub fn geometry_columns() -> Vec<String> {
+    let elements = ["pump", "turbine", "stator"].into_iter();
+    let per = elements.flat_map(|e| ELEMENT_QUANTITIES.iter().map(move |q| format!("{e}_{q}")));
+    per.chain(TORUS_QUANTITIES.iter().map(|q| q.to_string())).collect()
+}
+
+impl ElementGeometry {
+    fn values(&self) -> [f64; 8] {
+        [
+            self.shape_effect_m2,
+            self.arc_shape_effect_m2,
+            self.path_length_m,
+            self.axial_length_m,
+            self.axial_extent_m,
+            self.fluid_length_m,
+            self.fluid_mass_kg,
+            self.fluid_inertia_kg_m2,
+        ]
+    }
+}
+
+impl DesignGeometry {
+    /// The values in the order of [`geometry_columns`].
+    pub fn values(&self) -> Vec<f64> {
+        let mut v: Vec<f64> = [self.pump, self.turbine, self.stator].iter().flat_map(|e| e.values()).collect();
+        v.extend([self.fluid_length_m, self.path_length_m, self.fluid_mass_kg]);
+        v
+    }
+}
+
 /// Nodes of one element's path: radius, axial position, and the path length of each segment.
 struct Path {
     r: Vec<f64>,
@@ -287,13 +362,19 @@ fn check_points(points: usize) -> CoreResult<()> {
 /// element of each segment by the trapezoidal rule on the speed `√(a² sin² t + b² cos² t)`.
 fn conic_path(rc: f64, a: f64, b: f64, t0: f64, t1: f64, n: usize) -> Path {
     let h = (t1 - t0) / (n - 1) as f64;
-    let t: Vec<f64> = (0..n).map(|i| if i + 1 == n { t1 } else { t0 + h * i as f64 }).collect();
-    let speed: Vec<f64> = t.iter().map(|&t| (a * t.sin()).hypot(b * t.cos())).collect();
-    Path {
-        r: t.iter().map(|&t| rc - a * t.cos()).collect(),
-        z: t.iter().map(|&t| b * t.sin()).collect(),
-        dl: speed.windows(2).map(|w| 0.5 * (w[0] + w[1]) * h).collect(),
+    let (mut r, mut z, mut dl) = (Vec::with_capacity(n), Vec::with_capacity(n), Vec::with_capacity(n));
+    let mut last_speed = 0.0;
+    for i in 0..n {
+        let (sin, cos) = (if i + 1 == n { t1 } else { t0 + h * i as f64 }).sin_cos();
+        let speed = ((a * sin).powi(2) + (b * cos).powi(2)).sqrt();
+        r.push(rc - a * cos);
+        z.push(b * sin);
+        if i > 0 {
+            dl.push(0.5 * (last_speed + speed) * h);
+        }
+        last_speed = speed;
     }
+    Path { r, z, dl }
 }
 
 /// A polyline's nodes: each segment cut into pieces in proportion to its share of the length.
@@ -329,34 +410,38 @@ fn paths(d: &Design, n: usize) -> [Path; 3] {
     [conic_path(rc, a, b, 0.0, PI, n), conic_path(rc, a, b, PI, tt, n), conic_path(rc, a, b, tt, 2.0 * PI, n)]
 }
 
-/// Trapezoidal sum of node values `f` over segment weights `w`.
-fn trapezoid(f: &[f64], w: impl Iterator<Item = f64>) -> f64 {
-    f.windows(2).zip(w).map(|(f, w)| 0.5 * (f[0] + f[1]) * w).sum()
-}
-
 fn element(p: &Path, angles: BladeAngles, rho_a: f64) -> ElementGeometry {
     let length: f64 = p.dl.iter().sum();
     let (a0, a1) = (angles.inlet_deg.to_radians(), angles.exit_deg.to_radians());
-    let mut s = 0.0;
-    let mut tan = Vec::with_capacity(p.r.len());
-    for i in 0..p.r.len() {
-        tan.push((a0 + (a1 - a0) * (s / length).min(1.0)).tan());
-        s += p.dl.get(i).copied().unwrap_or(0.0);
+    let node = |i: usize, s: f64| {
+        let tan = (a0 + (a1 - a0) * (s / length).min(1.0)).tan();
+        (p.r[i] * tan, p.r[i] * p.r[i], 1.0 + tan * tan)
+    };
+    // trapezoidal sums: shape effect over |dz| and along dl, ∫R² dl, ∫(1 + tan²α) dl
+    let (mut axial, mut arc, mut r2, mut weight, mut dz_sum) = (0.0, 0.0, 0.0, 0.0, 0.0);
+    let (mut zmin, mut zmax) = (p.z[0], p.z[0]);
+    let (mut s, mut prev) = (0.0, node(0, 0.0));
+    for (i, &dl) in p.dl.iter().enumerate() {
+        s += dl;
+        let cur = node(i + 1, s);
+        let dz = (p.z[i + 1] - p.z[i]).abs();
+        axial += 0.5 * (prev.0 + cur.0) * dz;
+        arc += 0.5 * (prev.0 + cur.0) * dl;
+        r2 += 0.5 * (prev.1 + cur.1) * dl;
+        weight += 0.5 * (prev.2 + cur.2) * dl;
+        dz_sum += dz;
+        (zmin, zmax) = (zmin.min(p.z[i + 1]), zmax.max(p.z[i + 1]));
+        prev = cur;
     }
-    let g: Vec<f64> = p.r.iter().zip(&tan).map(|(r, t)| r * t).collect();
-    let r2: Vec<f64> = p.r.iter().map(|r| r * r).collect();
-    let weight: Vec<f64> = tan.iter().map(|t| 1.0 + t * t).collect();
-    let dz = || p.z.windows(2).map(|w| (w[1] - w[0]).abs());
-    let (zmin, zmax) = p.z.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &z| (lo.min(z), hi.max(z)));
     ElementGeometry {
-        shape_effect_m2: trapezoid(&g, dz()),
-        arc_shape_effect_m2: trapezoid(&g, p.dl.iter().copied()),
+        shape_effect_m2: axial,
+        arc_shape_effect_m2: arc,
         path_length_m: length,
-        axial_length_m: dz().sum(),
+        axial_length_m: dz_sum,
         axial_extent_m: zmax - zmin,
-        fluid_length_m: trapezoid(&weight, p.dl.iter().copied()),
+        fluid_length_m: weight,
         fluid_mass_kg: rho_a * length,
-        fluid_inertia_kg_m2: rho_a * trapezoid(&r2, p.dl.iter().copied()),
+        fluid_inertia_kg_m2: rho_a * r2,
     }
 }
 

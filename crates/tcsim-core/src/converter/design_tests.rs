@@ -269,3 +269,21 @@ fn bad_polylines_name_the_point() {
         "pump_path_m[0] = (0.06, 0): expected the last point of stator_path_m, (0.061, 0) (a closed path, to 1 µm)"
     );
 }
+
+#[test]
+fn profiles_by_name_and_columns() {
+    assert_eq!(Profile::from_parts("circular", None, None), Ok(Profile::Circular));
+    assert_eq!(Profile::from_parts("elliptic", Some(0.2), None), Ok(Profile::Elliptic { squash_ratio: 0.2 }));
+    let field = |k, s, p| Profile::from_parts(k, s, p).unwrap_err().field;
+    assert_eq!(field("oval", None, None), "profile");
+    assert_eq!(field("elliptic", None, None), "squash_ratio");
+    assert_eq!(field("circular", Some(0.1), None), "squash_ratio");
+    assert_eq!(field("polyline", None, None), "pump_path_m");
+    assert_eq!(field("elliptic", Some(0.1), Some(square(0.06, 0.065, 0.12))), "pump_path_m");
+    let g = geo(&table_d1(Profile::Circular));
+    let (names, values) = (geometry_columns(), g.values());
+    assert_eq!((names.len(), values.len()), (27, 27));
+    assert_eq!((names[0].as_str(), values[0]), ("pump_shape_effect_m2", g.pump.shape_effect_m2));
+    assert_eq!((names[23].as_str(), values[23]), ("stator_fluid_inertia_kg_m2", g.stator.fluid_inertia_kg_m2));
+    assert_eq!((names[24].as_str(), values[24]), ("fluid_length_m", g.fluid_length_m));
+}
