@@ -255,10 +255,15 @@ fn bad_polylines_name_the_point() {
         p[2][0] = [0.07, 0.0];
     };
     assert_eq!(field(&moved), "turbine_path_m[3] r");
-    // not ordered: the pump turning inwards, the turbine outwards, a point beyond R_p
+    // not ordered: the pump turning inwards, the turbine outwards (both within [R_s, R_p])
+    assert_eq!(field(&|p| p[0].insert(3, [0.10, 0.01])), "pump_path_m[3]");
+    assert_eq!(field(&|p| p[1].insert(3, [0.09, -0.01])), "turbine_path_m[3]");
+    // a point outside [R_s, R_p]
     assert_eq!(field(&|p| p[0][2] = [0.05, 0.02]), "pump_path_m[2]");
     assert_eq!(field(&|p| p[1].insert(2, [0.13, -0.02])), "turbine_path_m[2]");
     assert_eq!(field(&|p| p[2].insert(1, [0.05, 0.0])), "stator_path_m[1]");
+    let e = run(&|p| p[0].insert(3, [0.10, 0.01])).unwrap_err();
+    assert_eq!(e.expected, "a radius not below the point before's (the flow order)");
     // too short, not finite, repeated points
     assert_eq!(field(&|p| p[2].truncate(1)), "stator_path_m");
     assert_eq!(field(&|p| p[0][1] = [0.06, f64::NAN]), "pump_path_m[1]");
