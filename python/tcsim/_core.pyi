@@ -255,3 +255,19 @@ def fmu_event_indicator_variables(model: str) -> list[dict[str, Any]]:
     """FMI 3.0: the event indicators of a model kind as variables (as :func:`fmu_variables`)."""
 
 def time_resolution_s(t: float) -> float: ...
+
+# issue 15: the geometry of converter designs (tcsim_core::converter::design)
+def design_geometries(
+    designs: list[dict[str, Any]], points: int = ..., strict: bool = ..., threads: int = ...
+) -> dict[str, Any]:
+    """The geometry of each design: float64 arrays named by :func:`design_columns` and ``error``,
+    per design None or its bad input's message (with ``strict``, CoreInputError instead)."""
+
+def design_columns() -> list[str]:
+    """The result columns of :func:`design_geometries`, in order."""
+
+def design_profiles() -> list[str]:
+    """``circular``, ``elliptic``, ``polyline``."""
+
+def design_integration() -> tuple[int, int, int, float]:
+    """(default, least, most) integration nodes per element, and the polyline tolerance in m."""

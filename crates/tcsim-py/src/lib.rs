@@ -7,6 +7,7 @@
 //! [`LaunchRun`]). A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
 //! Python.
 
+mod design;
 mod fmu;
 
 use std::collections::BTreeMap;
@@ -1434,5 +1435,6 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
     m.add_function(wrap_pyfunction!(time_resolution_s, m)?)?;
     fmu::register(m)?;
+    design::register(m)?;
     Ok(())
 }

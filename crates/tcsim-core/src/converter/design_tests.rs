@@ -1,0 +1,294 @@
+//! Tests of [`super`]: hand calculations, the thesis's §4.1.1 statements, convergence, bad input.
+
+use super::*;
+
+/// Li & Sundén Table D.1's reference geometry with a profile.
+fn table_d1(profile: Profile) -> Design {
+    Design {
+        pump_exit_radius_m: 0.12,
+        turbine_exit_radius_m: 0.065,
+        stator_exit_radius_m: 0.06,
+        profile,
+        pump: BladeAngles { inlet_deg: -50.0, exit_deg: -20.0 },
+        turbine: BladeAngles { inlet_deg: 55.0, exit_deg: -50.0 },
+        stator: BladeAngles { inlet_deg: 15.0, exit_deg: 60.0 },
+        flow_area_m2: 0.01,
+        fluid_density_kg_m3: 840.0,
+    }
+}
+
+fn geo(d: &Design) -> DesignGeometry {
+    design_geometry(d, DEFAULT_POINTS).expect("a valid design")
+}
+
+fn elements(g: &DesignGeometry) -> [ElementGeometry; 3] {
+    [g.pump, g.turbine, g.stator]
+}
+
+fn close(a: f64, b: f64, rel: f64) -> bool {
+    (a - b).abs() <= rel * a.abs().max(b.abs()).max(1e-300)
+}
+
+#[test]
+fn squash_zero_is_the_circle() {
+    let (c, e) = (geo(&table_d1(Profile::Circular)), geo(&table_d1(Profile::Elliptic { squash_ratio: 0.0 })));
+    for (x, y) in elements(&c).iter().zip(elements(&e).iter()) {
+        for (u, v) in [
+            (x.shape_effect_m2, y.shape_effect_m2),
+            (x.arc_shape_effect_m2, y.arc_shape_effect_m2),
+            (x.fluid_inertia_kg_m2, y.fluid_inertia_kg_m2),
+            (x.fluid_length_m, y.fluid_length_m),
+            (x.axial_length_m, y.axial_length_m),
+        ] {
+            assert!(close(u, v, 1e-14), "{u} vs {v}");
+        }
+    }
+    assert!(close(c.fluid_length_m, e.fluid_length_m, 1e-14));
+}
+
+/// The circular torus of Table D.1 gives the numbers `tcsim.models.torus` gives (and docs/models.md
+/// quotes) where the definitions agree: the arc shape effects, L_f and the fluid inertias.
+#[test]
+fn circle_reproduces_the_arc_estimate() {
+    let g = geo(&table_d1(Profile::Circular));
+    assert!((g.pump.arc_shape_effect_m2 - -0.00569).abs() < 5e-6);
+    assert!((g.turbine.arc_shape_effect_m2 - 0.00134).abs() < 5e-6);
+    assert!((g.stator.arc_shape_effect_m2 - 0.00090).abs() < 5e-6);
+    assert!((g.fluid_length_m - 0.2914).abs() < 5e-5);
+    assert!((g.pump.fluid_inertia_kg_m2 - 0.0068).abs() < 5e-5);
+    assert!((g.turbine.fluid_inertia_kg_m2 - 0.0062).abs() < 5e-5);
+    assert!((g.stator.fluid_inertia_kg_m2 - 0.00056).abs() < 5e-6);
+    // the axial projection of each half circle is travelled out and back: twice the extent a
+    assert!(close(g.pump.axial_length_m, 0.06, 1e-9) && close(g.pump.axial_extent_m, 0.03, 1e-9));
+    assert!(close(g.path_length_m, PI * 0.06, 1e-12));
+    assert!(close(g.fluid_mass_kg, 840.0 * 0.01 * PI * 0.06, 1e-12));
+}
+
+/// A rectangular torus of axial width w, constant angles: the pump climbs the inner wall at R_s,
+/// crosses radially to R_p and comes back at R_p; the turbine mirrors it down to R_t, the stator
+/// is radial. By hand: S_p = (R_s + R_p)·w·tan α_p, S_t = (R_p + R_t)·w·tan α_t, S_s = 0; along the
+/// arc S_p = tan α_p·(R_s·w + (R_p² − R_s²)/2 + R_p·w).
+#[test]
+fn hand_calculation_pins_the_signs() {
+    let (rs, rt, rp, w) = (0.06, 0.07, 0.12, 0.02);
+    let profile = Profile::Polyline {
+        pump: vec![[rs, 0.0], [rs, w], [rp, w], [rp, 0.0]],
+        turbine: vec![[rp, 0.0], [rp, -w], [rt, -w], [rt, 0.0]],
+        stator: vec![[rt, 0.0], [rs, 0.0]],
+    };
+    let mut d = table_d1(profile);
+    d.turbine_exit_radius_m = rt;
+    d.pump = BladeAngles { inlet_deg: -30.0, exit_deg: -30.0 };
+    d.turbine = BladeAngles { inlet_deg: 45.0, exit_deg: 45.0 };
+    d.stator = BladeAngles { inlet_deg: 60.0, exit_deg: 60.0 };
+    let g = geo(&d);
+    let (tp, tt) = ((-30f64).to_radians().tan(), 1.0);
+    assert!(close(g.pump.shape_effect_m2, (rs + rp) * w * tp, 1e-12), "{}", g.pump.shape_effect_m2);
+    assert!(close(g.turbine.shape_effect_m2, (rp + rt) * w * tt, 1e-12));
+    assert_eq!(g.stator.shape_effect_m2, 0.0);
+    assert!(g.pump.shape_effect_m2 < 0.0 && g.turbine.shape_effect_m2 > 0.0);
+    assert!(close(g.pump.arc_shape_effect_m2, tp * (rs * w + 0.5 * (rp * rp - rs * rs) + rp * w), 1e-12));
+    assert!(close(g.pump.axial_length_m, 2.0 * w, 1e-12) && close(g.stator.axial_length_m, 0.0, 1e-12));
+    let rho_a = 8.4;
+    let inertia = rho_a * (rs * rs * w + (rp.powi(3) - rs.powi(3)) / 3.0 + rp * rp * w);
+    assert!(close(g.pump.fluid_inertia_kg_m2, inertia, 1e-6));
+    assert!(close(g.pump.fluid_length_m, (1.0 + tp * tp) * (2.0 * w + rp - rs), 1e-12));
+}
+
+/// §4.1.1: "a smaller diameter (smaller exit radii), axially thinner (shorter length of the axial
+/// projection) converter with less aggressive flow redirection (lower blade exit angles)" has a
+/// smaller shape effect.
+#[test]
+fn thesis_section_4_1_1_trends() {
+    let s = |d: &Design| {
+        let g = geo(d);
+        (g.pump.shape_effect_m2.abs(), g.turbine.shape_effect_m2.abs())
+    };
+    let base = table_d1(Profile::Elliptic { squash_ratio: 0.2 });
+    let (sp, st) = s(&base);
+    // smaller exit radii: the whole converter scaled down by 10 %
+    let mut small = base.clone();
+    small.pump_exit_radius_m *= 0.9;
+    small.turbine_exit_radius_m *= 0.9;
+    small.stator_exit_radius_m *= 0.9;
+    let (a, b) = s(&small);
+    assert!(a < sp && b < st && close(a, 0.81 * sp, 1e-9));
+    // a smaller pump exit radius alone
+    let mut rp = base.clone();
+    rp.pump_exit_radius_m = 0.11;
+    assert!(s(&rp).0 < sp && s(&rp).1 < st);
+    // axially thinner: squash 0.2 -> 0.35 -> 0.5
+    let mut last = (sp, st);
+    for q in [0.35, 0.5] {
+        let (a, b) = s(&table_d1(Profile::Elliptic { squash_ratio: q }));
+        assert!(a < last.0 && b < last.1, "squash {q}");
+        last = (a, b);
+    }
+    // lower exit angles: the pump's (inlet and exit of one sign)
+    let mut lo = base.clone();
+    lo.pump.exit_deg = -10.0;
+    assert!(s(&lo).0 < sp);
+    // the turbine's, with an inlet angle of the exit's sign (Table D.1's inlet 55° has the other
+    // sign: S_t is then the difference of an inlet and an exit part, docs/design.md)
+    let mut t = base.clone();
+    t.turbine.inlet_deg = -20.0;
+    let st0 = s(&t).1;
+    t.turbine.exit_deg = -40.0;
+    assert!(s(&t).1 < st0);
+}
+
+#[test]
+fn converges_with_the_number_of_points() {
+    for profile in [Profile::Circular, Profile::Elliptic { squash_ratio: 0.35 }] {
+        let d = table_d1(profile);
+        let at = |n| design_geometry(&d, n).unwrap();
+        let (coarse, mid, fine) = (at(101), at(1001), at(100_001));
+        for k in 0..3 {
+            let f = |g: &DesignGeometry| elements(g)[k].shape_effect_m2;
+            let (e1, e2) = ((f(&coarse) - f(&fine)).abs(), (f(&mid) - f(&fine)).abs());
+            // second order: ten times the nodes, about a hundredth of the error
+            assert!(e2 < 0.02 * e1 + 1e-15, "element {k}: {e1} then {e2}");
+            let e = (f(&at(DEFAULT_POINTS)) - f(&fine)).abs();
+            assert!(e < 1e-6 * f(&fine).abs(), "element {k}: {e}");
+        }
+        assert!(close(at(DEFAULT_POINTS).fluid_length_m, fine.fluid_length_m, 1e-6));
+    }
+}
+
+/// The axial reading keeps the mass-matrix bound of the arc reading (physics notes §4): with
+/// `|dz| ≤ dl`, `ρ²S_x² / I_x,fluid ≤ (ρ/A)∫_x tan²α dl`.
+#[test]
+fn axial_shape_effect_keeps_the_mass_matrix_bound() {
+    let mut seed = 12345u64;
+    let mut next = || {
+        seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        (seed >> 11) as f64 / (1u64 << 53) as f64
+    };
+    for _ in 0..200 {
+        let mut d = table_d1(Profile::Elliptic { squash_ratio: 0.8 * next() });
+        for a in [&mut d.pump, &mut d.turbine, &mut d.stator] {
+            *a = BladeAngles { inlet_deg: 170.0 * next() - 85.0, exit_deg: 170.0 * next() - 85.0 };
+        }
+        let g = geo(&d);
+        let (rho, area) = (d.fluid_density_kg_m3, d.flow_area_m2);
+        for e in elements(&g) {
+            let lhs = rho * rho * e.shape_effect_m2.powi(2) / e.fluid_inertia_kg_m2;
+            let rhs = rho / area * (e.fluid_length_m - e.path_length_m);
+            assert!(lhs <= rhs * (1.0 + 1e-9), "{lhs} > {rhs}");
+        }
+    }
+}
+
+#[test]
+fn batch_equals_one_by_one() {
+    let designs: Vec<Design> = (0..7).map(|i| table_d1(Profile::Elliptic { squash_ratio: 0.1 * i as f64 })).collect();
+    let mut bad = designs.clone();
+    bad[3].flow_area_m2 = -1.0;
+    let out = design_geometries(&bad, 301, 2);
+    assert_eq!(out.len(), 7);
+    for (i, (d, r)) in bad.iter().zip(&out).enumerate() {
+        assert_eq!(r, &design_geometry(d, 301), "design {i}");
+    }
+    assert!(out[3].is_err() && out[4].is_ok());
+    assert!(design_geometries(&[], 301, 2).is_empty());
+}
+
+fn field_of(d: &Design) -> String {
+    design_geometry(d, DEFAULT_POINTS).expect_err("bad input").field
+}
+
+#[test]
+fn bad_input_names_the_field() {
+    let base = table_d1(Profile::Circular);
+    let with = |f: &dyn Fn(&mut Design)| {
+        let mut d = base.clone();
+        f(&mut d);
+        field_of(&d)
+    };
+    assert_eq!(with(&|d| d.pump_exit_radius_m = f64::NAN), "pump_exit_radius_m");
+    assert_eq!(with(&|d| d.stator_exit_radius_m = 0.13), "stator_exit_radius_m");
+    assert_eq!(with(&|d| d.stator_exit_radius_m = 0.12), "stator_exit_radius_m");
+    assert_eq!(with(&|d| d.turbine_exit_radius_m = 0.05), "turbine_exit_radius_m");
+    assert_eq!(with(&|d| d.turbine.exit_deg = 90.0), "turbine_exit_angle_deg");
+    assert_eq!(with(&|d| d.stator.inlet_deg = f64::INFINITY), "stator_inlet_angle_deg");
+    assert_eq!(with(&|d| d.fluid_density_kg_m3 = 0.0), "fluid_density_kg_m3");
+    assert_eq!(with(&|d| d.flow_area_m2 = 1e308), "flow_area_m2");
+    for s in [-0.1, 1.0, f64::NAN] {
+        assert_eq!(with(&|d| d.profile = Profile::Elliptic { squash_ratio: s }), "squash_ratio");
+    }
+    let e = design_geometry(&base, 3).unwrap_err();
+    assert_eq!((e.field.as_str(), e.source), ("points", InputSource::Options));
+    let e = design_geometry(&table_d1(Profile::Elliptic { squash_ratio: 1.0 }), 301).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "squash_ratio = 1: expected a squash ratio in [0, 1): 1 − axial width / radial height of the torus"
+    );
+}
+
+/// The three elements' paths of a polyline profile.
+type Paths = [Vec<[f64; 2]>; 3];
+
+fn square(rs: f64, rt: f64, rp: f64) -> Paths {
+    [
+        vec![[rs, 0.0], [rs, 0.02], [rp, 0.02], [rp, 0.0]],
+        vec![[rp, 0.0], [rp, -0.02], [rt, -0.02], [rt, 0.0]],
+        vec![[rt, 0.0], [rs, 0.0]],
+    ]
+}
+
+#[test]
+fn bad_polylines_name_the_point() {
+    let run = |edit: &dyn Fn(&mut Paths)| {
+        let mut p = square(0.06, 0.065, 0.12);
+        edit(&mut p);
+        let [pump, turbine, stator] = p;
+        design_geometry(&table_d1(Profile::Polyline { pump, turbine, stator }), 301)
+    };
+    assert!(run(&|_| ()).is_ok());
+    let field = |edit: &dyn Fn(&mut Paths)| run(edit).unwrap_err().field;
+    // not closed
+    assert_eq!(field(&|p| p[2][1] = [0.061, 0.0]), "pump_path_m[0]");
+    assert_eq!(field(&|p| p[1][0] = [0.12, 0.001]), "turbine_path_m[0]");
+    // not through the design's radii
+    let moved = |p: &mut Paths| {
+        p[1][3] = [0.07, 0.0];
+        p[2][0] = [0.07, 0.0];
+    };
+    assert_eq!(field(&moved), "turbine_path_m[3] r");
+    // not ordered: the pump turning inwards, the turbine outwards (both within [R_s, R_p])
+    assert_eq!(field(&|p| p[0].insert(3, [0.10, 0.01])), "pump_path_m[3]");
+    assert_eq!(field(&|p| p[1].insert(3, [0.09, -0.01])), "turbine_path_m[3]");
+    // a point outside [R_s, R_p]
+    assert_eq!(field(&|p| p[0][2] = [0.05, 0.02]), "pump_path_m[2]");
+    assert_eq!(field(&|p| p[1].insert(2, [0.13, -0.02])), "turbine_path_m[2]");
+    assert_eq!(field(&|p| p[2].insert(1, [0.05, 0.0])), "stator_path_m[1]");
+    let e = run(&|p| p[0].insert(3, [0.10, 0.01])).unwrap_err();
+    assert_eq!(e.expected, "a radius not below the point before's (the flow order)");
+    // too short, not finite, repeated points
+    assert_eq!(field(&|p| p[2].truncate(1)), "stator_path_m");
+    assert_eq!(field(&|p| p[0][1] = [0.06, f64::NAN]), "pump_path_m[1]");
+    assert_eq!(field(&|p| p[0].insert(1, [0.06, 0.0])), "pump_path_m[1]");
+    let e = run(&|p| p[2][1] = [0.061, 0.0]).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "pump_path_m[0] = (0.06, 0): expected the last point of stator_path_m, (0.061, 0) (a closed path, to 1 µm)"
+    );
+}
+
+#[test]
+fn profiles_by_name_and_columns() {
+    assert_eq!(Profile::from_parts("circular", None, None), Ok(Profile::Circular));
+    assert_eq!(Profile::from_parts("elliptic", Some(0.2), None), Ok(Profile::Elliptic { squash_ratio: 0.2 }));
+    let field = |k, s, p| Profile::from_parts(k, s, p).unwrap_err().field;
+    assert_eq!(field("oval", None, None), "profile");
+    assert_eq!(field("elliptic", None, None), "squash_ratio");
+    assert_eq!(field("circular", Some(0.1), None), "squash_ratio");
+    assert_eq!(field("polyline", None, None), "pump_path_m");
+    assert_eq!(field("elliptic", Some(0.1), Some(square(0.06, 0.065, 0.12))), "pump_path_m");
+    let g = geo(&table_d1(Profile::Circular));
+    let (names, values) = (geometry_columns(), g.values());
+    assert_eq!((names.len(), values.len()), (27, 27));
+    assert_eq!((names[0].as_str(), values[0]), ("pump_shape_effect_m2", g.pump.shape_effect_m2));
+    assert_eq!((names[23].as_str(), values[23]), ("stator_fluid_inertia_kg_m2", g.stator.fluid_inertia_kg_m2));
+    assert_eq!((names[24].as_str(), values[24]), ("fluid_length_m", g.fluid_length_m));
+}
