@@ -155,7 +155,8 @@ def test_steps_are_rises_through_the_hysteresis_band():
     t = np.arange(0.0, 10.0, 0.01)
     starts_high = np.where(t < 3.0, 100.0, 0.0) + np.where((t > 5) & (t < 7), 100.0, 0.0)
     steps = te.detect_steps(starts_high)
-    assert [(t[a], t[rise], t[end - 1]) for a, rise, end in steps] == [(3.0, 5.01, 6.99)]  # not the first plateau
+    # not the first plateau; from halfway between the fall and the rise to the record's end
+    assert [(t[a], t[rise], t[fall], t[end - 1]) for a, rise, fall, end in steps] == [(4.0, 5.01, 7.0, 9.99)]
     # after a step to 100, a wobble across the middle (42-58 N·m) that stays inside the 40-60 % band
     wobbly = np.where(t < 4.0, 0.0, np.where((t > 6.0) & (t < 8.0), 50.0 + 8.0 * np.sin(t * 40), 100.0))
     assert len(te.detect_steps(wobbly)) == 1

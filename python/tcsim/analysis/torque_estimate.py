@@ -90,10 +90,12 @@ class ErrorStats:
 
 @dataclass(frozen=True)
 class LoadStep:
-    """One load step: grid samples ``first``..``end - 1``; levels and crossing times in s."""
+    """One load step: grid samples ``first``..``end - 1`` (:func:`detect_steps`); levels in N·m,
+    crossing times in s."""
 
     first: int
     rise: int
+    fall: int
     end: int
     initial_nm: float
     final_nm: float
@@ -188,6 +190,7 @@ class TorqueComparison:
                     "step": number,
                     "start_s": float(self.time_s[s.first]),
                     "end_s": float(self.time_s[s.end - 1]),
+                    "release_s": float(self.time_s[s.fall]) if s.fall < len(self.time_s) else math.nan,
                     "initial_torque_nm": s.initial_nm,
                     "final_torque_nm": s.final_nm,
                     "measured_t10_s": s.measured_t10_s,
@@ -218,6 +221,7 @@ STEP_COLUMNS = [
     "step",
     "start_s",
     "end_s",
+    "release_s",
     "initial_torque_nm",
     "final_torque_nm",
     "measured_t10_s",
@@ -335,25 +339,30 @@ def _hysteresis_state(measured_nm: np.ndarray) -> np.ndarray:
     return mark[index]
 
 
-def detect_steps(measured_nm: np.ndarray) -> list[tuple[int, int, int]]:
-    """The load steps of the measured torque, each as grid indices ``(first, rise, end)``.
+def detect_steps(measured_nm: np.ndarray) -> list[tuple[int, int, int, int]]:
+    """The load steps of the measured torque, each as grid indices ``(first, rise, fall, end)``.
 
     A step is a rise of the hysteresis state (:func:`_hysteresis_state`: above 60 % of the
-    record's range after having been below 40 %); it begins at the previous fall below 40 % (or the
-    record's start) and ends at the next fall (or the record's end, exclusive). Its initial level is
-    the 5th percentile of the measured torque from its beginning to the rise, its final level the
-    median of the second half of the rest (settled, after any overshoot); :func:`_step`."""
+    record's range after having been below 40 %) at ``rise``, held until the next fall below 40 %
+    at ``fall`` (or the record's end). Its window, ``first`` to ``end`` (exclusive), runs from
+    halfway between the previous fall and the rise (or the record's start) to halfway between its
+    fall and the next rise (or the record's end): the windows of the steps tile the record, each
+    with its application and its release. Its initial level is the 5th percentile of the measured
+    torque from ``first`` to ``rise``, its final level the median of the second half of ``rise``
+    to ``fall`` (settled, after any overshoot); :func:`_step`."""
     if np.ptp(measured_nm) <= 0:
         return []
+    n = len(measured_nm)
     change = np.diff(_hysteresis_state(measured_nm))
     rises = np.flatnonzero(change > 0) + 1
     falls = np.flatnonzero(change < 0) + 1
     steps = []
-    for rise in rises:
+    for i, rise in enumerate(rises):
         before, after = falls[falls < rise], falls[falls > rise]
-        steps.append(
-            (int(before[-1]) if len(before) else 0, int(rise), int(after[0]) if len(after) else len(measured_nm))
-        )
+        first = (int(before[-1]) + int(rise)) // 2 if len(before) else 0
+        fall = int(after[0]) if len(after) else n
+        end = (fall + int(rises[i + 1])) // 2 if i + 1 < len(rises) else n
+        steps.append((first, int(rise), fall, end))
     return steps
 
 
@@ -379,10 +388,10 @@ def last_leave(time_s: np.ndarray, values: np.ndarray, level: float, before: int
     return float(time_s[j] + (level - v0) / (v1 - v0) * (time_s[j + 1] - time_s[j]))
 
 
-def _step(comparison_arrays: tuple[np.ndarray, ...], first: int, rise: int, end: int) -> LoadStep | None:
+def _step(arrays: tuple[np.ndarray, ...], first: int, rise: int, fall: int, end: int) -> LoadStep | None:
     """The levels, crossing times and errors of one step; None when the step does not rise."""
-    t, measured, estimate, aligned = (a[first:end] for a in comparison_arrays)
-    high = measured[rise - first :]
+    t, measured, estimate, aligned = (a[first:end] for a in arrays)
+    high = measured[rise - first : fall - first]
     initial = float(np.percentile(measured[: rise - first], LEVEL_PERCENTILE))
     final = float(np.median(high[len(high) // 2 :]))
     if not final > initial:
@@ -393,6 +402,7 @@ def _step(comparison_arrays: tuple[np.ndarray, ...], first: int, rise: int, end:
     return LoadStep(
         first,
         rise,
+        fall,
         end,
         initial,
         final,
