@@ -14,6 +14,7 @@ import pytest
 from tcsim.analysis import torque_estimate as te
 from tcsim.analysis.torque_estimate import TorqueSignal, compare_torques
 from tcsim.errors import InputError, TcsimWarning
+from tcsim.plots.torque_estimate import MAX_DRAWN, drawn
 
 #: Load steps of the synthetic time-to-torque record: (onset s, initial N·m, final N·m, rise s, release s).
 STEPS = [(2.0, 30.0, 380.0, 0.6, 6.0), (9.0, 30.0, 250.0, 0.4, 12.0)]
@@ -199,3 +200,15 @@ def test_a_delay_between_grid_points_is_refined_by_the_parabola(delay_s):
     """Whole grid steps alone would be 0.3-0.4 of a step off; the refinement is within 0.15."""
     r = compare(estimate(0.01, delay_s), measured())
     assert abs(r.delay_s - delay_s) <= 0.15 * r.grid_step_s
+
+
+def test_long_series_are_drawn_with_every_peak():
+    t = np.arange(10 * MAX_DRAWN, dtype=float)
+    y = np.sin(t / 300.0)
+    y[12_345], y[99_999] = 7.0, -9.0
+    y[:50] = np.nan
+    td, yd = drawn(t, y)
+    assert len(td) <= MAX_DRAWN and np.all(np.diff(td) > 0)
+    assert np.nanmax(yd) == 7.0 and np.nanmin(yd) == -9.0
+    short = drawn(t[:100], y[:100])
+    assert np.array_equal(short[0], t[:100]) and np.array_equal(short[1], y[:100], equal_nan=True)

@@ -27,6 +27,8 @@ from .app import AllowImplausibleOpt, OutOpt, say
 if TYPE_CHECKING:
     from ..analysis.torque_estimate import TorqueComparison, TorqueSignal
 
+#: The most steps the command prints (steps.csv lists all).
+MAX_STEP_LINES = 10
 #: The command's ``--help`` text.
 HELP = (
     "Compare an estimated engine torque (e.g. the ECM's) with a measured one (dynamometer): delay, errors overall "
@@ -87,7 +89,8 @@ def write_torque_estimate(comparison: TorqueComparison, out_dir: Path) -> list[P
 
 
 def report_lines(comparison: TorqueComparison) -> list[str]:
-    """What the command prints: the delay, the overall errors and one line per step."""
+    """What the command prints: the delay, the overall errors and one line per step (the first
+    :data:`MAX_STEP_LINES`)."""
     row = comparison.summary().iloc[0]
     lines = [
         f"delay {row['delay_s']:.4g} s (positive: the estimate lags; correlation {row['correlation']:.4f}), "
@@ -97,12 +100,15 @@ def report_lines(comparison: TorqueComparison) -> list[str]:
         f"aligned:   RMSE {row['rmse_aligned_nm']:.4g} N·m, largest error {row['largest_error_aligned_nm']:.4g} N·m "
         f"at {row['largest_error_aligned_time_s']:.4g} s",
     ]
-    for _, s in comparison.steps_frame().iterrows():
+    steps = comparison.steps_frame()
+    for _, s in steps.head(MAX_STEP_LINES).iterrows():
         lines.append(
             f"step {int(s['step'])} at {s['measured_t90_s']:.4g} s: {s['initial_torque_nm']:.4g} → "
             f"{s['final_torque_nm']:.4g} N·m, rise 10–90 % {s['measured_rise_10_90_s']:.3g} s, t90 error "
             f"{s['t90_error_s']:.3g} s (aligned {s['t90_error_aligned_s']:.3g} s), RMSE {s['rmse_nm']:.4g} N·m"
         )
+    if len(steps) > MAX_STEP_LINES:
+        lines.append(f"... and {len(steps) - MAX_STEP_LINES} more steps (steps.csv lists all)")
     return lines
 
 
@@ -110,10 +116,10 @@ def torque_estimate(
     estimate: Annotated[str, typer.Argument(help="estimated engine torque: .csv, .parquet, .mat or .mf4/.mdf")],
     dyno: Annotated[str, typer.Argument(help="measured engine torque (dynamometer), same formats")],
     estimate_column: Annotated[
-        str | None, typer.Option("--estimate-column", help="ESTIMATE's torque column [default: engine_torque_nm]")
+        str | None, typer.Option("--estimate-column", help="ESTIMATE's torque column (default: engine_torque_nm)")
     ] = None,
     measured_column: Annotated[
-        str | None, typer.Option("--measured-column", help="DYNO's torque column [default: engine_torque_nm]")
+        str | None, typer.Option("--measured-column", help="DYNO's torque column (default: engine_torque_nm)")
     ] = None,
     max_delay: Annotated[
         float, typer.Option("--max-delay", help="largest delay searched, s, either sign (at most half the overlap)")
