@@ -6,7 +6,19 @@ they use when they run, so that ``tcsim --help`` starts fast.
 
 from __future__ import annotations
 
-from . import characterise, converters, drive, export_fmu, fit, fit_shapes, launch, operating_point, replay, study
+from . import (
+    characterise,
+    converters,
+    drive,
+    export_fmu,
+    fit,
+    fit_shapes,
+    launch,
+    operating_point,
+    replay,
+    study,
+    torque_estimate,
+)
 from .app import app, main
 
 # registered in the order ``tcsim --help`` lists them
@@ -19,6 +31,7 @@ app.command()(replay.replay)
 app.command("fit-shapes", help=fit_shapes.HELP)(fit_shapes.fit_shapes)
 app.command(help=launch.HELP)(launch.launch)
 app.command(help=drive.HELP)(drive.drive)
+app.command("torque-estimate", help=torque_estimate.HELP)(torque_estimate.torque_estimate)
 app.command("export-fmu", help=export_fmu.HELP)(export_fmu.export_fmu)
 
 __all__ = ["app", "main"]

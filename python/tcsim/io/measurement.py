@@ -76,6 +76,7 @@ _QUANTITY: dict[str, str] = {
     "turbine_load_torque_nm": "torque",
     "flow_m3_s": "flow",
     "lockup_capacity_nm": "torque",
+    "engine_torque_nm": "torque",  # tcsim torque-estimate
 }
 
 INPUT_CHANNELS: tuple[str, ...] = tuple(_QUANTITY)
