@@ -19,20 +19,11 @@ import pandas as pd
 import pytest
 import scipy.io
 
-#: Load steps: (onset s, initial N·m, final N·m, rise s, release s); exact plateaus.
-STEPS = [(2.0, 30.0, 380.0, 0.6, 6.0), (9.0, 30.0, 250.0, 0.4, 12.0)]
+from torque_steps import load_response
+
 DELAY_S = 0.2
 HANG_GUARD_S = 600  # a hang guard only; nothing is asserted about durations
 OUTPUTS = {"summary.csv", "steps.csv", "timeseries.csv", "torque_estimate.png", "steps.png", "tcsim-manifest.json"}
-
-
-def load_response(t: np.ndarray) -> np.ndarray:
-    out = np.full_like(t, 30.0, dtype=float)
-    for onset, low, high, rise, release in STEPS:
-        up = np.clip((t - onset) / rise, 0.0, 1.0)
-        down = np.clip((t - release) / rise, 0.0, 1.0)
-        out += (high - low) * ((1 - np.cos(np.pi * up)) - (1 - np.cos(np.pi * down))) / 2
-    return out
 
 
 def write_dyno(path: Path) -> None:

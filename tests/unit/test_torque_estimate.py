@@ -15,22 +15,10 @@ from tcsim.analysis import torque_estimate as te
 from tcsim.analysis.torque_estimate import TorqueSignal, compare_torques
 from tcsim.errors import InputError, TcsimWarning
 from tcsim.plots.torque_estimate import MAX_DRAWN, drawn
+from torque_steps import STEPS, load_response
 
-#: Load steps of the synthetic time-to-torque record: (onset s, initial N·m, final N·m, rise s, release s).
-STEPS = [(2.0, 30.0, 380.0, 0.6, 6.0), (9.0, 30.0, 250.0, 0.4, 12.0)]
 MEASURED_STEP_S = 1e-3
 END_S = 15.0
-
-
-def load_response(t: np.ndarray) -> np.ndarray:
-    """A time-to-torque record: each step a half-cosine from its initial to its final level over its
-    rise time, held, and released the same way (exact plateaus)."""
-    out = np.full_like(t, 30.0, dtype=float)
-    for onset, low, high, rise, release in STEPS:
-        up = np.clip((t - onset) / rise, 0.0, 1.0)
-        down = np.clip((t - release) / rise, 0.0, 1.0)
-        out += (high - low) * ((1 - np.cos(np.pi * up)) - (1 - np.cos(np.pi * down))) / 2
-    return out
 
 
 def measured() -> TorqueSignal:
