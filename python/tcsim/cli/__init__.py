@@ -6,7 +6,19 @@ they use when they run, so that ``tcsim --help`` starts fast.
 
 from __future__ import annotations
 
-from . import characterise, converters, drive, export_fmu, fit, fit_shapes, launch, operating_point, replay, study
+from . import (
+    characterise,
+    converters,
+    design,
+    drive,
+    export_fmu,
+    fit,
+    fit_shapes,
+    launch,
+    operating_point,
+    replay,
+    study,
+)
 from .app import app, main
 
 # registered in the order ``tcsim --help`` lists them
@@ -20,5 +32,6 @@ app.command("fit-shapes", help=fit_shapes.HELP)(fit_shapes.fit_shapes)
 app.command(help=launch.HELP)(launch.launch)
 app.command(help=drive.HELP)(drive.drive)
 app.command("export-fmu", help=export_fmu.HELP)(export_fmu.export_fmu)
+app.command(help=design.HELP)(design.design)
 
 __all__ = ["app", "main"]
