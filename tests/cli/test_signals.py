@@ -23,7 +23,7 @@ COMMANDS = {
     "characterise": ["characterise", "li-sunden-2016", "--out", "o"],
     "study": ["study", "li-sunden-2016", "--out", "o"],
     "drive": ["drive", "--cycle", "udds", "--model", "hrovat-tobler", "--out", "o"],  # no overrun warning
-    "design": ["design", "li-sunden-2016", "--out", "o"],
+    "design": ["design", "li-sunden-2016-design", "--out", "o"],
 }
 
 

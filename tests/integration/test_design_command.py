@@ -21,7 +21,8 @@ from tcsim.models.design_file import LOSS_KEYS, derive_converter, load_design_fi
 from tcsim.models.steady import characterise
 from tcsim.transient import isolated_takeoff, simulate
 
-BUNDLED = "li-sunden-2016"
+BUNDLED = "li-sunden-2016-design"
+REFERENCE = "li-sunden-2016"
 
 
 def _bundled_text() -> str:
@@ -30,7 +31,7 @@ def _bundled_text() -> str:
 
 @pytest.fixture(scope="module")
 def written(tmp_path_factory):
-    """``tcsim design li-sunden-2016 --out o``: the run and its output directory."""
+    """``tcsim design li-sunden-2016-design --out o``: the run and its output directory."""
     cwd = tmp_path_factory.mktemp("design")
     run = run_cli_in_process("design", BUNDLED, "--out", "o", cwd=cwd)
     return run, cwd / "o"
@@ -83,7 +84,7 @@ def test_the_report_files_and_the_reference(written):
     summary = pd.read_csv(out / "summary.csv")
     assert tuple(summary.columns) == SUMMARY_COLUMNS
     assert summary["role"].tolist() == ["design", "reference"]
-    assert summary["converter"].tolist() == ["li-sunden-2016-design", BUNDLED]
+    assert summary["converter"].tolist() == [BUNDLED, REFERENCE]
     takeoff = pd.read_csv(out / "takeoff.csv")
     assert set(takeoff["converter"]) == set(summary["converter"])
     # same Table D.1 steady state (the shape effects do not enter it), the same total inertias
@@ -120,7 +121,7 @@ def test_losses_not_given_come_from_table_d1_and_say_so(tmp_path, cli):
     assert "losses not in the design, taken from Table D.1" in r.stdout
     conv = load_converter(tmp_path / "o" / "converter.toml")
     assert conv.geometry is not None
-    table_d1 = load_converter(BUNDLED).geometry
+    table_d1 = load_converter(REFERENCE).geometry
     for k in LOSS_KEYS:
         assert getattr(conv.geometry, k) == getattr(table_d1, k)
         assert conv.sources[f"geometry.{k}"].startswith("default: Li & Sundén (2016) Table D.1")
@@ -168,7 +169,7 @@ def test_a_missing_design_or_reference_without_geometry_exits_2(tmp_path, cli, c
     r = cli("design", tmp_path / "none.toml", "--out", tmp_path / "o")
     assert r.code == 2 and r.stderr.strip().splitlines() == [
         f"error: {tmp_path / 'none.toml'}: design = '{tmp_path / 'none.toml'}': expected a bundled design "
-        "(li-sunden-2016) or an existing design .toml file"
+        "(li-sunden-2016-design) or an existing design .toml file"
     ]
     r = cli("design", BUNDLED, "--reference", c1_csv, "--out", tmp_path / "o")
     assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1 and "[geometry]" in r.stderr
@@ -177,7 +178,7 @@ def test_a_missing_design_or_reference_without_geometry_exits_2(tmp_path, cli, c
 
 def test_the_bundled_design_is_table_d1_with_the_bundled_total_inertias():
     file = load_design_file(BUNDLED)
-    conv = load_converter(BUNDLED)
+    conv = load_converter(REFERENCE)
     assert conv.geometry is not None and conv.inertia is not None
     for k in ("pump_exit_radius_m", "turbine_exit_radius_m", "stator_exit_radius_m", "flow_area_m2"):
         assert getattr(file.design, k) == getattr(conv.geometry, k)
@@ -185,4 +186,4 @@ def test_the_bundled_design_is_table_d1_with_the_bundled_total_inertias():
     for e in ("pump", "turbine", "stator"):
         total = getattr(file.metal_inertia, f"{e}_kg_m2") + getattr(g, e).fluid_inertia_kg_m2
         assert math.isclose(total, getattr(conv.inertia, f"{e}_kg_m2"), abs_tol=1e-6)
-    assert Path(file.path).name == f"{BUNDLED}.toml"
+    assert Path(file.path).name == f"{BUNDLED}.toml" and file.name == BUNDLED

@@ -5,7 +5,7 @@ file, its characteristic and its isolated take-off against a reference converter
 
     tcsim design DESIGN [--out DIR] [--reference CONVERTER]
 
-DESIGN is a design ``.toml`` or a bundled design's name (``li-sunden-2016``); the schema is in
+DESIGN is a design ``.toml`` or a bundled design's name (``li-sunden-2016-design``); the schema is in
 docs/design.md ("Design files"). DIR (default ``design``) receives, all at once and nothing on
 error (:mod:`tcsim.io.outputs`): ``converter.toml``, ``characteristic.csv``,
 ``reference_characteristic.csv``, ``takeoff.csv``, ``summary.csv`` and the plots of the
@@ -30,7 +30,7 @@ HELP = (
 
 
 def design(
-    design: Annotated[str, typer.Argument(help="design .toml or bundled design name (li-sunden-2016)")],
+    design: Annotated[str, typer.Argument(help="design .toml or bundled design name (li-sunden-2016-design)")],
     out: OutOpt = Path("design"),
     reference: Annotated[
         str, typer.Option("--reference", help="reference converter with [geometry]: bundled name or .toml")
