@@ -23,6 +23,7 @@ COMMANDS = {
     "characterise": ["characterise", "li-sunden-2016", "--out", "o"],
     "study": ["study", "li-sunden-2016", "--out", "o"],
     "drive": ["drive", "--cycle", "udds", "--model", "hrovat-tobler", "--out", "o"],  # no overrun warning
+    "design": ["design", "li-sunden-2016-design", "--out", "o"],
 }
 
 
@@ -81,6 +82,8 @@ CASES = [
     ("study", signal.SIGTERM, "writing"),
     ("drive", signal.SIGINT, "start"),
     ("drive", signal.SIGTERM, "writing"),
+    ("design", signal.SIGTERM, "start"),
+    ("design", signal.SIGINT, "writing"),
 ]
 
 

@@ -66,13 +66,21 @@ def test_circle_reproduces_the_torus_estimate_where_the_definitions_agree(bundle
     assert g.turbine.arc_shape_effect_m2 == pytest.approx(b.turbine_shape_effect_m2, abs=5e-6)
 
 
-def test_the_axial_reading_of_the_bundled_circle(bundled):
-    """Where the readings differ (docs/design.md): over the axial projection the pump's shape effect
-    is 37 % smaller, the turbine's 24 % larger, the stator's 4 % smaller; no sign changes."""
+def test_the_three_readings_of_the_bundled_circle(bundled):
+    """Where the readings differ (docs/design.md): the thesis's literal reading (exit radius × tan(exit
+    angle) × axial extent) flips the turbine's sign against both integral readings."""
     g = design_geometry(design_of_geometry(bundled))
-    assert g.pump.shape_effect_m2 == pytest.approx(-0.003568, abs=1e-6)
-    assert g.turbine.shape_effect_m2 == pytest.approx(0.001660, abs=1e-6)
-    assert g.stator.shape_effect_m2 == pytest.approx(0.000867, abs=1e-6)
+    tan = lambda deg: math.tan(math.radians(deg))  # noqa: E731
+    stator_extent = 0.03 * math.sqrt(1.0 - (0.025 / 0.03) ** 2)
+    assert g.pump.shape_effect_m2 == pytest.approx(0.12 * tan(-20.0) * 0.03, rel=1e-12)
+    assert g.turbine.shape_effect_m2 == pytest.approx(0.065 * tan(-50.0) * 0.03, rel=1e-12)
+    assert g.stator.shape_effect_m2 == pytest.approx(0.06 * tan(60.0) * stator_extent, rel=1e-12)
+    assert (g.pump.shape_effect_m2, g.turbine.shape_effect_m2, g.stator.shape_effect_m2) == pytest.approx(
+        (-0.001310, -0.002324, 0.001723), abs=1e-6
+    )
+    assert g.pump.axial_integral_shape_effect_m2 == pytest.approx(-0.003568, abs=1e-6)
+    assert g.turbine.axial_integral_shape_effect_m2 == pytest.approx(0.001660, abs=1e-6)
+    assert g.stator.axial_integral_shape_effect_m2 == pytest.approx(0.000867, abs=1e-6)
     assert g.pump.axial_extent_m == pytest.approx(0.03, rel=1e-12)
     assert g.pump.axial_length_m == pytest.approx(0.06, rel=1e-9)
 
@@ -91,8 +99,10 @@ def test_squash_zero_is_the_circle_and_squash_thins_the_shape_effect(bundled):
 
 
 def test_hand_calculation_of_a_rectangular_torus_pins_the_signs(bundled):
-    """Axial legs of width w at R_s and R_p (pump), R_p and R_t (turbine), a radial stator; constant
-    angles: S_p = (R_s + R_p)·w·tan α_p < 0 for α_p = −30°, S_t = (R_p + R_t)·w·tan α_t > 0 for 45°."""
+    """Axial legs of width w at R_s and R_p (pump), R_p and R_t (turbine), a radial stator. The
+    literal reading, by hand: S_p = R_p·w·tan α_p,exit, S_t = R_t·w·tan α_t,exit, S_s = 0 (Table
+    D.1's angles: both negative). The comparison reading with constant angles: over |dz|
+    S_p = (R_s + R_p)·w·tan α_p < 0 for α_p = −30°, S_t = (R_p + R_t)·w·tan α_t > 0 for 45°."""
     rs, rt, rp, w = 0.06, 0.065, 0.12, 0.02
     d = _replace(
         design_of_geometry(bundled),
@@ -100,15 +110,26 @@ def test_hand_calculation_of_a_rectangular_torus_pins_the_signs(bundled):
         pump_path_m=((rs, 0.0), (rs, w), (rp, w), (rp, 0.0)),
         turbine_path_m=((rp, 0.0), (rp, -w), (rt, -w), (rt, 0.0)),
         stator_path_m=((rt, 0.0), (rs, 0.0)),
-        pump_inlet_angle_deg=-30.0,
-        pump_exit_angle_deg=-30.0,
-        turbine_inlet_angle_deg=45.0,
-        turbine_exit_angle_deg=45.0,
     )
     g = design_geometry(d)
-    assert g.pump.shape_effect_m2 == pytest.approx((rs + rp) * w * math.tan(math.radians(-30.0)), rel=1e-12)
-    assert g.turbine.shape_effect_m2 == pytest.approx((rp + rt) * w, rel=1e-12)
+    assert g.pump.shape_effect_m2 == pytest.approx(rp * w * math.tan(math.radians(-20.0)), rel=1e-12)
+    assert g.turbine.shape_effect_m2 == pytest.approx(rt * w * math.tan(math.radians(-50.0)), rel=1e-12)
+    assert g.turbine.shape_effect_m2 < 0.0 < g.turbine.axial_integral_shape_effect_m2
     assert g.stator.shape_effect_m2 == 0.0
+    c = design_geometry(
+        _replace(
+            d,
+            pump_inlet_angle_deg=-30.0,
+            pump_exit_angle_deg=-30.0,
+            turbine_inlet_angle_deg=45.0,
+            turbine_exit_angle_deg=45.0,
+        )
+    )
+    assert c.pump.axial_integral_shape_effect_m2 == pytest.approx(
+        (rs + rp) * w * math.tan(math.radians(-30.0)), rel=1e-12
+    )
+    assert c.turbine.axial_integral_shape_effect_m2 == pytest.approx((rp + rt) * w, rel=1e-12)
+    assert c.stator.axial_integral_shape_effect_m2 == 0.0
     assert g.fluid_mass_kg == pytest.approx(840.0 * 0.01 * (4 * w + 2 * (rp - rs)), rel=1e-12)
 
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 from . import (
     characterise,
     converters,
+    design,
     drive,
     export_fmu,
     fit,
@@ -33,5 +34,6 @@ app.command(help=launch.HELP)(launch.launch)
 app.command(help=drive.HELP)(drive.drive)
 app.command("torque-estimate", help=torque_estimate.HELP)(torque_estimate.torque_estimate)
 app.command("export-fmu", help=export_fmu.HELP)(export_fmu.export_fmu)
+app.command(help=design.HELP)(design.design)
 
 __all__ = ["app", "main"]

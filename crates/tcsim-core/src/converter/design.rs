@@ -17,9 +17,13 @@
 //! Along each element the blade angle varies linearly with the path length from the inlet to the
 //! exit angle (signed as Table D.1). With `g = R·tan α`, per element x:
 //!
-//! * shape effect (eqs 2.16–2.18, fig. 4.7): `S_x = ∫ g dl_z` over the **axial projection** of the
-//!   element's path, `dl_z = |dz|`, whose length is `L_x = ∫ |dz|`;
-//! * the arc reading `∫ g dl` along the path (`tcsim.models.torus`), for comparison only;
+//! * shape effect, the thesis's literal reading (§4.1.1, eqs 4.1–4.2 and 2.16–2.18, fig. 4.7):
+//!   `S_x = R_x,exit · tan α_x,exit · L_x`, the element's exit radius and exit blade angle (constants
+//!   under the integral) times `L_x`, the length of the axial projection of the element's path (its
+//!   axial extent `max z − min z`, the "axial projections of the impeller and turbine measuring
+//!   approximately 30-50 mm" of §4.1.1);
+//! * for comparison only: the variable-integrand axial reading `∫ g |dz|` and the arc reading
+//!   `∫ g dl` along the path (`tcsim.models.torus`);
 //! * fluid mass `ρ·A·l_x` (`l_x` the path length) and fluid inertia `ρ·A·∫ R² dl`;
 //! * the equivalent fluid length `L_f = Σ_x ∫ (1 + tan² α) dl` (as `tcsim.models.torus`).
 //!
@@ -78,8 +82,11 @@ pub struct Design {
 /// What the design gives for one element.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ElementGeometry {
-    /// `S = ∫ R tan α |dz|` over the axial projection (eqs 2.16–2.18), m².
+    /// `S = R_exit · tan α_exit · L_axial` (eqs 4.1–4.2 and 2.16–2.18 read with the exit values,
+    /// `L_axial` the axial extent), m².
     pub shape_effect_m2: f64,
+    /// `∫ R tan α |dz|` with R and α varying along the path (comparison only), m².
+    pub axial_integral_shape_effect_m2: f64,
     /// `∫ R tan α dl` along the path (the arc reading of `tcsim.models.torus`), m².
     pub arc_shape_effect_m2: f64,
     /// Length of the path `l_x`, m.
@@ -140,8 +147,9 @@ impl Profile {
 }
 
 /// The quantities of each element in [`DesignGeometry::values`], after the element's name.
-pub const ELEMENT_QUANTITIES: [&str; 8] = [
+pub const ELEMENT_QUANTITIES: [&str; 9] = [
     "shape_effect_m2",
+    "axial_integral_shape_effect_m2",
     "arc_shape_effect_m2",
     "path_length_m",
     "axial_length_m",
@@ -162,9 +170,10 @@ pub fn geometry_columns() -> Vec<String> {
 }
 
 impl ElementGeometry {
-    fn values(&self) -> [f64; 8] {
+    fn values(&self) -> [f64; 9] {
         [
             self.shape_effect_m2,
+            self.axial_integral_shape_effect_m2,
             self.arc_shape_effect_m2,
             self.path_length_m,
             self.axial_length_m,
@@ -185,11 +194,26 @@ impl DesignGeometry {
     }
 }
 
-/// Nodes of one element's path: radius, axial position, and the path length of each segment.
+/// Nodes of one element's path: radius, axial position, the path length of each segment, and the
+/// exact axial extent of the path (`max z − min z`, m).
 struct Path {
     r: Vec<f64>,
     z: Vec<f64>,
     dl: Vec<f64>,
+    extent: f64,
+}
+
+/// `max z − min z` of `z = b sin t` over `[t0, t1]` (`t0 < t1 ≤ 2π`): the ends and the extrema at
+/// `π/2` and `3π/2` where they lie inside.
+fn conic_extent(b: f64, t0: f64, t1: f64) -> f64 {
+    let mut z = vec![b * t0.sin(), b * t1.sin()];
+    for (t, v) in [(0.5 * PI, b), (1.5 * PI, -b)] {
+        if t0 < t && t < t1 {
+            z.push(v);
+        }
+    }
+    let (lo, hi) = z.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| (lo.min(v), hi.max(v)));
+    hi - lo
 }
 
 fn err(field: impl Into<String>, value: impl std::fmt::Display, expected: impl Into<String>) -> CoreError {
@@ -374,7 +398,7 @@ fn conic_path(rc: f64, a: f64, b: f64, t0: f64, t1: f64, n: usize) -> Path {
         }
         last_speed = speed;
     }
-    Path { r, z, dl }
+    Path { r, z, dl, extent: conic_extent(b, t0, t1) }
 }
 
 /// A polyline's nodes: each segment cut into pieces in proportion to its share of the length.
@@ -391,7 +415,8 @@ fn polyline_path(vertices: &[[f64; 2]], n: usize) -> Path {
             dl.push(len / m as f64);
         }
     }
-    Path { r, z, dl }
+    let (lo, hi) = z.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v: &f64| (lo.min(v), hi.max(v)));
+    Path { r, z, dl, extent: hi - lo }
 }
 
 /// The three elements' paths of a checked design.
@@ -410,7 +435,8 @@ fn paths(d: &Design, n: usize) -> [Path; 3] {
     [conic_path(rc, a, b, 0.0, PI, n), conic_path(rc, a, b, PI, tt, n), conic_path(rc, a, b, tt, 2.0 * PI, n)]
 }
 
-fn element(p: &Path, angles: BladeAngles, rho_a: f64) -> ElementGeometry {
+/// One element's geometry; `exit_radius_m` is the design's radius at the element's exit.
+fn element(p: &Path, angles: BladeAngles, exit_radius_m: f64, rho_a: f64) -> ElementGeometry {
     let length: f64 = p.dl.iter().sum();
     let (a0, a1) = (angles.inlet_deg.to_radians(), angles.exit_deg.to_radians());
     let node = |i: usize, s: f64| {
@@ -419,7 +445,6 @@ fn element(p: &Path, angles: BladeAngles, rho_a: f64) -> ElementGeometry {
     };
     // trapezoidal sums: shape effect over |dz| and along dl, ∫R² dl, ∫(1 + tan²α) dl
     let (mut axial, mut arc, mut r2, mut weight, mut dz_sum) = (0.0, 0.0, 0.0, 0.0, 0.0);
-    let (mut zmin, mut zmax) = (p.z[0], p.z[0]);
     let (mut s, mut prev) = (0.0, node(0, 0.0));
     for (i, &dl) in p.dl.iter().enumerate() {
         s += dl;
@@ -430,15 +455,16 @@ fn element(p: &Path, angles: BladeAngles, rho_a: f64) -> ElementGeometry {
         r2 += 0.5 * (prev.1 + cur.1) * dl;
         weight += 0.5 * (prev.2 + cur.2) * dl;
         dz_sum += dz;
-        (zmin, zmax) = (zmin.min(p.z[i + 1]), zmax.max(p.z[i + 1]));
         prev = cur;
     }
+    let extent = p.extent;
     ElementGeometry {
-        shape_effect_m2: axial,
+        shape_effect_m2: exit_radius_m * a1.tan() * extent,
+        axial_integral_shape_effect_m2: axial,
         arc_shape_effect_m2: arc,
         path_length_m: length,
         axial_length_m: dz_sum,
-        axial_extent_m: zmax - zmin,
+        axial_extent_m: extent,
         fluid_length_m: weight,
         fluid_mass_kg: rho_a * length,
         fluid_inertia_kg_m2: rho_a * r2,
@@ -452,8 +478,11 @@ pub fn design_geometry(d: &Design, points: usize) -> CoreResult<DesignGeometry> 
     check_design(d)?;
     let rho_a = d.fluid_density_kg_m3 * d.flow_area_m2;
     let [p, t, s] = paths(d, points);
-    let (pump, turbine, stator) =
-        (element(&p, d.pump, rho_a), element(&t, d.turbine, rho_a), element(&s, d.stator, rho_a));
+    let (pump, turbine, stator) = (
+        element(&p, d.pump, d.pump_exit_radius_m, rho_a),
+        element(&t, d.turbine, d.turbine_exit_radius_m, rho_a),
+        element(&s, d.stator, d.stator_exit_radius_m, rho_a),
+    );
     let path = pump.path_length_m + turbine.path_length_m + stator.path_length_m;
     let out = DesignGeometry {
         pump,

@@ -35,6 +35,8 @@ fn squash_zero_is_the_circle() {
     for (x, y) in elements(&c).iter().zip(elements(&e).iter()) {
         for (u, v) in [
             (x.shape_effect_m2, y.shape_effect_m2),
+            (x.axial_integral_shape_effect_m2, y.axial_integral_shape_effect_m2),
+            (x.axial_extent_m, y.axial_extent_m),
             (x.arc_shape_effect_m2, y.arc_shape_effect_m2),
             (x.fluid_inertia_kg_m2, y.fluid_inertia_kg_m2),
             (x.fluid_length_m, y.fluid_length_m),
@@ -64,12 +66,38 @@ fn circle_reproduces_the_arc_estimate() {
     assert!(close(g.fluid_mass_kg, 840.0 * 0.01 * PI * 0.06, 1e-12));
 }
 
-/// A rectangular torus of axial width w, constant angles: the pump climbs the inner wall at R_s,
-/// crosses radially to R_p and comes back at R_p; the turbine mirrors it down to R_t, the stator
-/// is radial. By hand: S_p = (R_s + R_p)·w·tan α_p, S_t = (R_p + R_t)·w·tan α_t, S_s = 0; along the
-/// arc S_p = tan α_p·(R_s·w + (R_p² − R_s²)/2 + R_p·w).
+/// A rectangular torus of axial width w: the pump climbs the inner wall at R_s, crosses radially to
+/// R_p and comes back at R_p; the turbine mirrors it down to R_t, the stator is radial. The axial
+/// projection of pump and turbine is w long, the stator's 0. By hand, the thesis's literal reading
+/// (exit radius × tan(exit angle) × axial length, whatever the inlet angles):
+/// S_p = R_p·tan α_p,exit·w, S_t = R_t·tan α_t,exit·w, S_s = 0.
 #[test]
 fn hand_calculation_pins_the_signs() {
+    let (rs, rt, rp, w) = (0.06, 0.07, 0.12, 0.02);
+    let profile = Profile::Polyline {
+        pump: vec![[rs, 0.0], [rs, w], [rp, w], [rp, 0.0]],
+        turbine: vec![[rp, 0.0], [rp, -w], [rt, -w], [rt, 0.0]],
+        stator: vec![[rt, 0.0], [rs, 0.0]],
+    };
+    let mut d = table_d1(profile);
+    d.turbine_exit_radius_m = rt;
+    // Table D.1's angles: the turbine's inlet (+55°) and exit (−50°) have opposite signs
+    let g = geo(&d);
+    let tan = |deg: f64| deg.to_radians().tan();
+    let (sp, st) = (rp * tan(-20.0) * w, rt * tan(-50.0) * w);
+    assert!(close(g.pump.shape_effect_m2, sp, 1e-12), "{}", g.pump.shape_effect_m2);
+    assert!(close(g.turbine.shape_effect_m2, st, 1e-12), "{}", g.turbine.shape_effect_m2);
+    assert!((sp - -0.000873).abs() < 1e-6 && (st - -0.001668).abs() < 1e-6);
+    assert_eq!(g.stator.shape_effect_m2, 0.0);
+    assert!(g.pump.shape_effect_m2 < 0.0 && g.turbine.shape_effect_m2 < 0.0);
+    assert!(close(g.pump.axial_extent_m, w, 1e-12) && close(g.turbine.axial_extent_m, w, 1e-12));
+}
+
+/// The comparison readings on the rectangular torus with constant angles: over |dz| with R varying,
+/// S_p = (R_s + R_p)·w·tan α_p, S_t = (R_p + R_t)·w·tan α_t, S_s = 0; along the arc
+/// S_p = tan α_p·(R_s·w + (R_p² − R_s²)/2 + R_p·w).
+#[test]
+fn hand_calculation_of_the_comparison_readings() {
     let (rs, rt, rp, w) = (0.06, 0.07, 0.12, 0.02);
     let profile = Profile::Polyline {
         pump: vec![[rs, 0.0], [rs, w], [rp, w], [rp, 0.0]],
@@ -83,16 +111,32 @@ fn hand_calculation_pins_the_signs() {
     d.stator = BladeAngles { inlet_deg: 60.0, exit_deg: 60.0 };
     let g = geo(&d);
     let (tp, tt) = ((-30f64).to_radians().tan(), 1.0);
-    assert!(close(g.pump.shape_effect_m2, (rs + rp) * w * tp, 1e-12), "{}", g.pump.shape_effect_m2);
-    assert!(close(g.turbine.shape_effect_m2, (rp + rt) * w * tt, 1e-12));
-    assert_eq!(g.stator.shape_effect_m2, 0.0);
-    assert!(g.pump.shape_effect_m2 < 0.0 && g.turbine.shape_effect_m2 > 0.0);
+    assert!(close(g.pump.axial_integral_shape_effect_m2, (rs + rp) * w * tp, 1e-12));
+    assert!(close(g.turbine.axial_integral_shape_effect_m2, (rp + rt) * w * tt, 1e-12));
+    assert_eq!(g.stator.axial_integral_shape_effect_m2, 0.0);
+    assert!(close(g.pump.shape_effect_m2, rp * w * tp, 1e-12) && close(g.turbine.shape_effect_m2, rt * w, 1e-12));
     assert!(close(g.pump.arc_shape_effect_m2, tp * (rs * w + 0.5 * (rp * rp - rs * rs) + rp * w), 1e-12));
     assert!(close(g.pump.axial_length_m, 2.0 * w, 1e-12) && close(g.stator.axial_length_m, 0.0, 1e-12));
     let rho_a = 8.4;
     let inertia = rho_a * (rs * rs * w + (rp.powi(3) - rs.powi(3)) / 3.0 + rp * rp * w);
     assert!(close(g.pump.fluid_inertia_kg_m2, inertia, 1e-6));
     assert!(close(g.pump.fluid_length_m, (1.0 + tp * tp) * (2.0 * w + rp - rs), 1e-12));
+}
+
+/// Table D.1 as a circle: the literal reading flips the turbine's sign against both integral
+/// readings (issue 15), S = R_exit·tan α_exit·a with the half-circle's axial extent a = 0.03 m.
+#[test]
+fn table_d1_literal_reading_flips_the_turbine() {
+    let g = geo(&table_d1(Profile::Circular));
+    let tan = |deg: f64| deg.to_radians().tan();
+    assert!(close(g.pump.shape_effect_m2, 0.12 * tan(-20.0) * 0.03, 1e-12));
+    assert!(close(g.turbine.shape_effect_m2, 0.065 * tan(-50.0) * 0.03, 1e-12));
+    let stator_extent = 0.03 * (1.0 - (0.025f64 / 0.03).powi(2)).sqrt();
+    assert!(close(g.stator.axial_extent_m, stator_extent, 1e-12));
+    assert!(close(g.stator.shape_effect_m2, 0.06 * tan(60.0) * stator_extent, 1e-12));
+    assert!((g.turbine.shape_effect_m2 - -0.002324).abs() < 1e-6);
+    assert!(g.turbine.shape_effect_m2 < 0.0);
+    assert!(g.turbine.axial_integral_shape_effect_m2 > 0.0 && g.turbine.arc_shape_effect_m2 > 0.0);
 }
 
 /// §4.1.1: "a smaller diameter (smaller exit radii), axially thinner (shorter length of the axial
@@ -124,17 +168,20 @@ fn thesis_section_4_1_1_trends() {
         assert!(a < last.0 && b < last.1, "squash {q}");
         last = (a, b);
     }
-    // lower exit angles: the pump's (inlet and exit of one sign)
+    // lower exit angles: the pump's, and the turbine's with Table D.1's inlet angle (only the exit
+    // angle enters the literal reading)
     let mut lo = base.clone();
     lo.pump.exit_deg = -10.0;
-    assert!(s(&lo).0 < sp);
-    // the turbine's, with an inlet angle of the exit's sign (Table D.1's inlet 55° has the other
-    // sign: S_t is then the difference of an inlet and an exit part, docs/design.md)
+    assert!(s(&lo).0 < sp && s(&lo).1 == st);
     let mut t = base.clone();
-    t.turbine.inlet_deg = -20.0;
-    let st0 = s(&t).1;
     t.turbine.exit_deg = -40.0;
-    assert!(s(&t).1 < st0);
+    assert!(s(&t).1 < st && s(&t).0 == sp);
+    // the stator too: exit radius, axial thinness and exit angle
+    let ss = |d: &Design| geo(d).stator.shape_effect_m2.abs();
+    let mut sa = base.clone();
+    sa.stator.exit_deg = 45.0;
+    assert!(ss(&sa) < ss(&base));
+    assert!(ss(&table_d1(Profile::Elliptic { squash_ratio: 0.35 })) < ss(&base));
 }
 
 #[test]
@@ -144,7 +191,7 @@ fn converges_with_the_number_of_points() {
         let at = |n| design_geometry(&d, n).unwrap();
         let (coarse, mid, fine) = (at(101), at(1001), at(100_001));
         for k in 0..3 {
-            let f = |g: &DesignGeometry| elements(g)[k].shape_effect_m2;
+            let f = |g: &DesignGeometry| elements(g)[k].axial_integral_shape_effect_m2;
             let (e1, e2) = ((f(&coarse) - f(&fine)).abs(), (f(&mid) - f(&fine)).abs());
             // second order: ten times the nodes, about a hundredth of the error
             assert!(e2 < 0.02 * e1 + 1e-15, "element {k}: {e1} then {e2}");
@@ -152,13 +199,19 @@ fn converges_with_the_number_of_points() {
             assert!(e < 1e-6 * f(&fine).abs(), "element {k}: {e}");
         }
         assert!(close(at(DEFAULT_POINTS).fluid_length_m, fine.fluid_length_m, 1e-6));
+        // the literal reading takes the exact axial extent: no integration error at all
+        for k in 0..3 {
+            let f = |g: &DesignGeometry| elements(g)[k].shape_effect_m2;
+            assert!(close(f(&at(16)), f(&fine), 1e-12), "element {k}");
+        }
     }
 }
 
-/// The axial reading keeps the mass-matrix bound of the arc reading (physics notes §4): with
-/// `|dz| ≤ dl`, `ρ²S_x² / I_x,fluid ≤ (ρ/A)∫_x tan²α dl`.
+/// The variable-integrand axial reading keeps the mass-matrix bound of the arc reading (physics
+/// notes §4): with `|dz| ≤ dl`, `ρ²S_x² / I_x,fluid ≤ (ρ/A)∫_x tan²α dl`. The literal reading has no
+/// such bound (docs/design.md): the metal inertias carry it.
 #[test]
-fn axial_shape_effect_keeps_the_mass_matrix_bound() {
+fn axial_integral_shape_effect_keeps_the_mass_matrix_bound() {
     let mut seed = 12345u64;
     let mut next = || {
         seed = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
@@ -172,7 +225,7 @@ fn axial_shape_effect_keeps_the_mass_matrix_bound() {
         let g = geo(&d);
         let (rho, area) = (d.fluid_density_kg_m3, d.flow_area_m2);
         for e in elements(&g) {
-            let lhs = rho * rho * e.shape_effect_m2.powi(2) / e.fluid_inertia_kg_m2;
+            let lhs = rho * rho * e.axial_integral_shape_effect_m2.powi(2) / e.fluid_inertia_kg_m2;
             let rhs = rho / area * (e.fluid_length_m - e.path_length_m);
             assert!(lhs <= rhs * (1.0 + 1e-9), "{lhs} > {rhs}");
         }
@@ -287,8 +340,10 @@ fn profiles_by_name_and_columns() {
     assert_eq!(field("elliptic", Some(0.1), Some(square(0.06, 0.065, 0.12))), "pump_path_m");
     let g = geo(&table_d1(Profile::Circular));
     let (names, values) = (geometry_columns(), g.values());
-    assert_eq!((names.len(), values.len()), (27, 27));
+    assert_eq!((names.len(), values.len()), (30, 30));
     assert_eq!((names[0].as_str(), values[0]), ("pump_shape_effect_m2", g.pump.shape_effect_m2));
-    assert_eq!((names[23].as_str(), values[23]), ("stator_fluid_inertia_kg_m2", g.stator.fluid_inertia_kg_m2));
-    assert_eq!((names[24].as_str(), values[24]), ("fluid_length_m", g.fluid_length_m));
+    let integral = g.pump.axial_integral_shape_effect_m2;
+    assert_eq!((names[1].as_str(), values[1]), ("pump_axial_integral_shape_effect_m2", integral));
+    assert_eq!((names[26].as_str(), values[26]), ("stator_fluid_inertia_kg_m2", g.stator.fluid_inertia_kg_m2));
+    assert_eq!((names[27].as_str(), values[27]), ("fluid_length_m", g.fluid_length_m));
 }

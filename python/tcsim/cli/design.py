@@ -1,0 +1,71 @@
+"""``tcsim design``: from a converter design (torus, blades, fluid, metal inertias) to its converter
+file, its characteristic and its isolated take-off against a reference converter.
+
+::
+
+    tcsim design DESIGN [--out DIR] [--reference CONVERTER]
+
+DESIGN is a design ``.toml`` or a bundled design's name (``li-sunden-2016-design``); the schema is in
+docs/design.md ("Design files"). DIR (default ``design``) receives, all at once and nothing on
+error (:mod:`tcsim.io.outputs`): ``converter.toml``, ``characteristic.csv``,
+``reference_characteristic.csv``, ``takeoff.csv``, ``summary.csv`` and the plots of the
+characteristic (design and reference) and of the take-off. Bad input: exit 2, one line naming the
+file, the field and the value.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from .app import OutOpt, say
+
+#: The command's ``--help`` text.
+HELP = (
+    "From a converter design (torus, blades, fluid) to DIR/converter.toml, its characteristic and its "
+    "isolated take-off against a reference converter."
+)
+
+
+def design(
+    design: Annotated[str, typer.Argument(help="design .toml or bundled design name (li-sunden-2016-design)")],
+    out: OutOpt = Path("design"),
+    reference: Annotated[
+        str, typer.Option("--reference", help="reference converter with [geometry]: bundled name or .toml")
+    ] = "li-sunden-2016",
+) -> None:
+    """The command; its help is :data:`HELP`."""
+    from ..analysis.design_report import design_report
+    from ..io.design_outputs import write_design_files
+    from ..io.outputs import check_output_dir, output_dir
+    from ..models.design_file import LOSS_DEFAULTS_FROM, load_design_file
+    from ..plots.characteristic import plot_characteristic
+    from ..plots.design import plot_design_takeoff
+
+    check_output_dir(out, [design, reference])
+    file = load_design_file(design)
+    report = design_report(file, reference)
+    inputs = [design, file.path, reference, report.reference.path]
+    check_output_dir(out, inputs)
+    with output_dir(out, inputs) as stage:
+        write_design_files(report, file.path, stage)
+        title = f"{file.name} against {report.reference.name}"
+        curves = {f"{name} (hrovat-tobler)": df for name, df in report.characteristics.items()}
+        plot_characteristic(curves, stage, f"{title}, Hrovat & Tobler closed form")
+        plot_design_takeoff(report.takeoffs, stage, f"{title}: isolated take-off")
+    g = report.derived.geometry
+    say(
+        f"{file.name}: converter.toml with S_p, S_t, S_s = {g.pump.shape_effect_m2:.6g}, "
+        f"{g.turbine.shape_effect_m2:.6g}, {g.stator.shape_effect_m2:.6g} m², L_f = {g.fluid_length_m:.6g} m, "
+        f"written to {out}"
+    )
+    defaults = report.derived.default_losses
+    if defaults:
+        say(f"losses not in the design, taken from Table D.1 ({LOSS_DEFAULTS_FROM}): {', '.join(defaults)}")
+    for row in report.summary.itertuples():
+        say(
+            f"{row.role} {row.converter}: stall TR {row.stall_torque_ratio:.3f}, take-off effective-TR dip "
+            f"{row.takeoff_effective_tr_dip:.4f} at {row.takeoff_effective_tr_dip_time_s:.2f} s"
+        )

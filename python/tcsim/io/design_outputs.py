@@ -1,0 +1,37 @@
+"""The files of ``tcsim design`` (docs/design.md, "tcsim design"), written into a staging folder
+of :func:`tcsim.io.outputs.output_dir`: ``converter.toml``, ``characteristic.csv`` (the design's),
+``reference_characteristic.csv``, ``takeoff.csv`` (both converters, a ``converter`` column) and
+``summary.csv``."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pandas as pd
+import tomli_w
+
+from ..analysis.design_report import DesignReport
+from .results import write_frames
+
+#: The header of the written ``converter.toml``.
+CONVERTER_HEADER = (
+    "# Derived by `tcsim design` from the design file {name}: every value's formula is in [sources]\n"
+    "# (docs/design.md). A converter file like any other: it runs the hrovat-tobler model.\n\n"
+)
+
+
+def write_design_files(report: DesignReport, design_path: str, out_dir: Path) -> list[Path]:
+    """The converter file and the CSV files of ``report`` into ``out_dir``; the paths written."""
+    out_dir = Path(out_dir)
+    toml = out_dir / "converter.toml"
+    header = CONVERTER_HEADER.format(name=Path(design_path).name)
+    toml.write_text(header + tomli_w.dumps(report.derived.document), encoding="utf-8")
+    (design, steady), (_, ref_steady) = report.characteristics.items()
+    takeoff = pd.concat([df.assign(converter=name) for name, df in report.takeoffs.items()], ignore_index=True)
+    frames = {
+        "characteristic.csv": steady,
+        "reference_characteristic.csv": ref_steady,
+        "takeoff.csv": takeoff[["converter", *(c for c in takeoff.columns if c != "converter")]],
+        "summary.csv": report.summary,
+    }
+    return [toml, *write_frames(frames, out_dir)]

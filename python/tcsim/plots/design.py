@@ -1,0 +1,33 @@
+"""Figures of ``tcsim design``: the isolated take-off of a design against a reference converter
+(effective torque ratio and turbine speed against time; docs/design.md, "tcsim design")."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+
+import pandas as pd
+
+from .common import finish_figure, mpl_text, plt
+
+#: The take-off figures: column, axis label, file name.
+TAKEOFF_FIGURES = (
+    ("effective_torque_ratio", "Effective torque ratio [-]", "takeoff_effective_torque_ratio.png"),
+    ("turbine_speed_rad_s", "Turbine speed [rad/s]", "takeoff_turbine_speed.png"),
+)
+#: The time window of the effective-torque-ratio figure, s (the dip is in the first seconds).
+DIP_WINDOW_S = (0.0, 3.0)
+
+
+def plot_design_takeoff(takeoffs: Mapping[str, pd.DataFrame], out_dir: Path, title: str) -> list[Path]:
+    """One PNG per :data:`TAKEOFF_FIGURES` entry in ``out_dir``, a line per converter (``takeoffs``:
+    converter name → take-off frame with ``time_s`` in s); the paths written."""
+    paths = []
+    for column, label, filename in TAKEOFF_FIGURES:
+        fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+        for i, (name, df) in enumerate(takeoffs.items()):
+            frame = df[df["time_s"] <= DIP_WINDOW_S[1]] if column == "effective_torque_ratio" else df
+            ax.plot(frame["time_s"], frame[column], lw=1.4, ls="-" if i == 0 else "--", label=mpl_text(name))
+        ax.set_ylabel(label)
+        paths.append(finish_figure(fig, ax, Path(out_dir) / filename, title))
+    return paths
