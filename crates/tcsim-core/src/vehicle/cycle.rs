@@ -477,7 +477,7 @@ pub fn simulate_drive(
         let energies = c.energies;
         let t_next = ((k + 1) as f64 * dt).min(end);
         if !v.gearbox.shift_pedal.is_identity() && t_next > t_k {
-            let (signal, next) = v.gearbox.shift_pedal.filtered(|_| pedal, shift_pedal, t_k, t_next)?;
+            let (signal, next) = v.gearbox.shift_pedal.filtered(&Signal::constant(pedal), shift_pedal, t_k, t_next)?;
             (sc.shift_pedal, shift_pedal) = (Some(signal), next);
         }
         let first = if k == n_steps || t_next <= t_k {

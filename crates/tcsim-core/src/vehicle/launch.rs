@@ -279,8 +279,8 @@ pub fn with_shift_pedal(v: &Vehicle, sc: &Scenario) -> CoreResult<Scenario> {
     if filter.is_identity() || sc.shift_pedal.is_some() {
         return Ok(sc.clone());
     }
-    let pedal = |t: f64| sc.accelerator_pedal.value(t);
-    let (signal, _) = filter.filtered(pedal, pedal(0.0), 0.0, sc.end_time_s)?;
+    let pedal = &sc.accelerator_pedal;
+    let (signal, _) = filter.filtered(pedal, pedal.value(0.0), 0.0, sc.end_time_s)?;
     Ok(Scenario { shift_pedal: Some(signal), ..sc.clone() })
 }
 
