@@ -26,6 +26,7 @@ fn flip_flop(pedal: f64, end: f64, stop: f64) -> Scenario {
         end_time_s: end,
         stop_speed_m_s: Some(stop),
         engine_torque_nm: None,
+        shift_pedal: None,
     }
 }
 
@@ -187,6 +188,7 @@ fn coasting_slows_down_and_the_brake_stops_and_holds_the_vehicle() {
         end_time_s: 40.0,
         stop_speed_m_s: None,
         engine_torque_nm: None,
+        shift_pedal: None,
     };
     let r = run(&table(), &sc);
     let speed_at = |time: f64| r.samples.iter().find(|s| s.time_s >= time).unwrap().u[SPEED];
@@ -216,6 +218,7 @@ fn coast_and_brake(brake: f64) -> Scenario {
         end_time_s: 40.0,
         stop_speed_m_s: None,
         engine_torque_nm: None,
+        shift_pedal: None,
     }
 }
 
@@ -246,6 +249,7 @@ fn a_lockup_clutch_that_breaks_away_locks_again() {
         end_time_s: 40.0,
         stop_speed_m_s: None,
         engine_torque_nm: None,
+        shift_pedal: None,
     };
     let r = simulate_launch(&table(), &v, &sc, 0.01, &SolverOptions::default()).unwrap();
     let kinds: Vec<&str> = r.events.iter().map(|e| e.kind).collect();

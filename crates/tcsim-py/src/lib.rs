@@ -1103,6 +1103,7 @@ fn scenario_from(d: &Bound<'_, PyDict>) -> PyResult<Scenario> {
             Some(v) => Some(Signal::new("engine_torque_nm", t.clone(), v, 0.0).map_err(scenario_error)?),
             None => None,
         },
+        shift_pedal: None,
     })
 }
 

@@ -84,6 +84,12 @@ impl Vehicle {
 }
 
 impl Scenario {
+    /// The pedal the shift schedule reads at `t`: the TCU's filtered pedal if the scenario has it,
+    /// else the accelerator pedal ([`super::shift_pedal`]).
+    pub fn shift_pedal_at(&self, t: f64) -> f64 {
+        self.shift_pedal.as_ref().unwrap_or(&self.accelerator_pedal).value(t)
+    }
+
     /// Net crank torque, the engine's (indicated) power and its drag loss at `u`, `t`.
     pub fn engine(&self, e: &Engine, u: &[f64; N_COORDS], t: f64) -> (f64, f64, f64) {
         let w = u[PUMP];
@@ -158,6 +164,7 @@ mod tests {
             downshift_speed_zero_pedal_m_s: vec![2.0, 5.0],
             downshift_speed_full_pedal_m_s: vec![8.0, 16.0],
             shift_control: Default::default(),
+            shift_pedal: Default::default(),
         };
         g.validate().unwrap();
         assert_eq!((g.upshift_speed(0, 0.5), g.upshift_speed(1, 1.0), g.downshift_speed(2, 0.0)), (8.0, 24.0, 5.0));

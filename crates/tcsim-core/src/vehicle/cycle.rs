@@ -316,6 +316,7 @@ fn held_scenario(pedal: f64, brake: f64, end_time_s: f64) -> Scenario {
         end_time_s,
         stop_speed_m_s: None,
         engine_torque_nm: None,
+        shift_pedal: None,
     }
 }
 
@@ -461,6 +462,8 @@ pub fn simulate_drive(
     }
     try_reserve(&mut out.run.samples, n_steps + 1)?;
     let mut integral = 0.0;
+    // the TCU's filtered pedal for the shift schedule, from the standstill's closed pedal
+    let mut shift_pedal = 0.0;
     let mut sample = {
         let plant = Plant::new(model, v, &sc0, c.mode, c.sync);
         plant.sample(&plant.state_of(&c.u), 0.0)
@@ -470,9 +473,13 @@ pub fn simulate_drive(
         let t_k = c.t;
         let (pedal, brake) = driver.command(v, trace, t_k, &sample, &mut integral);
         veh.body.grade_percent = trace.grade(t_k);
-        let sc = held_scenario(pedal, brake, end);
+        let mut sc = held_scenario(pedal, brake, end);
         let energies = c.energies;
         let t_next = ((k + 1) as f64 * dt).min(end);
+        if !v.gearbox.shift_pedal.is_identity() && t_next > t_k {
+            let (signal, next) = v.gearbox.shift_pedal.filtered(&Signal::constant(pedal), shift_pedal, t_k, t_next)?;
+            (sc.shift_pedal, shift_pedal) = (Some(signal), next);
+        }
         let first = if k == n_steps || t_next <= t_k {
             let plant = Plant::new(model, &veh, &sc, c.mode, c.sync);
             plant.sample(&plant.state_of(&c.u), t_k)

@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 
 use super::parameters::{field, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Tyres, Vehicle};
 use super::shift::ShiftControl;
+use super::shift_pedal::PedalFilter;
 use crate::error::{CoreError, CoreResult};
 
 /// The sections of a vehicle file that hold the vehicle's values, in file order.
@@ -108,6 +109,13 @@ pub struct GearboxSection {
     /// on-coming clutch keeps `shift_clutch_capacity_nm` ([`super::shift`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub upshift_inertia_phase_s: Option<f64>,
+    /// Time constant of the TCU's filter of the pedal the shift schedule reads while the pedal
+    /// rises, s, 0–10 ([`super::shift_pedal::PEDAL_TIME_CONSTANT`]); absent: 0 (at once).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift_pedal_rise_s: Option<f64>,
+    /// As `shift_pedal_rise_s`, while the pedal falls; absent: 0 (no filter).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub shift_pedal_fall_s: Option<f64>,
     /// Vehicle speed of the upshift from gear k at zero pedal, m/s, > 0, gears − 1 values,
     /// strictly increasing.
     pub upshift_speed_zero_pedal_m_s: Vec<f64>,
@@ -255,6 +263,10 @@ impl VehicleFile {
                 shift_control: ShiftControl {
                     torque_reduction: g.upshift_torque_reduction.unwrap_or(0.0),
                     inertia_phase_s: g.upshift_inertia_phase_s,
+                },
+                shift_pedal: PedalFilter {
+                    rise_s: g.shift_pedal_rise_s.unwrap_or(0.0),
+                    fall_s: g.shift_pedal_fall_s.unwrap_or(0.0),
                 },
             },
             lockup: Lockup {

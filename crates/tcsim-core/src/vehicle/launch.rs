@@ -188,10 +188,11 @@ pub(super) fn pending_switch(plant: &Plant, u: &Coords, t: f64) -> Option<Root> 
         return Some(Root::LockupRelease);
     }
     if m.shift.is_none() && !m.wheels_held {
-        if m.gear + 1 < gb.ratios.len() && u[SPEED] > gb.upshift_speed(m.gear, p) {
+        let p_shift = plant.sc.shift_pedal_at(t);
+        if m.gear + 1 < gb.ratios.len() && u[SPEED] > gb.upshift_speed(m.gear, p_shift) {
             return Some(Root::Upshift);
         }
-        if m.gear > 0 && u[SPEED] < gb.downshift_speed(m.gear, p) {
+        if m.gear > 0 && u[SPEED] < gb.downshift_speed(m.gear, p_shift) {
             return Some(Root::Downshift);
         }
         if m.lockup == LockupState::Open
@@ -270,6 +271,19 @@ pub(super) fn initial_mode(model: &dyn ConverterDynamics, sc: &Scenario) -> Vehi
     }
 }
 
+/// `sc` with the pedal the shift schedule reads: the accelerator pedal through the gearbox's
+/// TCU filter from its value at 0 to the end time ([`super::shift_pedal`]); `sc` itself if the
+/// filter passes the pedal unchanged or the scenario already has a shift pedal.
+pub fn with_shift_pedal(v: &Vehicle, sc: &Scenario) -> CoreResult<Scenario> {
+    let filter = &v.gearbox.shift_pedal;
+    if filter.is_identity() || sc.shift_pedal.is_some() {
+        return Ok(sc.clone());
+    }
+    let pedal = &sc.accelerator_pedal;
+    let (signal, _) = filter.filtered(pedal, pedal.value(0.0), 0.0, sc.end_time_s)?;
+    Ok(Scenario { shift_pedal: Some(signal), ..sc.clone() })
+}
+
 /// Run a launch from the braked standstill ([`initial_state`]), sampled every `output_step_s`
 /// until the stop speed or the end time.
 pub fn simulate_launch(
@@ -280,6 +294,8 @@ pub fn simulate_launch(
     options: &SolverOptions,
 ) -> TransientResult<LaunchTrajectory> {
     let times = output_times(v, sc, output_step_s, options)?;
+    let filtered = with_shift_pedal(v, sc)?;
+    let sc = &filtered;
     let u0 = initial_state(model, v, sc)?;
     let mut mode = initial_mode(model, sc);
     let mut traj = LaunchTrajectory::default();

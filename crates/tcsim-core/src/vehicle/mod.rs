@@ -28,6 +28,7 @@
 //! * [`modes`]: the discrete state (gear, shift, lock-up, brake hold) and the event kinds.
 //! * [`plant`]: the plant in one mode (mass matrix, generalised coordinates, forces, roots).
 //! * [`shift`]: the gearbox's inertia during a shift and the shift control of upshifts.
+//! * [`shift_pedal`]: the TCU's filtered pedal the shift schedule reads.
 //! * [`launch`]: the run loop of a launch, its initial state and its switches.
 //! * [`outputs`]: the output columns of a launch.
 //! * [`cycle`]: drive cycles, a driver following a speed trace with the same plant.
@@ -42,6 +43,7 @@ pub mod parameters;
 pub mod plant;
 pub mod range;
 pub mod shift;
+pub mod shift_pedal;
 
 /// Number of coordinates of the vehicle plant.
 pub const N_COORDS: usize = 12;

@@ -4,6 +4,7 @@
 //! `[gearbox].ratios[3]`). The physics that uses them is in [`super::components`].
 
 use super::shift::ShiftControl;
+use super::shift_pedal::PedalFilter;
 use crate::engine::signal::Signal;
 use crate::error::{CoreError, CoreResult};
 
@@ -259,6 +260,8 @@ pub struct Gearbox {
     pub downshift_speed_full_pedal_m_s: Vec<f64>,
     /// Shift control of upshifts (torque reduction, on-coming clutch profile): [`super::shift`].
     pub shift_control: ShiftControl,
+    /// The TCU's filter of the pedal the shift schedule reads: [`super::shift_pedal`].
+    pub shift_pedal: PedalFilter,
 }
 
 impl Gearbox {
@@ -307,7 +310,8 @@ impl Gearbox {
         GEARBOX_OUTPUT_INERTIA.check(&f("output_inertia_kg_m2"), self.output_inertia_kg_m2)?;
         CLUTCH_CAPACITY.check(&f("shift_clutch_capacity_nm"), self.shift_clutch_capacity_nm)?;
         Range::POSITIVE.check(&f("shift_handover_s"), self.shift_handover_s)?;
-        self.shift_control.validate()
+        self.shift_control.validate()?;
+        self.shift_pedal.validate()
     }
 }
 
@@ -433,6 +437,10 @@ pub struct Scenario {
     /// its complete-vehicle simulation (§3.5.2.2). The pedal then only drives the shift and lock-up
     /// schedules.
     pub engine_torque_nm: Option<Signal>,
+    /// The pedal the shift schedule reads (the TCU's filtered pedal, [`super::shift_pedal`]); None:
+    /// the accelerator pedal. A launch fills it from the gearbox's filter
+    /// ([`super::launch::with_shift_pedal`]), a drive at each control step.
+    pub shift_pedal: Option<Signal>,
 }
 
 #[cfg(test)]

@@ -470,8 +470,8 @@ impl<'a> Plant<'a> {
                     (fd * shaft[0].abs() - 0.8 * cap * share).max(fd * shaft[1].abs() - 0.8 * cap * (1.0 - share));
                 spin.max(short)
             }
-            Root::Upshift => gb.upshift_speed(self.mode.gear, p) - u[SPEED],
-            Root::Downshift => u[SPEED] - gb.downshift_speed(self.mode.gear, p),
+            Root::Upshift => gb.upshift_speed(self.mode.gear, self.sc.shift_pedal_at(t)) - u[SPEED],
+            Root::Downshift => u[SPEED] - gb.downshift_speed(self.mode.gear, self.sc.shift_pedal_at(t)),
             Root::ShiftHandover => self.mode.shift.map_or(1.0, |s| s.since_s + gb.shift_handover_s - t),
             Root::ShiftSync => self
                 .mode
