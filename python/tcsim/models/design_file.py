@@ -18,12 +18,12 @@ and the formula of every value. It has no ``[characteristic]``: it runs the ``hr
 from __future__ import annotations
 
 import tomllib
-from dataclasses import dataclass, fields
+from dataclasses import MISSING, dataclass, fields
 from importlib import resources
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, get_type_hints
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
 from ..errors import InputError
 from .converter import Converter, InertiaSection, load_converter, parse_converter
@@ -41,25 +41,20 @@ class _Strict(BaseModel):
     model_config = ConfigDict(extra="forbid", strict=False)
 
 
-class DesignSection(_Strict):
-    """``[design]``: the types only; the values are checked by the core (docs/design.md, "Bad input")."""
+def _design_section() -> type[_Strict]:
+    """``[design]``: the fields of :class:`~.design.TorusDesign` (the one owner of the schema), typed;
+    the values are checked by the core (docs/design.md, "Bad input")."""
+    types = get_type_hints(TorusDesign)
+    defs: dict[str, Any] = {
+        f.name: (types[f.name], ... if f.default is MISSING else f.default) for f in fields(TorusDesign)
+    }
+    return create_model("DesignSection", __base__=_Strict, **defs)
 
-    pump_exit_radius_m: float
-    turbine_exit_radius_m: float
-    stator_exit_radius_m: float
-    pump_inlet_angle_deg: float
-    pump_exit_angle_deg: float
-    turbine_inlet_angle_deg: float
-    turbine_exit_angle_deg: float
-    stator_inlet_angle_deg: float
-    stator_exit_angle_deg: float
-    flow_area_m2: float
-    fluid_density_kg_m3: float
-    profile: str = "circular"
-    squash_ratio: float | None = None
-    pump_path_m: list[tuple[float, float]] | None = None
-    turbine_path_m: list[tuple[float, float]] | None = None
-    stator_path_m: list[tuple[float, float]] | None = None
+
+if TYPE_CHECKING:
+    DesignSection = _Strict
+else:
+    DesignSection = _design_section()
 
 
 class LossSection(_Strict):
