@@ -19,6 +19,7 @@ converters. The summary gives, per converter (:data:`SUMMARY_COLUMNS`):
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,6 +36,8 @@ from ..units import DEFAULT_PUMP_SPEED_RPM
 DEFAULT_REFERENCE = "li-sunden-2016"
 #: The take-off's sample step and end, s; the start of its torque ramp, s.
 TAKEOFF_STEP_S, TAKEOFF_END_S, RAMP_START_S = 0.01, 10.0, 0.1
+#: The take-off columns the figures read.
+TAKEOFF_COLUMNS = ("time_s", "speed_ratio", "effective_torque_ratio", "turbine_speed_rad_s")
 #: The columns of the summary, one row per converter.
 SUMMARY_COLUMNS = (
     "converter",
@@ -70,16 +73,31 @@ def takeoff_frame(conv: Converter) -> pd.DataFrame:
     return simulate(conv, isolated_takeoff(), model="hrovat-tobler", times_s=times).frame()
 
 
+def takeoff_figures(
+    takeoff: Mapping[str, np.ndarray], steady_sr: np.ndarray, steady_tr: np.ndarray
+) -> dict[str, float]:
+    """The take-off's effective-TR dip (-), its time (s) and the turbine speed 1 s after the start of
+    the ramp (rad/s), from the take-off's columns (``time_s``, ``speed_ratio``,
+    ``effective_torque_ratio``, ``turbine_speed_rad_s``) and the characteristic's SR (ascending from
+    0) and TR."""
+    t = np.asarray(takeoff["time_s"], dtype=float)
+    after = t >= RAMP_START_S
+    sr = np.asarray(takeoff["speed_ratio"], dtype=float)[after]
+    gap = np.interp(sr, steady_sr, steady_tr) - np.asarray(takeoff["effective_torque_ratio"], dtype=float)[after]
+    k = int(np.argmax(gap))
+    return {
+        "takeoff_effective_tr_dip": float(gap[k]),
+        "takeoff_effective_tr_dip_time_s": float(t[after][k]),
+        "takeoff_turbine_speed_1s_rad_s": float(np.interp(RAMP_START_S + 1.0, t, takeoff["turbine_speed_rad_s"])),
+    }
+
+
 def summary_row(conv: Converter, role: str, steady: pd.DataFrame, takeoff: pd.DataFrame) -> dict[str, object]:
     """One row of the summary (:data:`SUMMARY_COLUMNS`) from a converter's characteristic ``steady``
     (SR ascending from 0) and take-off ``takeoff``."""
     assert conv.geometry is not None  # the hrovat-tobler model ran
-    t = takeoff["time_s"].to_numpy(dtype=float)
-    after = t >= RAMP_START_S
-    sr = takeoff["speed_ratio"].to_numpy(dtype=float)[after]
-    steady_tr = np.interp(sr, steady["speed_ratio"].to_numpy(dtype=float), steady["torque_ratio"].to_numpy(dtype=float))
-    gap = steady_tr - takeoff["effective_torque_ratio"].to_numpy(dtype=float)[after]
-    k = int(np.argmax(gap))
+    ssr, steady_tr = steady["speed_ratio"].to_numpy(dtype=float), steady["torque_ratio"].to_numpy(dtype=float)
+    figures = takeoff_figures({c: takeoff[c].to_numpy(dtype=float) for c in TAKEOFF_COLUMNS}, ssr, steady_tr)
     cp = coupling_point(conv)
     below = steady["speed_ratio"] < (cp if cp is not None else np.inf)
     return {
@@ -89,9 +107,7 @@ def summary_row(conv: Converter, role: str, steady: pd.DataFrame, takeoff: pd.Da
         "stall_k_factor_rpm_per_sqrt_nm": float(steady["k_factor_rpm_per_sqrt_nm"].iloc[0]),
         "peak_converter_efficiency": float(steady["efficiency"][below].max()),
         "coupling_point_speed_ratio": float("nan") if cp is None else float(cp),
-        "takeoff_effective_tr_dip": float(gap[k]),
-        "takeoff_effective_tr_dip_time_s": float(t[after][k]),
-        "takeoff_turbine_speed_1s_rad_s": float(np.interp(RAMP_START_S + 1.0, t, takeoff["turbine_speed_rad_s"])),
+        **figures,
         "pump_shape_effect_m2": conv.geometry.pump_shape_effect_m2,
         "turbine_shape_effect_m2": conv.geometry.turbine_shape_effect_m2,
         "stator_shape_effect_m2": conv.geometry.stator_shape_effect_m2,
@@ -116,4 +132,12 @@ def design_report(
     return DesignReport(derived, ref, characteristics, takeoffs, summary)
 
 
-__all__ = ["DEFAULT_REFERENCE", "SUMMARY_COLUMNS", "DesignReport", "design_report", "summary_row", "takeoff_frame"]
+__all__ = [
+    "DEFAULT_REFERENCE",
+    "SUMMARY_COLUMNS",
+    "DesignReport",
+    "design_report",
+    "summary_row",
+    "takeoff_figures",
+    "takeoff_frame",
+]

@@ -10,6 +10,7 @@ from . import (
     characterise,
     converters,
     design,
+    design_study,
     drive,
     export_fmu,
     fit,
@@ -35,5 +36,6 @@ app.command(help=drive.HELP)(drive.drive)
 app.command("torque-estimate", help=torque_estimate.HELP)(torque_estimate.torque_estimate)
 app.command("export-fmu", help=export_fmu.HELP)(export_fmu.export_fmu)
 app.command(help=design.HELP)(design.design)
+app.command("design-study", help=design_study.HELP)(design_study.design_study)
 
 __all__ = ["app", "main"]

@@ -17,6 +17,7 @@ and the formula of every value. It has no ``[characteristic]``: it runs the ``hr
 
 from __future__ import annotations
 
+import functools
 import tomllib
 from dataclasses import MISSING, dataclass, fields
 from importlib import resources
@@ -26,7 +27,7 @@ from typing import TYPE_CHECKING, Any, get_type_hints
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
 from ..errors import InputError
-from .converter import Converter, InertiaSection, load_converter, parse_converter
+from .converter import Converter, GeometrySection, InertiaSection, load_converter, parse_converter
 from .design import DEFAULT_POINTS, DesignGeometry, TorusDesign, design_geometry
 
 #: The bundled converter whose ``[geometry]`` gives the default loss coefficients (Table D.1).
@@ -183,6 +184,15 @@ def _sources(file: DesignFile, defaults: tuple[str, ...]) -> dict[str, str]:
     return out
 
 
+@functools.cache
+def _table_d1() -> GeometrySection:
+    """The ``[geometry]`` of the bundled :data:`LOSS_DEFAULTS_FROM` (read once: a design study derives
+    thousands of converters)."""
+    geometry = load_converter(LOSS_DEFAULTS_FROM).geometry
+    assert geometry is not None  # the bundled thesis converter has [geometry]
+    return geometry
+
+
 def derive_converter(file: DesignFile, points: int | None = None) -> DerivedConverter:
     """The converter of a design: its geometry by the core (bad values name the design file), the
     converter TOML document, and the converter validated as any converter file is."""
@@ -191,8 +201,7 @@ def derive_converter(file: DesignFile, points: int | None = None) -> DerivedConv
     except InputError as e:  # the core names the design's field: it lives in [design]
         field = e.field if e.field == "points" else f"[design].{e.field}"
         raise InputError(e.source, field, e.value, e.expected, e.core_source) from None
-    table_d1 = load_converter(LOSS_DEFAULTS_FROM).geometry
-    assert table_d1 is not None  # the bundled thesis converter has [geometry]
+    table_d1 = _table_d1()
     defaults = tuple(k for k in LOSS_KEYS if k not in file.losses)
     d = file.design
     geometry: dict[str, Any] = {

@@ -1,0 +1,111 @@
+"""Design studies (issue 15 item 3; docs/design.md, "Design studies"): the batched figures equal
+``tcsim design``'s one design at a time, a failing design keeps its row with the reason, sweeps are
+checked, and the Pareto front is the non-dominated set."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from tcsim.analysis.design_report import design_report
+from tcsim.analysis.design_study import FIGURE_COLUMNS, check_sweep, design_study, pareto_front, parse_sweep
+from tcsim.errors import InputError
+from tcsim.models.design_file import load_design_file
+
+
+@pytest.fixture(scope="module")
+def elliptic():
+    base = load_design_file("li-sunden-2016-design")
+    return replace(base, design=replace(base.design, profile="elliptic", squash_ratio=0.0))
+
+
+def test_batched_figures_equal_tcsim_design_one_at_a_time(elliptic):
+    sweep = {"squash_ratio": [0.0, 0.3], "turbine_exit_angle_deg": [-60.0, -40.0]}
+    study = design_study(elliptic, sweep)
+    assert len(study) == 4 and (study["error"] == "").all()
+    assert study[["squash_ratio", "turbine_exit_angle_deg"]].to_numpy().tolist() == [
+        [0.0, -60.0],
+        [0.0, -40.0],
+        [0.3, -60.0],
+        [0.3, -40.0],
+    ]
+    for _, row in study.iterrows():
+        d = replace(
+            elliptic.design, squash_ratio=row["squash_ratio"], turbine_exit_angle_deg=row["turbine_exit_angle_deg"]
+        )
+        one = design_report(replace(elliptic, design=d)).summary.iloc[0]
+        for c in FIGURE_COLUMNS:
+            assert row[c] == pytest.approx(one[c], rel=1e-9, abs=0.0), c
+    # the sweep moves the figures (not one design repeated); the squash ratio only acts through
+    # the shape effects and L_f, which the steady state does not see
+    assert study["turbine_shape_effect_m2"].nunique() == 4
+    assert study["takeoff_effective_tr_dip"].nunique() == 4
+    assert study["stall_torque_ratio"].nunique() == 2
+
+
+def test_a_failing_design_keeps_its_row_and_the_others_survive(elliptic):
+    bad = design_study(elliptic, {"pump_exit_angle_deg": [-30.0, 95.0, -10.0]})
+    good = design_study(elliptic, {"pump_exit_angle_deg": [-30.0, -10.0]})
+    assert bad["error"].iloc[0] == bad["error"].iloc[2] == ""
+    msg = bad["error"].iloc[1]
+    assert "[design].pump_exit_angle_deg = 95: expected" in msg and "\n" not in msg
+    assert bad.loc[1, list(FIGURE_COLUMNS)].isna().all()
+    assert not bool(bad["pareto_front"].iloc[1])
+    for c in FIGURE_COLUMNS:
+        assert bad[c].iloc[[0, 2]].tolist() == good[c].tolist(), c
+
+
+def test_a_squash_ratio_out_of_range_is_a_row_error_not_a_failed_study(elliptic):
+    study = design_study(elliptic, {"squash_ratio": [0.1, 1.0]})
+    assert study["error"].iloc[0] == ""
+    assert "squash_ratio = 1" in study["error"].iloc[1]
+
+
+@pytest.mark.parametrize(
+    ("text", "field"),
+    [
+        ("axial_length_m=0.1:0.2:3", "NAME"),  # not a [design] field
+        ("squash_ratio", "NAME"),  # no '='
+        ("squash_ratio=0:0.3", "squash_ratio"),  # no count
+        ("squash_ratio=a:0.3:4", "squash_ratio bounds"),
+        ("squash_ratio=0.3:0.3:4", "squash_ratio bounds"),  # MIN = MAX
+        ("squash_ratio=0.3:0.1:4", "squash_ratio bounds"),  # MIN > MAX
+        ("squash_ratio=0:inf:4", "squash_ratio bounds"),
+        ("squash_ratio=0:0.3:1", "squash_ratio count"),  # N < 2
+        ("squash_ratio=0:0.3:1001", "squash_ratio count"),  # N > 1000
+        ("squash_ratio=0:0.3:2.5", "squash_ratio count"),
+        ("squash_ratio=0:0.3:-3", "squash_ratio count"),
+    ],
+)
+def test_bad_sweeps_are_input_errors(text, field):
+    with pytest.raises(InputError) as e:
+        parse_sweep(text)
+    assert e.value.source == "--sweep" and e.value.field == field
+
+
+def test_a_sweep_parses_to_evenly_spaced_values_with_both_ends():
+    name, values = parse_sweep("pump_exit_radius_m=0.11:0.14:4")
+    assert name == "pump_exit_radius_m"
+    assert values.tolist() == pytest.approx([0.11, 0.12, 0.13, 0.14], rel=1e-15)
+    assert values[0] == 0.11 and values[-1] == 0.14
+
+
+def test_check_sweep_limits_parameters_and_designs():
+    with pytest.raises(InputError, match="one or two"):
+        check_sweep({})
+    with pytest.raises(InputError, match="one or two"):
+        check_sweep({"squash_ratio": [0.0], "pump_exit_radius_m": [0.1], "stator_exit_radius_m": [0.05]})
+    with pytest.raises(InputError, match="at most 20000 designs"):
+        check_sweep({"squash_ratio": np.zeros(1000), "pump_exit_radius_m": np.zeros(21)})
+    with pytest.raises(InputError, match="finite"):
+        check_sweep({"squash_ratio": [0.0, float("nan")]})
+    check_sweep({"squash_ratio": np.zeros(1000), "pump_exit_radius_m": np.zeros(20)})  # 20000: the limit
+
+
+def test_pareto_front_is_the_non_dominated_set():
+    tr = np.array([2.0, 2.2, 2.1, 2.2, np.nan, 1.9])
+    dip = np.array([0.01, 0.02, 0.03, 0.02, 0.0, 0.005])
+    # 2 is beaten by 1 (higher TR, smaller dip); 1 and 3 tie (neither beats the other); NaN never
+    assert pareto_front(tr, dip).tolist() == [True, True, False, True, False, True]
