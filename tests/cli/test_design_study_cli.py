@@ -71,3 +71,11 @@ def test_a_missing_design_exits_2_naming_it(cli, tmp_path):
     lines = r.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("error: nope.toml: design = 'nope.toml': expected"), r.stderr
     assert os.listdir(tmp_path) == []
+
+
+def test_without_out_it_writes_the_default_folder(cli, tmp_path):
+    """The default ``--out`` (a Path) goes through the ``--out`` parser too (it failed with exit 1)."""
+    r = cli("design-study", "li-sunden-2016-design", "--sweep", "squash_ratio=0:0.3:2", cwd=tmp_path)
+    assert r.code == 0, r.stderr
+    assert os.listdir(tmp_path) == ["design-study"]
+    assert set(os.listdir(tmp_path / "design-study")) == OUTPUTS

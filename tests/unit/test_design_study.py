@@ -63,6 +63,17 @@ def test_a_squash_ratio_out_of_range_is_a_row_error_not_a_failed_study(elliptic)
     assert "squash_ratio = 1" in study["error"].iloc[1]
 
 
+def test_a_squash_sweep_of_a_circular_design_is_elliptic_and_squash_0_is_the_circle():
+    circular = load_design_file("li-sunden-2016-design")
+    assert circular.design.profile == "circular"
+    study = design_study(circular, {"squash_ratio": [0.0, 0.3]})
+    assert (study["error"] == "").all()
+    one = design_report(circular).summary.iloc[0]
+    for c in FIGURE_COLUMNS:
+        assert study[c].iloc[0] == pytest.approx(one[c], rel=1e-9, abs=1e-15), c
+    assert study["turbine_shape_effect_m2"].iloc[1] != study["turbine_shape_effect_m2"].iloc[0]
+
+
 @pytest.mark.parametrize(
     ("text", "field"),
     [

@@ -190,7 +190,8 @@ def design_study(
         The base design: a read design file, a bundled design's name or a design ``.toml``.
     sweep : mapping
         One or two of :data:`SWEEP_PARAMETERS` → their values (units of the ``[design]`` field: m,
-        m², degrees, kg/m³, or the squash ratio).
+        m², degrees, kg/m³, or the squash ratio). Sweeping ``squash_ratio`` of a circular design
+        sweeps the elliptic profile (squash 0 is the circle).
     threads : int
         Core workers for the take-offs (0: all cores).
 
@@ -203,6 +204,8 @@ def design_study(
     """
     file = design if isinstance(design, DesignFile) else load_design_file(design)
     check_sweep(sweep)
+    if "squash_ratio" in sweep and file.design.profile == "circular":  # squash 0 is the circle
+        file = replace(file, design=replace(file.design, profile="elliptic"))
     names = list(sweep)
     grid = list(itertools.product(*(np.asarray(sweep[n], dtype=float).tolist() for n in names)))
     rows: list[dict[str, Any]] = []

@@ -43,8 +43,10 @@ ModelsOpt = Annotated[
 ]
 
 
-def _out_path(text: str) -> Path:
-    """``--out``: an empty name is a mistake (an unset shell variable), not the current folder."""
+def _out_path(text: str | Path) -> Path:
+    """``--out``: an empty name is a mistake (an unset shell variable), not the current folder. Typer
+    passes the default (a Path) through the parser as well."""
+    text = str(text)
     if not text.strip():
         raise InputError("command line", "--out", text, "a directory name (an empty name is not the current folder)")
     return Path(text)
