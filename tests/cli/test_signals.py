@@ -24,6 +24,7 @@ COMMANDS = {
     "study": ["study", "li-sunden-2016", "--out", "o"],
     "drive": ["drive", "--cycle", "udds", "--model", "hrovat-tobler", "--out", "o"],  # no overrun warning
     "design": ["design", "li-sunden-2016-design", "--out", "o"],
+    "design-study": ["design-study", "li-sunden-2016-design", "--sweep", "squash_ratio=0:0.3:20", "--out", "o"],
 }
 
 
@@ -84,6 +85,8 @@ CASES = [
     ("drive", signal.SIGTERM, "writing"),
     ("design", signal.SIGTERM, "start"),
     ("design", signal.SIGINT, "writing"),
+    ("design-study", signal.SIGTERM, "start"),
+    ("design-study", signal.SIGINT, "writing"),
 ]
 
 
