@@ -9,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+import tcsim.analysis.design_study as ds
 from tcsim.analysis.design_report import design_report
 from tcsim.analysis.design_study import FIGURE_COLUMNS, check_sweep, design_study, pareto_front, parse_sweep
 from tcsim.errors import InputError
@@ -120,3 +121,12 @@ def test_pareto_front_is_the_non_dominated_set():
     dip = np.array([0.01, 0.02, 0.03, 0.02, 0.0, 0.005])
     # 2 is beaten by 1 (higher TR, smaller dip); 1 and 3 tie (neither beats the other); NaN never
     assert pareto_front(tr, dip).tolist() == [True, True, False, True, False, True]
+
+
+def test_take_offs_in_chunks_give_the_same_figures(elliptic, monkeypatch):
+    sweep = {"squash_ratio": [0.0, 0.2, 0.4], "pump_exit_angle_deg": [-30.0, 95.0, -10.0]}  # 3 bad rows
+    whole = design_study(elliptic, sweep)
+    monkeypatch.setattr(ds, "TAKEOFF_CHUNK", 2)
+    chunked = design_study(elliptic, sweep)
+    assert (chunked["error"] != "").sum() == 3
+    assert chunked.equals(whole)

@@ -5,7 +5,7 @@ full grid, each design's steady-state and take-off figures as ``tcsim design`` c
 Every design is derived by :func:`tcsim.models.design_file.derive_converter` (the core's geometry);
 the Hrovat & Tobler characteristics of all designs at :data:`~tcsim.units.DEFAULT_PUMP_SPEED_RPM`
 (SR 0–1 in steps of 0.01 and the coupling point, as ``tcsim design``) go to the core's closed form in
-one call, and the isolated take-offs of all designs in one batched call
+one call, and the isolated take-offs in batched calls of :data:`TAKEOFF_CHUNK` designs
 (:func:`tcsim.simulation.transient.simulate_batch`, GIL released, ``threads`` workers); the take-off
 figures are :func:`~tcsim.analysis.design_report.takeoff_figures`. A design
 whose derivation, steady state or take-off fails keeps its row, with NaN figures and the one-line
@@ -46,6 +46,8 @@ SWEEP_COUNT_RANGE = (2, 1000)
 MAX_DESIGNS = 20_000
 #: The figures of each design (the summary columns of ``tcsim design``, without name and role).
 FIGURE_COLUMNS: tuple[str, ...] = tuple(c for c in SUMMARY_COLUMNS if c not in ("converter", "role"))
+#: Take-offs per batched core call: bounds the memory of the runs' outputs (about 0.26 MB per take-off).
+TAKEOFF_CHUNK = 1000
 #: The geometry columns added to each row: the equivalent fluid length L_f, m.
 GEOMETRY_COLUMNS = ("fluid_length_m",)
 
@@ -221,7 +223,11 @@ def design_study(
             row["fluid_length_m"] = derived.geometry.fluid_length_m
         rows.append(row)
     converted = [r for r in rows if not r["error"]]
-    for row, conv, steady, run in zip(converted, convs, _steady_figures(convs), _takeoffs(convs, threads)):
+    steadies = _steady_figures(convs)
+    runs = itertools.chain.from_iterable(
+        _takeoffs(convs[i : i + TAKEOFF_CHUNK], threads) for i in range(0, len(convs), TAKEOFF_CHUNK)
+    )
+    for row, conv, steady, run in zip(converted, convs, steadies, runs):
         g = conv.geometry
         assert g is not None  # derived converters have [geometry]
         row |= {f"{e}_shape_effect_m2": getattr(g, f"{e}_shape_effect_m2") for e in ("pump", "turbine", "stator")}
