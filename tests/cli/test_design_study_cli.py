@@ -4,10 +4,16 @@ written."""
 
 from __future__ import annotations
 
+import importlib
 import os
+import signal
 
 import pandas as pd
 import pytest
+
+import tcsim.analysis.design_study as ds
+
+APP = importlib.import_module("tcsim.cli.app")  # the module (``tcsim.cli.app`` the attribute is the Typer app)
 
 OUTPUTS = {"study.csv", "pareto.png", "tcsim-manifest.json"}
 
@@ -79,3 +85,18 @@ def test_without_out_it_writes_the_default_folder(cli, tmp_path):
     assert r.code == 0, r.stderr
     assert os.listdir(tmp_path) == ["design-study"]
     assert set(os.listdir(tmp_path / "design-study")) == OUTPUTS
+
+
+def test_a_signal_swallowed_into_another_exception_is_still_an_interrupt(cli, tmp_path, monkeypatch):
+    """SIGTERM arriving while an extension module initialises becomes ``ImportError: initialization
+    failed``; it exited 1 ("tcsim failed") instead of 143 (seen in test_signals' start phase)."""
+
+    def interrupted_import(*args, **kwargs):
+        APP._received.append(signal.SIGTERM)
+        raise ImportError("initialization failed")
+
+    monkeypatch.setattr(ds, "design_study", interrupted_import)
+    r = cli("design-study", "li-sunden-2016-design", "--sweep", "squash_ratio=0:0.3:2", "--out", "o", cwd=tmp_path)
+    assert r.code == 128 + signal.SIGTERM, r.stderr
+    assert r.stdout.strip().splitlines() + r.stderr.strip().splitlines() == ["interrupted (SIGTERM): nothing written"]
+    assert os.listdir(tmp_path) == []

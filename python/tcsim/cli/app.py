@@ -176,6 +176,8 @@ def _run(argv: list[str] | None) -> int:
     except SystemExit as e:  # typer/click's own exits
         return e.code if isinstance(e.code, int) else 1
     except Exception as e:  # click usage errors, and failures that are not the user's
+        if _received:  # a signal handled inside an extension's import surfaces as its ImportError
+            raise Interrupted(_received[-1]) from None
         if callable(getattr(e, "format_message", None)) and getattr(e, "exit_code", None) == 2:
             line = usage_error_line(e, sys.argv[1:] if argv is None else argv)
             console.print(f"[red]error:[/red] {rich_text(line)}", highlight=False, soft_wrap=True)
