@@ -29,7 +29,7 @@
 //!   would hold the on-coming clutch near that small torque and the inertia phase would crawl, so
 //!   the upshift is a power-off one (constant capacity, no torque reduction). Without
 //!   `upshift_inertia_phase_s` the on-coming capacity ramps to `shift_clutch_capacity_nm` and stays
-//!   there (the behaviour before shift control). Coast upshifts and downshifts keep that constant
+//!   there (the behaviour before shift control). Power-off upshifts and downshifts keep that constant
 //!   capacity and no torque reduction.
 
 use super::range::{field, Range};
