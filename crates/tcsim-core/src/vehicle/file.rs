@@ -109,6 +109,10 @@ pub struct GearboxSection {
     /// on-coming clutch keeps `shift_clutch_capacity_nm` ([`super::shift`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub upshift_inertia_phase_s: Option<f64>,
+    /// Input torque above which an upshift is power-on, N·m, ≥ 0
+    /// ([`super::shift::POWER_ON_THRESHOLD`]); absent: 0 (any positive input torque).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub upshift_power_on_nm: Option<f64>,
     /// Time constant of the TCU's filter of the pedal the shift schedule reads while the pedal
     /// rises, s, 0–10 ([`super::shift_pedal::PEDAL_TIME_CONSTANT`]); absent: 0 (at once).
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -263,6 +267,7 @@ impl VehicleFile {
                 shift_control: ShiftControl {
                     torque_reduction: g.upshift_torque_reduction.unwrap_or(0.0),
                     inertia_phase_s: g.upshift_inertia_phase_s,
+                    power_on_nm: g.upshift_power_on_nm.unwrap_or(0.0),
                 },
                 shift_pedal: PedalFilter {
                     rise_s: g.shift_pedal_rise_s.unwrap_or(0.0),

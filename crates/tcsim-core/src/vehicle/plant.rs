@@ -231,13 +231,14 @@ impl<'a> Plant<'a> {
             Some(s) => {
                 let w = ((t - s.since_s) / gb.shift_handover_s).clamp(0.0, 1.0);
                 let c = gb.shift_clutch_capacity_nm;
-                // power-on upshifts only: a coast upshift keeps the constant capacity
-                let controlled = if s.to > s.from && s.start_input_nm > 0.0 {
+                // power-on upshifts only: a power-off upshift keeps the constant capacity
+                let controlled = if s.to > s.from && gb.shift_control.is_power_on(s.start_input_nm) {
                     let phase = s.handed_over.then(|| InertiaPhase {
                         start_nm: s.start_input_nm,
                         step: gb.ratios[s.from] * gb.efficiencies[s.from] / gb.ratios[s.to],
                         inertia_kg_m2: self.input_inertia(),
                         slip_rad_s: (gb.ratios[s.from] - gb.ratios[s.to]) * u[GEARBOX_OUT],
+                        remaining_rad_s: u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT],
                         since_s: t - s.since_s - gb.shift_handover_s,
                     });
                     gb.shift_control.oncoming_capacity_nm(input_nm, phase.as_ref(), w, c)
@@ -272,7 +273,10 @@ impl<'a> Plant<'a> {
         let gb = &self.v.gearbox;
         match self.mode.shift {
             Some(s)
-                if s.handed_over && s.to > s.from && s.start_input_nm > 0.0 && self.sc.engine_torque_nm.is_none() =>
+                if s.handed_over
+                    && s.to > s.from
+                    && gb.shift_control.is_power_on(s.start_input_nm)
+                    && self.sc.engine_torque_nm.is_none() =>
             {
                 let whole = (gb.ratios[s.from] - gb.ratios[s.to]) * u[GEARBOX_OUT];
                 let slip = u[TURBINE] - gb.ratios[s.to] * u[GEARBOX_OUT];

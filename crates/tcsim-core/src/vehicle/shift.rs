@@ -15,16 +15,21 @@
 //!     [`CAPACITY_RAMP_S`] to the input torque at the shift's start plus the inertia torque that
 //!     closes the slip in `upshift_inertia_phase_s` (open-loop feed-forward; no more than gives the
 //!     off-going gear's output torque, `i_from η_from / i_to` times that input torque, so the output
-//!     torque does not rise above its level before the shift; at least
-//!     the present input torque plus [`SYNC_MARGIN`] of the inertia torque, capped at
-//!     `shift_clutch_capacity_nm`), and the
+//!     torque does not rise above its level before the shift; at least the present input torque plus
+//!     [`SYNC_MARGIN`] of the inertia torque, and at least the present input torque plus the torque
+//!     that closes the remaining slip by the deadline [`LONGEST_INERTIA_PHASE`] ×
+//!     `upshift_inertia_phase_s` after the handover, capped at `shift_clutch_capacity_nm`), and the
 //!     engine's torque is reduced by `upshift_torque_reduction` (spark retard, fuel cut), ramped in
 //!     over [`TORQUE_REDUCTION_RAMP_S`] and restored over the last [`TORQUE_RESTORE_SLIP`] of the
 //!     slip.
 //!
-//!   This is for power-on upshifts (input torque above 0 at the shift command). Without
+//!   This is for power-on upshifts: the TCU's power-on/power-off decision at the shift command
+//!   ([`ShiftControl::is_power_on`]) calls an upshift power-on when the input torque is above
+//!   `upshift_power_on_nm` (default 0). Below it the engine hardly pulls: the output-torque cap
+//!   would hold the on-coming clutch near that small torque and the inertia phase would crawl, so
+//!   the upshift is a power-off one (constant capacity, no torque reduction). Without
 //!   `upshift_inertia_phase_s` the on-coming capacity ramps to `shift_clutch_capacity_nm` and stays
-//!   there (the behaviour before shift control). Coast upshifts and downshifts keep that constant
+//!   there (the behaviour before shift control). Power-off upshifts and downshifts keep that constant
 //!   capacity and no torque reduction.
 
 use super::range::{field, Range};
@@ -43,10 +48,21 @@ pub const TORQUE_REDUCTION_RAMP_S: f64 = 0.05;
 /// The reduction fades out linearly over this last fraction of the on-coming clutch's slip, so the
 /// engine's torque is back when the clutch locks.
 pub const TORQUE_RESTORE_SLIP: f64 = 0.2;
+/// `[gearbox].upshift_power_on_nm`, N·m at the gearbox input: at least 0 (finite). An upshift is
+/// power-on when the input torque at its command is above it. Typical: a few per cent of the
+/// engine's peak torque (assumed); 0 is the rule before the threshold (any positive torque).
+pub const POWER_ON_THRESHOLD: Range = Range::NON_NEGATIVE;
 /// In the inertia phase the on-coming clutch's capacity exceeds the present input torque by at
 /// least this fraction of the target inertia torque, so the slip closes however the input torque
 /// rises.
 pub const SYNC_MARGIN: f64 = 0.1;
+/// The longest inertia phase of a power-on upshift, in multiples of `upshift_inertia_phase_s` (the
+/// TCU's supervision of the synchronisation time): the on-coming clutch's capacity exceeds the
+/// present input torque by at least `J × remaining slip / time left to this deadline` (the time
+/// left no less than [`CAPACITY_RAMP_S`]), so a shift that starts with a small input torque, where
+/// the output-torque cap holds the clutch near that torque, still synchronises in time (the cap
+/// then gives way). A shift on time needs less and is unchanged.
+pub const LONGEST_INERTIA_PHASE: f64 = 2.5;
 /// Time over which the on-coming clutch's capacity rises from the input torque to its inertia-phase
 /// value after the handover, s.
 pub const CAPACITY_RAMP_S: f64 = 0.05;
@@ -59,6 +75,8 @@ pub struct ShiftControl {
     pub torque_reduction: f64,
     /// Target duration of the inertia phase, s; None: constant on-coming capacity.
     pub inertia_phase_s: Option<f64>,
+    /// Input torque above which an upshift is power-on, N·m, ≥ 0.
+    pub power_on_nm: f64,
 }
 
 impl ShiftControl {
@@ -68,7 +86,15 @@ impl ShiftControl {
         if let Some(t) = self.inertia_phase_s {
             INERTIA_PHASE.check(&field("gearbox", "upshift_inertia_phase_s"), t)?;
         }
+        POWER_ON_THRESHOLD.check(&field("gearbox", "upshift_power_on_nm"), self.power_on_nm)?;
         Ok(())
+    }
+
+    /// The TCU's power-on/power-off decision at an upshift's command: power-on (controlled
+    /// on-coming capacity and torque reduction) when the input torque `start_input_nm`, N·m, is
+    /// above `upshift_power_on_nm`; otherwise power-off (constant capacity, no torque reduction).
+    pub fn is_power_on(&self, start_input_nm: f64) -> bool {
+        start_input_nm > self.power_on_nm
     }
 
     /// The on-coming clutch's capacity in an upshift, N·m at the input, or None without a target
@@ -80,7 +106,8 @@ impl ShiftControl {
     /// the shift's start plus the inertia torque `J Δω / upshift_inertia_phase_s` (rising over
     /// [`CAPACITY_RAMP_S`]), but no more than the output torque before the shift allows
     /// (`step` × that input torque); at least the present input torque plus [`SYNC_MARGIN`] of the
-    /// inertia torque, so the slip always closes.
+    /// inertia torque, so the slip always closes, and plus the torque that closes the remaining slip
+    /// by [`LONGEST_INERTIA_PHASE`] target phases after the handover, so it closes in time.
     pub fn oncoming_capacity_nm(
         &self,
         input_nm: f64,
@@ -96,7 +123,12 @@ impl ShiftControl {
                 let held = p.start_nm.max(0.0);
                 let inertia = p.inertia_kg_m2 * p.slip_rad_s.max(0.0) / tau;
                 let rise = (p.since_s / CAPACITY_RAMP_S).clamp(0.0, 1.0);
-                (held + rise * inertia).min(held.max(p.step * held)).max(now + SYNC_MARGIN * rise * inertia)
+                let left_s = (LONGEST_INERTIA_PHASE * tau - p.since_s).max(CAPACITY_RAMP_S);
+                let deadline = p.inertia_kg_m2 * p.remaining_rad_s.max(0.0) / left_s;
+                (held + rise * inertia)
+                    .min(held.max(p.step * held))
+                    .max(now + SYNC_MARGIN * rise * inertia)
+                    .max(now + rise * deadline)
             }
         };
         Some(c.min(capacity_nm))
@@ -125,6 +157,8 @@ pub struct InertiaPhase {
     pub inertia_kg_m2: f64,
     /// The slip a whole shift closes at the present output speed, `(i_from − i_to) ω_o`, rad/s.
     pub slip_rad_s: f64,
+    /// The on-coming clutch's slip now, `ω_t − i_to ω_o`, rad/s.
+    pub remaining_rad_s: f64,
     /// Time since the handover, s.
     pub since_s: f64,
 }
@@ -162,12 +196,19 @@ mod tests {
 
     #[test]
     fn oncoming_capacity_carries_the_input_then_adds_the_inertia_torque() {
-        let s = ShiftControl { torque_reduction: 0.5, inertia_phase_s: Some(0.4) };
+        let s = ShiftControl { torque_reduction: 0.5, inertia_phase_s: Some(0.4), power_on_nm: 0.0 };
         // half-way through the torque phase: half the input torque
         assert_eq!(s.oncoming_capacity_nm(200.0, None, 0.5, 500.0), Some(100.0));
         // in the inertia phase: the handover's input plus 0.1 kg m² · 200 rad/s / 0.4 s = 50 N·m,
-        // capped; at least the present input plus a quarter of the inertia torque
-        let p = InertiaPhase { start_nm: 200.0, step: 1.5, inertia_kg_m2: 0.1, slip_rad_s: 200.0, since_s: 1.0 };
+        // capped; at least the present input plus a tenth of the inertia torque
+        let p = InertiaPhase {
+            start_nm: 200.0,
+            step: 1.5,
+            inertia_kg_m2: 0.1,
+            slip_rad_s: 200.0,
+            remaining_rad_s: 1.0,
+            since_s: 0.5,
+        };
         assert_eq!(s.oncoming_capacity_nm(150.0, Some(&p), 1.0, 500.0), Some(250.0));
         assert_eq!(s.oncoming_capacity_nm(300.0, Some(&p), 1.0, 500.0), Some(305.0));
         assert_eq!(s.oncoming_capacity_nm(200.0, Some(&p), 1.0, 220.0), Some(220.0));
@@ -183,11 +224,58 @@ mod tests {
     }
 
     #[test]
+    fn an_upshift_is_power_on_only_above_the_threshold() {
+        let s = ShiftControl { torque_reduction: 0.5, inertia_phase_s: Some(0.4), power_on_nm: 20.0 };
+        assert!(!s.is_power_on(3.0) && !s.is_power_on(20.0) && !s.is_power_on(-5.0));
+        assert!(s.is_power_on(20.5) && s.is_power_on(300.0));
+        // the default threshold 0: any positive input torque
+        let d = ShiftControl { power_on_nm: 0.0, ..s };
+        assert!(d.is_power_on(3.0) && !d.is_power_on(0.0));
+    }
+
+    #[test]
+    fn a_tiny_input_torque_still_closes_the_slip_by_the_deadline() {
+        // 3 N·m at the command (a tip-out), 1→2 step 1.7, 0.1 kg m², 76 rad/s to close: the
+        // output-torque cap alone allows 5.1 N·m, 2.1 N·m above the input (3.6 s for 76 rad/s)
+        let s = ShiftControl { torque_reduction: 0.5, inertia_phase_s: Some(0.4), power_on_nm: 0.0 };
+        let deadline_s = LONGEST_INERTIA_PHASE * 0.4;
+        for (since_s, remaining_rad_s) in [(0.2, 76.0), (0.6, 40.0), (0.95, 5.0), (1.5, 2.0)] {
+            let p = InertiaPhase {
+                start_nm: 3.0,
+                step: 1.7,
+                inertia_kg_m2: 0.1,
+                slip_rad_s: 76.0,
+                remaining_rad_s,
+                since_s,
+            };
+            for now in [3.0, 0.5, -10.0, 40.0] {
+                let c = s.oncoming_capacity_nm(now, Some(&p), 1.0, 500.0).unwrap();
+                let closing_s = p.inertia_kg_m2 * remaining_rad_s / (c - now.max(0.0));
+                assert!(since_s + closing_s <= deadline_s.max(since_s + CAPACITY_RAMP_S) + 1e-9, "{since_s} {now} {c}");
+            }
+        }
+        // a shift on time is left alone: 2 N·m of deadline torque is below the cap's 100 N·m
+        let p = InertiaPhase {
+            start_nm: 200.0,
+            step: 1.5,
+            inertia_kg_m2: 0.1,
+            slip_rad_s: 200.0,
+            remaining_rad_s: 10.0,
+            since_s: 0.5,
+        };
+        assert_eq!(s.oncoming_capacity_nm(200.0, Some(&p), 1.0, 500.0), Some(250.0));
+    }
+
+    #[test]
     fn validation_names_the_field() {
-        let bad = ShiftControl { torque_reduction: 0.95, inertia_phase_s: None };
+        let bad = ShiftControl { torque_reduction: 0.95, inertia_phase_s: None, power_on_nm: 0.0 };
         assert_eq!(bad.validate().unwrap_err().field, "[gearbox].upshift_torque_reduction");
-        let bad = ShiftControl { torque_reduction: 0.4, inertia_phase_s: Some(0.01) };
+        let bad = ShiftControl { torque_reduction: 0.4, inertia_phase_s: Some(0.01), power_on_nm: 0.0 };
         assert_eq!(bad.validate().unwrap_err().field, "[gearbox].upshift_inertia_phase_s");
-        ShiftControl { torque_reduction: 0.4, inertia_phase_s: Some(0.3) }.validate().unwrap();
+        for bad in [-1.0, f64::NAN, f64::INFINITY] {
+            let bad = ShiftControl { torque_reduction: 0.4, inertia_phase_s: Some(0.3), power_on_nm: bad };
+            assert_eq!(bad.validate().unwrap_err().field, "[gearbox].upshift_power_on_nm");
+        }
+        ShiftControl { torque_reduction: 0.4, inertia_phase_s: Some(0.3), power_on_nm: 20.0 }.validate().unwrap();
     }
 }
