@@ -66,14 +66,13 @@ fn circle_reproduces_the_arc_estimate() {
     assert!(close(g.fluid_mass_kg, 840.0 * 0.01 * PI * 0.06, 1e-12));
 }
 
-/// A rectangular torus of axial width w: the pump climbs the inner wall at R_s, crosses radially to
-/// R_p and comes back at R_p; the turbine mirrors it down to R_t, the stator is radial. The axial
-/// projection of pump and turbine is w long, the stator's 0. By hand, the thesis's literal reading
-/// (exit radius × tan(exit angle) × axial length, whatever the inlet angles):
-/// S_p = R_p·tan α_p,exit·w, S_t = R_t·tan α_t,exit·w, S_s = 0.
-#[test]
-fn hand_calculation_pins_the_signs() {
-    let (rs, rt, rp, w) = (0.06, 0.07, 0.12, 0.02);
+/// The rectangular torus of the hand calculations: (R_s, R_t, R_p, axial width w), m.
+const RECTANGLE: (f64, f64, f64, f64) = (0.06, 0.07, 0.12, 0.02);
+
+/// Table D.1's angles on the [`RECTANGLE`] polyline: the pump runs axially at R_s, out to R_p and
+/// back; the turbine mirrors it down to R_t; the stator is radial.
+fn rectangular_torus() -> Design {
+    let (rs, rt, rp, w) = RECTANGLE;
     let profile = Profile::Polyline {
         pump: vec![[rs, 0.0], [rs, w], [rp, w], [rp, 0.0]],
         turbine: vec![[rp, 0.0], [rp, -w], [rt, -w], [rt, 0.0]],
@@ -81,6 +80,18 @@ fn hand_calculation_pins_the_signs() {
     };
     let mut d = table_d1(profile);
     d.turbine_exit_radius_m = rt;
+    d
+}
+
+/// A rectangular torus of axial width w: the pump climbs the inner wall at R_s, crosses radially to
+/// R_p and comes back at R_p; the turbine mirrors it down to R_t, the stator is radial. The axial
+/// projection of pump and turbine is w long, the stator's 0. By hand, the thesis's literal reading
+/// (exit radius × tan(exit angle) × axial length, whatever the inlet angles):
+/// S_p = R_p·tan α_p,exit·w, S_t = R_t·tan α_t,exit·w, S_s = 0.
+#[test]
+fn hand_calculation_pins_the_signs() {
+    let (_, rt, rp, w) = RECTANGLE;
+    let d = rectangular_torus();
     // Table D.1's angles: the turbine's inlet (+55°) and exit (−50°) have opposite signs
     let g = geo(&d);
     let tan = |deg: f64| deg.to_radians().tan();
@@ -98,14 +109,8 @@ fn hand_calculation_pins_the_signs() {
 /// S_p = tan α_p·(R_s·w + (R_p² − R_s²)/2 + R_p·w).
 #[test]
 fn hand_calculation_of_the_comparison_readings() {
-    let (rs, rt, rp, w) = (0.06, 0.07, 0.12, 0.02);
-    let profile = Profile::Polyline {
-        pump: vec![[rs, 0.0], [rs, w], [rp, w], [rp, 0.0]],
-        turbine: vec![[rp, 0.0], [rp, -w], [rt, -w], [rt, 0.0]],
-        stator: vec![[rt, 0.0], [rs, 0.0]],
-    };
-    let mut d = table_d1(profile);
-    d.turbine_exit_radius_m = rt;
+    let (rs, rt, rp, w) = RECTANGLE;
+    let mut d = rectangular_torus();
     d.pump = BladeAngles { inlet_deg: -30.0, exit_deg: -30.0 };
     d.turbine = BladeAngles { inlet_deg: 45.0, exit_deg: 45.0 };
     d.stator = BladeAngles { inlet_deg: 60.0, exit_deg: 60.0 };
