@@ -144,7 +144,12 @@ impl QuasiDynamics {
     /// Steady flow Q_ss and its gradient with respect to (ω_p, ω_t): the table's flow, with CF
     /// from [`smooth_capacity`] where a single table is pump-referred within its rows.
     fn steady_flow(&self, wp: f64, wt: f64) -> (f64, [f64; 2]) {
-        let t = self.characteristic.torques(wp, wt);
+        self.steady_flow_of(&self.characteristic.torques(wp, wt), wp, wt)
+    }
+
+    /// [`Self::steady_flow`] from the table's torques `t` at these speeds (evaluated once per call
+    /// of the forces).
+    fn steady_flow_of(&self, t: &TableTorques, wp: f64, wt: f64) -> (f64, [f64; 2]) {
         let k = self.flow_scale();
         if t.region == Region::Pump {
             if let Some((cf, dcf)) = self.characteristic.single().and_then(|c| smooth_capacity(c, wt / wp)) {
@@ -206,7 +211,7 @@ impl QuasiDynamics {
     /// table's torques `t` at these speeds.
     fn flow_forcing(&self, u: &Vec4, t: &TableTorques) -> (f64, [f64; 3]) {
         let (wp, wt, q) = (u[PUMP], u[TURBINE], u[FLOW]);
-        let (qss, dqss) = self.steady_flow(wp, wt);
+        let (qss, dqss) = self.steady_flow_of(t, wp, wt);
         // the table's loss and its gradient; a passive table has P ≥ 0 (clipped against rounding)
         let p = t.pump_nm * wp - t.delivered_nm * wt;
         let dp = if p > 0.0 {
