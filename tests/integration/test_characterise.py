@@ -14,7 +14,7 @@ from tcsim import _core
 from tcsim.errors import TcsimWarning
 from tcsim.models.converter import load_converter
 from tcsim.models.steady import characterise, coupling_point
-from tcsim.models.torus import torus_estimate
+from torus_reference import torus_estimate
 
 WP = 2000 * math.pi / 30
 
@@ -163,7 +163,9 @@ def test_bundled_converter_documents_every_value(ls):
         assert f"characteristic.{key}" in ls.sources
 
 
-def test_bundled_fluid_parameters_come_from_the_torus_estimate(ls):
+def test_bundled_fluid_parameters_come_from_the_circular_torus(ls):
+    """The bundled [geometry]'s fluid length and shape effects are the circle's (docs/design.md: the
+    literal reading of §4.1.1, R_exit·|tan α_exit|·L), checked against the plain reference."""
     g = ls.geometry
     e = torus_estimate(
         g.pump_exit_radius_m,
@@ -179,11 +181,11 @@ def test_bundled_fluid_parameters_come_from_the_torus_estimate(ls):
         g.fluid_density_kg_m3,
     )
     assert g.fluid_length_m == pytest.approx(e.fluid_length_m, abs=5e-5)
-    assert g.pump_shape_effect_m2 == pytest.approx(e.pump_shape_effect_m2, abs=5e-6)
-    assert g.turbine_shape_effect_m2 == pytest.approx(e.turbine_shape_effect_m2, abs=5e-6)
-    assert g.stator_shape_effect_m2 == pytest.approx(e.stator_shape_effect_m2, abs=5e-6)
-    # physics notes §4: with the fluid inertia inside each element's inertia the mass matrix
-    # is positive definite: ρL_f/A > ρ²S_p²/I_p + ρ²S_t²/I_t (+ the stator term)
+    assert g.pump_shape_effect_m2 == pytest.approx(e.pump_literal_shape_effect_m2, abs=5e-7)
+    assert g.turbine_shape_effect_m2 == pytest.approx(e.turbine_literal_shape_effect_m2, abs=5e-7)
+    assert g.stator_shape_effect_m2 == pytest.approx(e.stator_literal_shape_effect_m2, abs=5e-7)
+    # the mass matrix of eqs 2.12–2.15 with the bundled inertias is positive definite:
+    # ρL_f/A > ρ²S_p²/I_p + ρ²S_t²/I_t + ρ²S_s²/I_s
     rho, A, i = g.fluid_density_kg_m3, g.flow_area_m2, ls.inertia
     lhs = rho * g.fluid_length_m / A
     rhs = rho**2 * (
@@ -197,7 +199,8 @@ def test_bundled_fluid_parameters_come_from_the_torus_estimate(ls):
 
 
 def test_torus_bound_holds_for_any_angles():
-    """Cauchy–Schwarz: ρ²S²/I_fluid ≤ (ρ/A)∫tan²α dl < ρL_f/A, element by element."""
+    """Cauchy–Schwarz for the arc reading: ρ²S²/I_fluid ≤ (ρ/A)∫tan²α dl < ρL_f/A, element by
+    element (a property of the reference's formulas, docs/design.md "Mass-matrix bound")."""
     rng = np.random.default_rng(1)
     for _ in range(50):
         ang = rng.uniform(-75, 75, 6)

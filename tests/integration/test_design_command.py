@@ -14,7 +14,15 @@ import pandas as pd
 import pytest
 
 from conftest import run_cli_in_process
-from tcsim.analysis.design_report import SUMMARY_COLUMNS, design_report, summary_row, takeoff_frame
+from tcsim.analysis.design_report import (
+    LAUNCH_COLUMNS,
+    SUMMARY_COLUMNS,
+    design_report,
+    launch_runs,
+    summary_row,
+    takeoff_frame,
+)
+from tcsim.analysis.design_study import design_study
 from tcsim.models.converter import load_converter
 from tcsim.models.design import design_geometry
 from tcsim.models.design_file import LOSS_KEYS, derive_converter, load_design_file, read_design_file
@@ -58,7 +66,7 @@ def test_the_written_converter_is_the_design_model_and_runs_everywhere(written, 
     # every value is traceable: a [sources] entry for each [geometry] and [inertia] key
     keys = {f"geometry.{k}" for k in geo.model_dump()} | {f"inertia.{k}" for k in conv.inertia.model_dump()}
     assert keys <= set(conv.sources)
-    assert "S = R_exit·tan(α_exit)·L_axial" in conv.sources["geometry.turbine_shape_effect_m2"]
+    assert "S = R_exit·|tan(α_exit)|·L_axial" in conv.sources["geometry.turbine_shape_effect_m2"]
     # characteristic.csv is `tcsim characterise`'s closed form for this converter
     written_steady = pd.read_csv(out / "characteristic.csv")
     expected = characterise(conv, "hrovat-tobler")
@@ -78,38 +86,69 @@ def test_the_report_files_and_the_reference(written):
         "characteristic.csv",
         "reference_characteristic.csv",
         "takeoff.csv",
+        "launch.csv",
         "summary.csv",
     } <= names
     assert {"takeoff_effective_torque_ratio.png", "torque_ratio.png", "tcsim-manifest.json"} <= names
+    assert {"launch_effective_torque_ratio.png", "launch_vehicle_speed.png"} <= names
     summary = pd.read_csv(out / "summary.csv")
     assert tuple(summary.columns) == SUMMARY_COLUMNS
     assert summary["role"].tolist() == ["design", "reference"]
     assert summary["converter"].tolist() == [BUNDLED, REFERENCE]
     takeoff = pd.read_csv(out / "takeoff.csv")
     assert set(takeoff["converter"]) == set(summary["converter"])
+    launch = pd.read_csv(out / "launch.csv")
+    assert tuple(launch.columns) == ("converter", *LAUNCH_COLUMNS)
+    for name, one in launch.groupby("converter"):
+        # the run stops at 50 km/h, reached after the summary's time from the release (1 s)
+        t50 = float(summary.set_index("converter").loc[name, "launch_time_0_50_km_h_s"])
+        assert one["vehicle_speed_m_s"].iloc[-1] == pytest.approx(50 / 3.6, rel=1e-3)
+        assert 1.0 + t50 == pytest.approx(one["time_s"].iloc[-1], abs=0.011)
     # same Table D.1 steady state (the shape effects do not enter it), the same total inertias
     assert summary["stall_torque_ratio"][0] == pytest.approx(summary["stall_torque_ratio"][1], rel=1e-12)
     assert "li-sunden-2016-design" in run.stdout
 
 
-def test_the_takeoff_dip_follows_the_signed_geometry_derived_shape_effects():
-    """Thesis ch. 4 with geometry-derived values, the shape effects alone changed (same steady state,
-    L_f and inertias): Table D.1's literal S_p, S_t are negative, and in the Hrovat & Tobler model as
-    written (docs/transient.md) a positive S deepens the dip, so the negative values *lessen* it and
-    their mirror images (+|S|) deepen it, the more the larger |S| is (docs/design.md "tcsim design")."""
+def test_the_launch_dip_deepens_with_the_geometry_derived_shape_effects():
+    """Thesis ch. 4 with geometry-derived values: squashing the bundled design (squash 0 → 0.5)
+    shrinks every shape effect (§4.1.1) and leaves the steady state as it is; the launch's
+    effective-TR deficit over the first 0.5 s, the take-off's dip and the time to 50 km/h all fall
+    with it. Before the sign convention of docs/design.md (S signed as the exit angle) Table D.1's
+    S_p, S_t were negative and the derived converter's take-off dip (0.0115) lay *below* that of
+    S = 0 (0.0337)."""
+    study = design_study(BUNDLED, {"squash_ratio": [0.0, 0.2, 0.35, 0.5]}, threads=2)
+    assert (study["error"] == "").all()
+    for column in ("pump_shape_effect_m2", "turbine_shape_effect_m2", "stator_shape_effect_m2"):
+        assert (study[column] > 0).all() and (np.diff(study[column]) < 0).all(), column
+    np.testing.assert_allclose(study["stall_torque_ratio"], study["stall_torque_ratio"][0], rtol=1e-12)
+    for column in ("launch_effective_tr_deficit_first_0_5_s", "takeoff_effective_tr_dip", "launch_time_0_50_km_h_s"):
+        assert (np.diff(study[column]) < 0).all(), (column, study[column].tolist())
+    assert study["launch_effective_tr_deficit_first_0_5_s"].iloc[0] > 0.02  # a visible dip: 0.031 measured
+
+
+def test_the_dip_grows_with_the_shape_effects_alone():
+    """§4.1's experiment on the derived converter: the shape effects alone scaled by 0, 1 and 2
+    (the same steady state, L_f and inertias). The launch deficit and the take-off dip grow with the
+    shape effect; at 1 they are the derived converter's own (docs/design.md "tcsim design")."""
     derived = derive_converter(load_design_file(BUNDLED))
     conv, g = derived.converter, derived.geometry
     assert conv.geometry is not None
-
-    def dip(scale: float) -> float:
-        values = {f"{e}_shape_effect_m2": scale * abs(getattr(g, e).shape_effect_m2) for e in ("pump", "turbine")}
-        c = replace(conv, geometry=conv.geometry.model_copy(update=values))
-        steady = characterise(c, "hrovat-tobler")
-        return float(summary_row(c, "design", steady, takeoff_frame(c))["takeoff_effective_tr_dip"])
-
-    as_derived = float(design_report(load_design_file(BUNDLED)).summary["takeoff_effective_tr_dip"][0])
-    assert dip(-1.0) == pytest.approx(as_derived, rel=1e-9)  # the derived values are −|S|
-    assert dip(-1.0) < dip(0.0) < dip(0.5) < dip(1.0)
+    steady = characterise(conv, "hrovat-tobler")
+    scaled = []
+    for k in (0.0, 1.0, 2.0):
+        values = {f"{e}_shape_effect_m2": k * getattr(g, e).shape_effect_m2 for e in ("pump", "turbine", "stator")}
+        scaled.append(replace(conv, geometry=conv.geometry.model_copy(update=values), name=f"x{k:g}"))
+    launches = launch_runs(scaled, [c.name for c in scaled])
+    rows = [
+        summary_row(c, "design", steady, takeoff_frame(c), launches[c.name].frame.loc[:, list(LAUNCH_COLUMNS)])
+        for c in scaled
+    ]
+    for column in ("launch_effective_tr_deficit_first_0_5_s", "takeoff_effective_tr_dip"):
+        values = [float(r[column]) for r in rows]
+        assert values[0] < values[1] < values[2], (column, values)
+    report = design_report(load_design_file(BUNDLED)).summary
+    for column in ("launch_effective_tr_deficit_first_0_5_s", "takeoff_effective_tr_dip"):
+        assert float(rows[1][column]) == pytest.approx(float(report[column][0]), rel=1e-9)
 
 
 def test_losses_not_given_come_from_table_d1_and_say_so(tmp_path, cli):

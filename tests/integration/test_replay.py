@@ -359,7 +359,7 @@ def _converter(tmp_path: Path, edit: str | None) -> str | Path:
     if edit == "characteristic only":
         text = text[: text.index("[inertia]")]
     else:
-        old = "pump_shape_effect_m2 = -0.00569"
+        old = "pump_shape_effect_m2 = 0.001310"
         assert old in text
         text = text.replace(old, "pump_shape_effect_m2 = 0.2", 1)
     path.write_text(text)

@@ -1,5 +1,6 @@
 """The design geometry (issue 15, docs/design.md): the Python facade over the core's
-``converter::design``, against the circular-torus estimate and by hand; bad input."""
+``converter::design``, against the plain circular-torus reference (tests/torus_reference.py) and by
+hand; bad input."""
 
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from tcsim.models.design import (
     design_of_geometry,
     design_table,
 )
-from tcsim.models.torus import torus_estimate
+from torus_reference import torus_estimate
 
 
 @pytest.fixture(scope="module")
@@ -57,26 +58,30 @@ def test_circle_reproduces_the_torus_estimate_where_the_definitions_agree(bundle
         (g.pump.arc_shape_effect_m2, e.pump_shape_effect_m2),
         (g.turbine.arc_shape_effect_m2, e.turbine_shape_effect_m2),
         (g.stator.arc_shape_effect_m2, e.stator_shape_effect_m2),
+        (g.pump.shape_effect_m2, e.pump_literal_shape_effect_m2),
+        (g.turbine.shape_effect_m2, e.turbine_literal_shape_effect_m2),
+        (g.stator.shape_effect_m2, e.stator_literal_shape_effect_m2),
     ]
     for ours, theirs in pairs:
         assert ours == pytest.approx(theirs, rel=1e-12)
     # the bundled file's values are these, rounded
     assert g.fluid_length_m == pytest.approx(b.fluid_length_m, abs=5e-5)
-    assert g.pump.arc_shape_effect_m2 == pytest.approx(b.pump_shape_effect_m2, abs=5e-6)
-    assert g.turbine.arc_shape_effect_m2 == pytest.approx(b.turbine_shape_effect_m2, abs=5e-6)
+    for element in ("pump", "turbine", "stator"):
+        ours = getattr(g, element).shape_effect_m2
+        assert ours == pytest.approx(getattr(b, f"{element}_shape_effect_m2"), abs=5e-7), element
 
 
 def test_the_three_readings_of_the_bundled_circle(bundled):
-    """Where the readings differ (docs/design.md): the thesis's literal reading (exit radius × tan(exit
-    angle) × axial extent) flips the turbine's sign against both integral readings."""
+    """Where the readings differ (docs/design.md): the thesis's literal reading (exit radius × |tan(exit
+    angle)| × axial extent) is positive for every element; the signed integral readings are not."""
     g = design_geometry(design_of_geometry(bundled))
     tan = lambda deg: math.tan(math.radians(deg))  # noqa: E731
     stator_extent = 0.03 * math.sqrt(1.0 - (0.025 / 0.03) ** 2)
-    assert g.pump.shape_effect_m2 == pytest.approx(0.12 * tan(-20.0) * 0.03, rel=1e-12)
-    assert g.turbine.shape_effect_m2 == pytest.approx(0.065 * tan(-50.0) * 0.03, rel=1e-12)
+    assert g.pump.shape_effect_m2 == pytest.approx(0.12 * tan(20.0) * 0.03, rel=1e-12)
+    assert g.turbine.shape_effect_m2 == pytest.approx(0.065 * tan(50.0) * 0.03, rel=1e-12)
     assert g.stator.shape_effect_m2 == pytest.approx(0.06 * tan(60.0) * stator_extent, rel=1e-12)
     assert (g.pump.shape_effect_m2, g.turbine.shape_effect_m2, g.stator.shape_effect_m2) == pytest.approx(
-        (-0.001310, -0.002324, 0.001723), abs=1e-6
+        (0.001310, 0.002324, 0.001723), abs=1e-6
     )
     assert g.pump.axial_integral_shape_effect_m2 == pytest.approx(-0.003568, abs=1e-6)
     assert g.turbine.axial_integral_shape_effect_m2 == pytest.approx(0.001660, abs=1e-6)
@@ -100,8 +105,9 @@ def test_squash_zero_is_the_circle_and_squash_thins_the_shape_effect(bundled):
 
 def test_hand_calculation_of_a_rectangular_torus_pins_the_signs(bundled):
     """Axial legs of width w at R_s and R_p (pump), R_p and R_t (turbine), a radial stator. The
-    literal reading, by hand: S_p = R_p·w·tan α_p,exit, S_t = R_t·w·tan α_t,exit, S_s = 0 (Table
-    D.1's angles: both negative). The comparison reading with constant angles: over |dz|
+    literal reading, by hand: S_p = R_p·w·|tan α_p,exit|, S_t = R_t·w·|tan α_t,exit|, S_s = 0:
+    positive although Table D.1's exit angles (−20°, −50°) are negative (docs/design.md, "Sign
+    convention"). The comparison reading with constant angles: over |dz|
     S_p = (R_s + R_p)·w·tan α_p < 0 for α_p = −30°, S_t = (R_p + R_t)·w·tan α_t > 0 for 45°."""
     rs, rt, rp, w = 0.06, 0.065, 0.12, 0.02
     d = _replace(
@@ -112,9 +118,9 @@ def test_hand_calculation_of_a_rectangular_torus_pins_the_signs(bundled):
         stator_path_m=((rt, 0.0), (rs, 0.0)),
     )
     g = design_geometry(d)
-    assert g.pump.shape_effect_m2 == pytest.approx(rp * w * math.tan(math.radians(-20.0)), rel=1e-12)
-    assert g.turbine.shape_effect_m2 == pytest.approx(rt * w * math.tan(math.radians(-50.0)), rel=1e-12)
-    assert g.turbine.shape_effect_m2 < 0.0 < g.turbine.axial_integral_shape_effect_m2
+    assert g.pump.shape_effect_m2 == pytest.approx(rp * w * math.tan(math.radians(20.0)), rel=1e-12)
+    assert g.turbine.shape_effect_m2 == pytest.approx(rt * w * math.tan(math.radians(50.0)), rel=1e-12)
+    assert g.pump.shape_effect_m2 > 0.0 and g.turbine.shape_effect_m2 > 0.0
     assert g.stator.shape_effect_m2 == 0.0
     c = design_geometry(
         _replace(

@@ -33,7 +33,15 @@ from ..models.dynamic import dynamic_model
 from ..models.steady import _derived, coupling_point, hrovat_tobler_steady_state, steady_torque_ratio
 from ..simulation.transient import SolverError, TransientResult, simulate_batch
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
-from .design_report import SUMMARY_COLUMNS, TAKEOFF_END_S, TAKEOFF_STEP_S, takeoff_figures
+from .design_report import (
+    LAUNCH_COLUMNS,
+    SUMMARY_COLUMNS,
+    TAKEOFF_END_S,
+    TAKEOFF_STEP_S,
+    launch_figures,
+    launch_runs,
+    takeoff_figures,
+)
 
 #: The parameters a study sweeps: the numeric fields of ``[design]`` (:class:`TorusDesign`).
 SWEEP_PARAMETERS: tuple[str, ...] = tuple(
@@ -169,6 +177,28 @@ def _takeoffs(convs: Sequence[Converter], threads: int) -> list[TransientResult 
         return out
 
 
+def _launches(convs: Sequence[Converter], threads: int) -> list[Mapping[str, np.ndarray] | str]:
+    """The launches of ``convs`` (their :data:`LAUNCH_COLUMNS`) in one core call; when one fails,
+    each again alone so that only the failing ones become their error message."""
+    if not convs:
+        return []
+
+    def columns(run) -> Mapping[str, np.ndarray]:
+        return {c: run.frame[c].to_numpy(dtype=float) for c in LAUNCH_COLUMNS}
+
+    labels = [str(i) for i in range(len(convs))]
+    try:
+        return [columns(r) for r in launch_runs(convs, labels, threads=threads).values()]
+    except (InputError, SolverError):
+        out: list[Mapping[str, np.ndarray] | str] = []
+        for c in convs:
+            try:
+                out.append(columns(launch_runs([c], ["0"], threads=1)["0"]))
+            except (InputError, SolverError) as e:
+                out.append(f"launch: {e}")
+        return out
+
+
 def pareto_front(stall_tr: np.ndarray, dip: np.ndarray) -> np.ndarray:
     """True for the designs no other design beats: none with a stall TR at least as high and a
     take-off dip at least as small, and better in one (NaN rows are never on the front)."""
@@ -224,17 +254,20 @@ def design_study(
         rows.append(row)
     converted = [r for r in rows if not r["error"]]
     steadies = _steady_figures(convs)
-    runs = itertools.chain.from_iterable(
-        _takeoffs(convs[i : i + TAKEOFF_CHUNK], threads) for i in range(0, len(convs), TAKEOFF_CHUNK)
-    )
-    for row, conv, steady, run in zip(converted, convs, steadies, runs):
+    chunks = range(0, len(convs), TAKEOFF_CHUNK)
+    runs = itertools.chain.from_iterable(_takeoffs(convs[i : i + TAKEOFF_CHUNK], threads) for i in chunks)
+    launches = itertools.chain.from_iterable(_launches(convs[i : i + TAKEOFF_CHUNK], threads) for i in chunks)
+    for row, conv, steady, run, launch in zip(converted, convs, steadies, runs, launches):
         g = conv.geometry
         assert g is not None  # derived converters have [geometry]
         row |= {f"{e}_shape_effect_m2": getattr(g, f"{e}_shape_effect_m2") for e in ("pump", "turbine", "stator")}
-        if isinstance(steady, str) or isinstance(run, str):
-            row["error"] = steady if isinstance(steady, str) else run
+        failed = next((x for x in (steady, run, launch) if isinstance(x, str)), None)
+        if failed is not None:
+            row["error"] = failed
             continue
-        row |= steady.figures | takeoff_figures(run.columns, steady.speed_ratio, steady.torque_ratio)
+        assert isinstance(steady, _Steady) and isinstance(run, TransientResult) and not isinstance(launch, str)
+        sr, tr = steady.speed_ratio, steady.torque_ratio
+        row |= steady.figures | takeoff_figures(run.columns, sr, tr) | launch_figures(launch, sr, tr)
     columns = [*names, "pump_shape_effect_m2", "turbine_shape_effect_m2", "stator_shape_effect_m2"]
     columns += [*GEOMETRY_COLUMNS, *(c for c in FIGURE_COLUMNS if not c.endswith("_shape_effect_m2")), "error"]
     df = pd.DataFrame(rows).reindex(columns=columns)

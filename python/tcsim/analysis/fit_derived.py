@@ -1,10 +1,12 @@
 """What ``tcsim fit`` derives from the fitted geometry, what it warns about, and what it checks.
 
 A fitted converter must be one converter: every quantity that follows from the radii and angles is
-recomputed from the *fitted* ones through the same geometry code the rest of tcsim uses, the
-circular-torus estimate of :mod:`tcsim.models.torus` (Python; ``docs/models.md``):
+recomputed from the *fitted* ones through the same geometry code the rest of tcsim uses, the core's
+design model (:mod:`tcsim.models.design`, ``docs/design.md``) with the circular profile through the
+fitted radii:
 
-* ``fluid_length_m`` and the three ``*_shape_effect_m2`` of ``[geometry]`` (eqs 2.16–2.18);
+* ``fluid_length_m`` and the three ``*_shape_effect_m2`` of ``[geometry]`` (eqs 2.16–2.18 as
+  §4.1.1 reads them, ``R_exit·|tan α_exit|·L``);
 * the fluid's share of ``[inertia]``, ``ρA∫R²dl`` per element: when a radius, the flow area or the
   density is free, the start's metal part (its inertia less its torus fluid inertia) plus the fitted
   torus's fluid; otherwise the fitted angles leave the fluid inertia unchanged and ``[inertia]`` is
@@ -25,10 +27,10 @@ import numpy as np
 from .. import _core
 from ..errors import CoreText, InputError
 from ..models.converter import Converter, GeometrySection, InertiaSection
+from ..models.design import DesignGeometry, design_geometry, design_of_geometry
 from ..models.design_ranges import DESIGN_RANGES
 from ..models.dynamic import dynamic_model
 from ..models.steady import characterise_hrovat_tobler, coupling_point
-from ..models.torus import TorusEstimate, torus_estimate
 
 #: ``[geometry]`` keys derived from the radii and angles (never fitted, never copied).
 DERIVED_KEYS = ("fluid_length_m", "pump_shape_effect_m2", "turbine_shape_effect_m2", "stator_shape_effect_m2")
@@ -41,7 +43,7 @@ SIZE_KEYS = (
     "fluid_density_kg_m3",
 )
 #: How the derived keys are computed (the text of the report, ``[sources]`` and the fitted.toml header).
-DERIVATION = "circular-torus estimate from the fitted radii and angles (tcsim.models.torus, docs/models.md)"
+DERIVATION = "design model (circular profile) of the fitted radii and angles (tcsim.models.design, docs/design.md)"
 #: The radii's order the circular torus needs (and every converter has).
 RADII_ORDER = "stator exit radius < turbine exit radius < pump exit radius"
 _ELEMENTS = ("pump", "turbine", "stator")
@@ -52,33 +54,23 @@ def radii_ordered(pump_m: float, turbine_m: float, stator_m: float) -> bool:
     return bool(stator_m < turbine_m < pump_m)
 
 
-def torus_of(g: GeometrySection) -> TorusEstimate:
-    """The circular-torus estimate of ``g`` (:func:`tcsim.models.torus.torus_estimate`)."""
-    return torus_estimate(
-        g.pump_exit_radius_m,
-        g.turbine_exit_radius_m,
-        g.stator_exit_radius_m,
-        g.pump_inlet_angle_deg,
-        g.pump_exit_angle_deg,
-        g.turbine_inlet_angle_deg,
-        g.turbine_exit_angle_deg,
-        g.stator_inlet_angle_deg,
-        g.stator_exit_angle_deg,
-        g.flow_area_m2,
-        g.fluid_density_kg_m3,
-    )
+def torus_of(g: GeometrySection) -> DesignGeometry:
+    """The geometry of ``g``'s circular torus (:func:`tcsim.models.design.design_geometry`)."""
+    return design_geometry(design_of_geometry(g, "circular"), source="fitted [geometry]")
 
 
 def derive_geometry(g: GeometrySection) -> GeometrySection:
     """``g`` with its fluid length, m, and shape effects, m², recomputed from its radii and angles."""
     e = torus_of(g)
-    return GeometrySection(**{**g.model_dump(), **{k: float(getattr(e, k)) for k in DERIVED_KEYS}})
+    derived = {"fluid_length_m": e.fluid_length_m}
+    derived |= {f"{x}_shape_effect_m2": getattr(e, x).shape_effect_m2 for x in _ELEMENTS}
+    return GeometrySection(**{**g.model_dump(), **derived})
 
 
 def fluid_inertias(g: GeometrySection) -> np.ndarray:
     """Fluid inertia of pump, turbine and stator, kg·m² (``ρA∫R²dl`` over each element's torus arc)."""
     e = torus_of(g)
-    return np.array([getattr(e, f"{x}_fluid_inertia_kg_m2") for x in _ELEMENTS])
+    return np.array([getattr(e, x).fluid_inertia_kg_m2 for x in _ELEMENTS])
 
 
 def derive_inertia(

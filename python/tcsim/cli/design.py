@@ -1,5 +1,5 @@
 """``tcsim design``: from a converter design (torus, blades, fluid, metal inertias) to its converter
-file, its characteristic and its isolated take-off against a reference converter.
+file, its characteristic, its isolated take-off and its vehicle launch against a reference converter.
 
 ::
 
@@ -8,8 +8,8 @@ file, its characteristic and its isolated take-off against a reference converter
 DESIGN is a design ``.toml`` or a bundled design's name (``li-sunden-2016-design``); the schema is in
 docs/design.md ("Design files"). DIR (default ``design``) receives, all at once and nothing on
 error (:mod:`tcsim.io.outputs`): ``converter.toml``, ``characteristic.csv``,
-``reference_characteristic.csv``, ``takeoff.csv``, ``summary.csv`` and the plots of the
-characteristic (design and reference) and of the take-off. Bad input: exit 2, one line naming the
+``reference_characteristic.csv``, ``takeoff.csv``, ``launch.csv``, ``summary.csv`` and the plots
+of the characteristic (design and reference), of the take-off and of the launch. Bad input: exit 2, one line naming the
 file, the field and the value.
 """
 
@@ -24,8 +24,8 @@ from .app import OutOpt, say
 
 #: The command's ``--help`` text.
 HELP = (
-    "From a converter design (torus, blades, fluid) to DIR/converter.toml, its characteristic and its "
-    "isolated take-off against a reference converter."
+    "From a converter design (torus, blades, fluid) to DIR/converter.toml, its characteristic, its "
+    "isolated take-off and its vehicle launch (to 50 km/h) against a reference converter."
 )
 
 
@@ -42,7 +42,7 @@ def design(
     from ..io.outputs import check_output_dir, output_dir
     from ..models.design_file import LOSS_DEFAULTS_FROM, load_design_file
     from ..plots.characteristic import plot_characteristic
-    from ..plots.design import plot_design_takeoff
+    from ..plots.design import plot_design_launch, plot_design_takeoff
 
     check_output_dir(out, [design, reference])
     file = load_design_file(design)
@@ -55,6 +55,7 @@ def design(
         curves = {f"{name} (hrovat-tobler)": df for name, df in report.characteristics.items()}
         plot_characteristic(curves, stage, f"{title}, Hrovat & Tobler closed form")
         plot_design_takeoff(report.takeoffs, stage, f"{title}: isolated take-off")
+        plot_design_launch(report.launches, stage, f"{title}: launch, Hrovat & Tobler")
     g = report.derived.geometry
     say(
         f"{file.name}: converter.toml with S_p, S_t, S_s = {g.pump.shape_effect_m2:.6g}, "
@@ -67,5 +68,7 @@ def design(
     for row in report.summary.itertuples():
         say(
             f"{row.role} {row.converter}: stall TR {row.stall_torque_ratio:.3f}, take-off effective-TR dip "
-            f"{row.takeoff_effective_tr_dip:.4f} at {row.takeoff_effective_tr_dip_time_s:.2f} s"
+            f"{row.takeoff_effective_tr_dip:.4f} at {row.takeoff_effective_tr_dip_time_s:.2f} s, launch 0–50 km/h "
+            f"{row.launch_time_0_50_km_h_s:.2f} s (effective-TR deficit "
+            f"{row.launch_effective_tr_deficit_first_0_5_s:.4f} over the first 0.5 s)"
         )

@@ -1,7 +1,7 @@
 """The files of ``tcsim design`` (docs/design.md, "tcsim design"), written into a staging folder
 of :func:`tcsim.io.outputs.output_dir`: ``converter.toml``, ``characteristic.csv`` (the design's),
-``reference_characteristic.csv``, ``takeoff.csv`` (both converters, a ``converter`` column) and
-``summary.csv``."""
+``reference_characteristic.csv``, ``takeoff.csv`` and ``launch.csv`` (both converters, a
+``converter`` column) and ``summary.csv``."""
 
 from __future__ import annotations
 
@@ -20,6 +20,12 @@ CONVERTER_HEADER = (
 )
 
 
+def _stacked(runs: dict[str, pd.DataFrame]) -> pd.DataFrame:
+    """The runs one below the other, the converter's name in a first column ``converter``."""
+    frame = pd.concat([df.assign(converter=name) for name, df in runs.items()], ignore_index=True)
+    return frame[["converter", *(c for c in frame.columns if c != "converter")]]
+
+
 def write_design_files(report: DesignReport, design_path: str, out_dir: Path) -> list[Path]:
     """The converter file and the CSV files of ``report`` into ``out_dir``; the paths written."""
     out_dir = Path(out_dir)
@@ -27,11 +33,11 @@ def write_design_files(report: DesignReport, design_path: str, out_dir: Path) ->
     header = CONVERTER_HEADER.format(name=Path(design_path).name)
     toml.write_text(header + tomli_w.dumps(report.derived.document), encoding="utf-8")
     (design, steady), (_, ref_steady) = report.characteristics.items()
-    takeoff = pd.concat([df.assign(converter=name) for name, df in report.takeoffs.items()], ignore_index=True)
     frames = {
         "characteristic.csv": steady,
         "reference_characteristic.csv": ref_steady,
-        "takeoff.csv": takeoff[["converter", *(c for c in takeoff.columns if c != "converter")]],
+        "takeoff.csv": _stacked(report.takeoffs),
+        "launch.csv": _stacked(report.launches),
         "summary.csv": report.summary,
     }
     return [toml, *write_frames(frames, out_dir)]

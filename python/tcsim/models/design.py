@@ -6,11 +6,11 @@ The mean meridional streamline runs through the pump from the pump inlet (the st
 ``R_s``, the innermost point) out to the pump exit (``R_p``, the outermost), through the turbine
 in to the turbine exit ``R_t`` and through the stator back to ``R_s`` (Li & Sundén 2016,
 Appendix B). Per element the core gives the shape effect as the thesis's text defines it (§4.1.1,
-eqs 4.1–4.2, fig. 4.7): ``S = R_exit · tan α_exit · L``, the exit radius and exit blade angle times
-the length of the axial projection ``L`` of the element's path (its axial extent); for comparison the
-variable-integrand axial reading ``∫ R tan α |dz|`` and the arc reading ``∫ R tan α dl`` of
-:mod:`tcsim.models.torus`; the fluid mass ``ρAl`` and inertia ``ρA∫R²dl``, and the
-equivalent fluid length ``L_f = Σ∫(1 + tan²α) dl``.
+eqs 4.1–4.2, fig. 4.7): ``S = R_exit · |tan α_exit| · L``, the exit radius and exit blade angle
+times the length of the axial projection ``L`` of the element's path (its axial extent), a magnitude
+as chapter 4 uses it (docs/design.md, "Sign convention"); for comparison, signed as the angles, the
+variable-integrand axial reading ``∫ R tan α |dz|`` and the arc reading ``∫ R tan α dl``; the fluid
+mass ``ρAl`` and inertia ``ρA∫R²dl``, and the equivalent fluid length ``L_f = Σ∫(1 + tan²α) dl``.
 """
 
 from __future__ import annotations
@@ -94,13 +94,14 @@ class ElementGeometry:
     Attributes
     ----------
     shape_effect_m2 : float
-        ``S = R_exit · tan α_exit · L_axial``: the element's exit radius and exit blade angle times
-        the length of the axial projection of its path, its axial extent (eqs 4.1–4.2 and
-        2.16–2.18 as §4.1.1 reads them, fig. 4.7), m², signed as the exit angle.
+        ``S = R_exit · |tan α_exit| · L_axial``: the element's exit radius and exit blade angle
+        times the length of the axial projection of its path, its axial extent (eqs 4.1–4.2 and
+        2.16–2.18 as §4.1.1 reads them, fig. 4.7), m², ≥ 0 (docs/design.md, "Sign convention").
     axial_integral_shape_effect_m2 : float
-        ``∫ R tan α |dz|`` with R and α varying along the path (comparison only), m².
+        ``∫ R tan α |dz|`` with R and α varying along the path (comparison only), m², signed.
     arc_shape_effect_m2 : float
-        ``∫ R tan α dl`` along the path (the reading of :mod:`tcsim.models.torus`), m².
+        ``∫ R tan α dl`` along the path (comparison only: the bundled values before issue 15), m²,
+        signed.
     path_length_m, axial_length_m, axial_extent_m : float
         Path length ``l``, length of its axial projection ``∫|dz|``, axial extent, m.
     fluid_length_m : float

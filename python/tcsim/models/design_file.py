@@ -177,7 +177,7 @@ def _sources(file: DesignFile, defaults: tuple[str, ...]) -> dict[str, str]:
     out["geometry.fluid_length_m"] = f"L_f = Σ ∫(1 + tan²α) dl along the mean streamline, {profile} ({_DOC})"
     for e in _ELEMENTS:
         out[f"geometry.{e}_shape_effect_m2"] = (
-            f"S = R_exit·tan(α_exit)·L_axial, Li & Sundén (2016) §4.1.1 eqs 4.1–4.2 / 2.16–2.18, "
+            f"S = R_exit·|tan(α_exit)|·L_axial, Li & Sundén (2016) §4.1.1 eqs 4.1–4.2 / 2.16–2.18, "
             f"L_axial the axial extent of the {e}'s path, {profile} ({_DOC})"
         )
         out[f"inertia.{e}_kg_m2"] = f"metal {name} [inertia].{e}_kg_m2 + fluid ρA∫R²dl along the {e}'s path ({_DOC})"

@@ -18,14 +18,17 @@
 //! exit angle (signed as Table D.1). With `g = R·tan α`, per element x:
 //!
 //! * shape effect, the thesis's literal reading (§4.1.1, eqs 4.1–4.2 and 2.16–2.18, fig. 4.7):
-//!   `S_x = R_x,exit · tan α_x,exit · L_x`, the element's exit radius and exit blade angle (constants
-//!   under the integral) times `L_x`, the length of the axial projection of the element's path (its
-//!   axial extent `max z − min z`, the "axial projections of the impeller and turbine measuring
-//!   approximately 30-50 mm" of §4.1.1);
-//! * for comparison only: the variable-integrand axial reading `∫ g |dz|` and the arc reading
-//!   `∫ g dl` along the path (`tcsim.models.torus`);
+//!   `S_x = R_x,exit · |tan α_x,exit| · L_x`, the element's exit radius and exit blade angle
+//!   (constants under the integral) times `L_x`, the length of the axial projection of the element's
+//!   path (its axial extent `max z − min z`, the "axial projections of the impeller and turbine
+//!   measuring approximately 30-50 mm" of §4.1.1). A magnitude: the thesis's chapter 4 runs eqs
+//!   2.12–2.13 with positive shape effects "calculated in accordance with equations 2.16 and 2.17",
+//!   and its finding (a larger shape effect, a deeper effective-TR dip; none at S = 0) holds only
+//!   with S ≥ 0 (docs/design.md, "Sign convention");
+//! * for comparison only, signed as the angles: the variable-integrand axial reading `∫ g |dz|` and
+//!   the arc reading `∫ g dl` along the path (the angular momentum of the fluid relative to the blades);
 //! * fluid mass `ρ·A·l_x` (`l_x` the path length) and fluid inertia `ρ·A·∫ R² dl`;
-//! * the equivalent fluid length `L_f = Σ_x ∫ (1 + tan² α) dl` (as `tcsim.models.torus`).
+//! * the equivalent fluid length `L_f = Σ_x ∫ (1 + tan² α) dl`.
 //!
 //! The flow area A is given (thesis assumption 2: constant around the path; Table D.1 gives 0.01
 //! m²); blade thickness is not taken into account (assumption 4). Integrals are trapezoidal over
@@ -82,12 +85,13 @@ pub struct Design {
 /// What the design gives for one element.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct ElementGeometry {
-    /// `S = R_exit · tan α_exit · L_axial` (eqs 4.1–4.2 and 2.16–2.18 read with the exit values,
-    /// `L_axial` the axial extent), m².
+    /// `S = R_exit · |tan α_exit| · L_axial` (eqs 4.1–4.2 and 2.16–2.18 read with the exit values,
+    /// `L_axial` the axial extent), m². A magnitude, as the thesis's chapter 4 uses the shape
+    /// effects (docs/design.md, "Sign convention").
     pub shape_effect_m2: f64,
     /// `∫ R tan α |dz|` with R and α varying along the path (comparison only), m².
     pub axial_integral_shape_effect_m2: f64,
-    /// `∫ R tan α dl` along the path (the arc reading of `tcsim.models.torus`), m².
+    /// `∫ R tan α dl` along the path (the arc reading), m².
     pub arc_shape_effect_m2: f64,
     /// Length of the path `l_x`, m.
     pub path_length_m: f64,
@@ -459,7 +463,7 @@ fn element(p: &Path, angles: BladeAngles, exit_radius_m: f64, rho_a: f64) -> Ele
     }
     let extent = p.extent;
     ElementGeometry {
-        shape_effect_m2: exit_radius_m * a1.tan() * extent,
+        shape_effect_m2: exit_radius_m * a1.tan().abs() * extent,
         axial_integral_shape_effect_m2: axial,
         arc_shape_effect_m2: arc,
         path_length_m: length,

@@ -48,8 +48,9 @@ fn squash_zero_is_the_circle() {
     assert!(close(c.fluid_length_m, e.fluid_length_m, 1e-14));
 }
 
-/// The circular torus of Table D.1 gives the numbers `tcsim.models.torus` gives (and docs/models.md
-/// quotes) where the definitions agree: the arc shape effects, L_f and the fluid inertias.
+/// The circular torus of Table D.1 gives the numbers of the earlier arc estimate (the bundled
+/// converter's `[geometry]` before issue 15) where the definitions agree: the arc shape effects, L_f
+/// and the fluid inertias.
 #[test]
 fn circle_reproduces_the_arc_estimate() {
     let g = geo(&table_d1(Profile::Circular));
@@ -86,8 +87,9 @@ fn rectangular_torus() -> Design {
 /// A rectangular torus of axial width w: the pump climbs the inner wall at R_s, crosses radially to
 /// R_p and comes back at R_p; the turbine mirrors it down to R_t, the stator is radial. The axial
 /// projection of pump and turbine is w long, the stator's 0. By hand, the thesis's literal reading
-/// (exit radius × tan(exit angle) × axial length, whatever the inlet angles):
-/// S_p = R_p·tan α_p,exit·w, S_t = R_t·tan α_t,exit·w, S_s = 0.
+/// (exit radius × |tan(exit angle)| × axial length, whatever the inlet angles):
+/// S_p = R_p·|tan α_p,exit|·w, S_t = R_t·|tan α_t,exit|·w, S_s = 0. Positive although Table D.1's
+/// pump and turbine exit angles are negative: the sign convention of docs/design.md.
 #[test]
 fn hand_calculation_pins_the_signs() {
     let (_, rt, rp, w) = RECTANGLE;
@@ -95,12 +97,24 @@ fn hand_calculation_pins_the_signs() {
     // Table D.1's angles: the turbine's inlet (+55°) and exit (−50°) have opposite signs
     let g = geo(&d);
     let tan = |deg: f64| deg.to_radians().tan();
-    let (sp, st) = (rp * tan(-20.0) * w, rt * tan(-50.0) * w);
+    let (sp, st) = (rp * tan(20.0) * w, rt * tan(50.0) * w);
     assert!(close(g.pump.shape_effect_m2, sp, 1e-12), "{}", g.pump.shape_effect_m2);
     assert!(close(g.turbine.shape_effect_m2, st, 1e-12), "{}", g.turbine.shape_effect_m2);
-    assert!((sp - -0.000873).abs() < 1e-6 && (st - -0.001668).abs() < 1e-6);
+    assert!((sp - 0.000873).abs() < 1e-6 && (st - 0.001668).abs() < 1e-6);
     assert_eq!(g.stator.shape_effect_m2, 0.0);
-    assert!(g.pump.shape_effect_m2 < 0.0 && g.turbine.shape_effect_m2 < 0.0);
+    assert!(g.pump.shape_effect_m2 > 0.0 && g.turbine.shape_effect_m2 > 0.0);
+    // the sign of the exit angle does not enter: mirrored blades give the same shape effects
+    let mut mirrored = d.clone();
+    for a in [&mut mirrored.pump, &mut mirrored.turbine, &mut mirrored.stator] {
+        *a = BladeAngles { inlet_deg: -a.inlet_deg, exit_deg: -a.exit_deg };
+    }
+    let m = geo(&mirrored);
+    assert_eq!(
+        (m.pump.shape_effect_m2, m.turbine.shape_effect_m2),
+        (g.pump.shape_effect_m2, g.turbine.shape_effect_m2)
+    );
+    // while the signed comparison readings change sign with the blades
+    assert!(close(m.turbine.arc_shape_effect_m2, -g.turbine.arc_shape_effect_m2, 1e-12));
     assert!(close(g.pump.axial_extent_m, w, 1e-12) && close(g.turbine.axial_extent_m, w, 1e-12));
 }
 
@@ -119,7 +133,7 @@ fn hand_calculation_of_the_comparison_readings() {
     assert!(close(g.pump.axial_integral_shape_effect_m2, (rs + rp) * w * tp, 1e-12));
     assert!(close(g.turbine.axial_integral_shape_effect_m2, (rp + rt) * w * tt, 1e-12));
     assert_eq!(g.stator.axial_integral_shape_effect_m2, 0.0);
-    assert!(close(g.pump.shape_effect_m2, rp * w * tp, 1e-12) && close(g.turbine.shape_effect_m2, rt * w, 1e-12));
+    assert!(close(g.pump.shape_effect_m2, rp * w * tp.abs(), 1e-12) && close(g.turbine.shape_effect_m2, rt * w, 1e-12));
     assert!(close(g.pump.arc_shape_effect_m2, tp * (rs * w + 0.5 * (rp * rp - rs * rs) + rp * w), 1e-12));
     assert!(close(g.pump.axial_length_m, 2.0 * w, 1e-12) && close(g.stator.axial_length_m, 0.0, 1e-12));
     let rho_a = 8.4;
@@ -128,20 +142,21 @@ fn hand_calculation_of_the_comparison_readings() {
     assert!(close(g.pump.fluid_length_m, (1.0 + tp * tp) * (2.0 * w + rp - rs), 1e-12));
 }
 
-/// Table D.1 as a circle: the literal reading flips the turbine's sign against both integral
-/// readings (issue 15), S = R_exit·tan α_exit·a with the half-circle's axial extent a = 0.03 m.
+/// Table D.1 as a circle: S = R_exit·|tan α_exit|·a with the half-circle's axial extent a = 0.03 m.
+/// The turbine's exit angle (−50°) and the integral readings' sign (its inlet part, +55°, dominates)
+/// differ (issue 15's "flips the sign"); the literal reading takes the magnitude of the exit term.
 #[test]
-fn table_d1_literal_reading_flips_the_turbine() {
+fn table_d1_literal_reading_by_hand() {
     let g = geo(&table_d1(Profile::Circular));
     let tan = |deg: f64| deg.to_radians().tan();
-    assert!(close(g.pump.shape_effect_m2, 0.12 * tan(-20.0) * 0.03, 1e-12));
-    assert!(close(g.turbine.shape_effect_m2, 0.065 * tan(-50.0) * 0.03, 1e-12));
+    assert!(close(g.pump.shape_effect_m2, 0.12 * tan(20.0) * 0.03, 1e-12));
+    assert!(close(g.turbine.shape_effect_m2, 0.065 * tan(50.0) * 0.03, 1e-12));
     let stator_extent = 0.03 * (1.0 - (0.025f64 / 0.03).powi(2)).sqrt();
     assert!(close(g.stator.axial_extent_m, stator_extent, 1e-12));
     assert!(close(g.stator.shape_effect_m2, 0.06 * tan(60.0) * stator_extent, 1e-12));
-    assert!((g.turbine.shape_effect_m2 - -0.002324).abs() < 1e-6);
-    assert!(g.turbine.shape_effect_m2 < 0.0);
-    assert!(g.turbine.axial_integral_shape_effect_m2 > 0.0 && g.turbine.arc_shape_effect_m2 > 0.0);
+    assert!((g.turbine.shape_effect_m2 - 0.002324).abs() < 1e-6);
+    assert!(g.pump.arc_shape_effect_m2 < 0.0 && g.turbine.arc_shape_effect_m2 > 0.0);
+    assert!(g.turbine.axial_integral_shape_effect_m2 > 0.0);
 }
 
 /// §4.1.1: "a smaller diameter (smaller exit radii), axially thinner (shorter length of the axial
@@ -151,7 +166,7 @@ fn table_d1_literal_reading_flips_the_turbine() {
 fn thesis_section_4_1_1_trends() {
     let s = |d: &Design| {
         let g = geo(d);
-        (g.pump.shape_effect_m2.abs(), g.turbine.shape_effect_m2.abs())
+        (g.pump.shape_effect_m2, g.turbine.shape_effect_m2)
     };
     let base = table_d1(Profile::Elliptic { squash_ratio: 0.2 });
     let (sp, st) = s(&base);
@@ -182,7 +197,7 @@ fn thesis_section_4_1_1_trends() {
     t.turbine.exit_deg = -40.0;
     assert!(s(&t).1 < st && s(&t).0 == sp);
     // the stator too: exit radius, axial thinness and exit angle
-    let ss = |d: &Design| geo(d).stator.shape_effect_m2.abs();
+    let ss = |d: &Design| geo(d).stator.shape_effect_m2;
     let mut sa = base.clone();
     sa.stator.exit_deg = 45.0;
     assert!(ss(&sa) < ss(&base));
