@@ -105,7 +105,7 @@ def test_documented_names_resolve(dotted):
     assert resolve(dotted) is not None
 
 
-@pytest.mark.parametrize("module", ["transient", "replay", "fmu", "fitting", "shape_fit", "torus", "steady", "study"])
+@pytest.mark.parametrize("module", ["transient", "replay", "fmu", "fitting", "shape_fit", "steady", "study"])
 def test_facades_export_what_all_says(module):
     mod = importlib.import_module(f"tcsim.{module}")
     assert all(hasattr(mod, name) for name in mod.__all__)

@@ -202,8 +202,9 @@ def test_replay_bad_capacity_exits_2_with_one_line(cli, tmp_path, measurement, v
 # control, whose longer upshifts (0.73-0.77 s) move the engagement after the 2-3 upshift by 0.38 s.
 LAUNCH_LOCKUP_EVENTS = {
     "table": [("lockup-engage", 10.890870033058132), ("lockup-lock", 11.390870033058132)],
-    # issue 14: the fitted converter's derived geometry recomputed from its angles (was 10.8267/11.3267 s)
-    "hrovat-tobler": [("lockup-engage", 10.827781611592133), ("lockup-lock", 11.327781611592133)],
+    # issue 14: the fitted converter's derived geometry recomputed from its angles (was 10.8267/11.3267 s);
+    # issue 15: its shape effects by the design model's literal reading (was 10.827782/11.327782 s)
+    "hrovat-tobler": [("lockup-engage", 10.830444), ("lockup-lock", 11.330444)],
     # issue 14: the quasi-dynamic model's steady flow is C¹ in SR (was 10.891168693/11.391168693 s), then
     # the bundled converter's thesis shape effects with τ(ω) and τ_Q = 0.35 s (was 10.8911736/11.3911736 s)
     "quasi-dynamic": [("lockup-engage", 10.934776581234221), ("lockup-lock", 11.434776581234221)],

@@ -97,7 +97,7 @@ def test_inadmissible_shape_effect_names_the_bound():
     with pytest.raises(InputError) as e:
         tr.simulate(m, tr.isolated_takeoff(), times_s=T)
     assert e.value.field == "geometry.pump_shape_effect_m2"
-    assert "|S| < 0.0614" in str(e.value)  # √(I_p ρL_f/A − …)/ρ with the bundled S_t, S_s
+    assert "|S| < 0.0612283" in str(e.value)  # √(I_p(ρL_f/A − ρ²S_s²/I_s))/ρ: S_t = 0 here, the bundled S_s
 
 
 def test_bad_signals_and_initial_states_are_input_errors():

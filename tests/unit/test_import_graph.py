@@ -174,7 +174,7 @@ def test_relative_imports_resolve(module, is_package, level, target, expected):
     assert resolve(module, is_package, level, target) == expected
 
 
-FACADES = ("transient", "replay", "fmu", "fitting", "shape_fit", "steady", "study", "torus", "measurement")
+FACADES = ("transient", "replay", "fmu", "fitting", "shape_fit", "steady", "study", "measurement")
 
 
 @pytest.mark.parametrize("name", FACADES)

@@ -453,3 +453,28 @@ fn a_run_stepped_interval_by_interval_follows_the_single_run() {
         assert!(!stepper.sample().unwrap().mode.stator_locked && !single.samples.last().unwrap().mode.stator_locked);
     }
 }
+
+/// A first turbine speed a rounding below zero is a standstill: a launch's brake hold leaves
+/// −8.4e-14 rad/s in its log, and the replay of that log (pump torque and turbine speed in) must
+/// start from the stall steady state as from 0, not refuse it. Below the rounding it is refused.
+#[test]
+fn a_standstill_rounded_below_zero_starts_like_zero() {
+    let t = grid(0.0, 0.2, 21);
+    let model = ht(SHAPE);
+    let start = |wt0: f64| {
+        let drive = Drive::PumpTorqueTurbineSpeed {
+            pump_torque_nm: signal("pump_torque_nm", &[(0.0, 100.0), (0.2, 100.0)]),
+            turbine_speed_rad_s: signal("turbine_speed_rad_s", &[(0.0, wt0), (0.2, 0.0)]),
+            lockup: None,
+        };
+        simulate(&model, &drive, &t, &InitialState::default(), &SolverOptions::default())
+    };
+    let zero = start(0.0).unwrap_or_else(|e| panic!("{e}"));
+    let rounded = start(-8.4e-14).unwrap_or_else(|e| panic!("{e}"));
+    let wp = |traj: &Trajectory| {
+        columns(&model, traj).unwrap()[COLUMNS.iter().position(|c| *c == "pump_speed_rad_s").unwrap()][0]
+    };
+    assert_eq!(wp(&zero), wp(&rounded));
+    let refused = start(-1e-6).err().map(|e| e.to_string()).unwrap_or_default();
+    assert!(refused.contains("a turbine speed of zero or more"), "{refused}");
+}

@@ -38,7 +38,7 @@ from ..models.drives import isolated_takeoff
 from ..models.dynamic import dynamic_model
 from ..models.steady import characterise, coupling_point
 from ..models.vehicle import Vehicle, load_vehicle
-from ..simulation.launch import LaunchRun, run_launch
+from ..simulation.launch import LaunchRun, launch_columns, run_launch
 from ..simulation.scenarios import SPEED_50_KM_H_M_S, Scenario, flip_flop
 from ..simulation.transient import simulate
 from ..units import DEFAULT_PUMP_SPEED_RPM
@@ -164,6 +164,17 @@ def launch_runs(
     return run_launch(veh, launch_scenario(), models, {"output_step_s": LAUNCH_STEP_S}, threads, labels, on_error)
 
 
+def launch_column_runs(
+    converters: Sequence[Converter], vehicle: Vehicle | None = None, threads: int = 0
+) -> list[dict[str, np.ndarray] | Exception]:
+    """:func:`launch_runs` as :data:`LAUNCH_COLUMNS` arrays only, each run or its error in its place
+    (:func:`tcsim.simulation.launch.launch_columns`; for studies of thousands of designs)."""
+    models = [dynamic_model(c, "hrovat-tobler") for c in converters]
+    veh = load_vehicle(None) if vehicle is None else vehicle
+    options = {"output_step_s": LAUNCH_STEP_S}
+    return launch_columns(veh, launch_scenario(), models, LAUNCH_COLUMNS, options, threads)
+
+
 def launch_figures(launch: Mapping[str, np.ndarray], steady_sr: np.ndarray, steady_tr: np.ndarray) -> dict[str, float]:
     """The launch's time from the release to 50 km/h (s; NaN if not reached) and its mean
     effective-TR gap to the converter's steady state over the first 0.5 s after the release (-),
@@ -233,6 +244,7 @@ def design_report(
 __all__ = [
     "DEFAULT_REFERENCE",
     "LAUNCH_COLUMNS",
+    "launch_column_runs",
     "launch_figures",
     "launch_runs",
     "launch_scenario",

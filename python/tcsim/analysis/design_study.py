@@ -1,15 +1,18 @@
 """Design studies (docs/design.md, "Design studies"): one or two parameters of a design swept over a
-full grid, each design's steady-state and take-off figures as ``tcsim design`` computes them (its summary,
-:mod:`tcsim.analysis.design_report`), batched.
+full grid, each design's steady-state, take-off and launch figures as ``tcsim design`` computes them
+(its summary, :mod:`tcsim.analysis.design_report`), batched.
 
-Every design is derived by :func:`tcsim.models.design_file.derive_converter` (the core's geometry);
-the Hrovat & Tobler characteristics of all designs at :data:`~tcsim.units.DEFAULT_PUMP_SPEED_RPM`
-(SR 0–1 in steps of 0.01 and the coupling point, as ``tcsim design``) go to the core's closed form in
-one call, and the isolated take-offs in batched calls of :data:`TAKEOFF_CHUNK` designs
-(:func:`tcsim.simulation.transient.simulate_batch`, GIL released, ``threads`` workers); the take-off
-figures are :func:`~tcsim.analysis.design_report.takeoff_figures`. A design
-whose derivation, steady state or take-off fails keeps its row, with NaN figures and the one-line
-reason in ``error``; the others are unaffected.
+Every design is derived by :func:`tcsim.models.design_file.derive_converters` (the core's geometry
+of all designs in one threaded call, then each converter validated as a converter file is); the
+Hrovat & Tobler characteristics of all designs at :data:`~tcsim.units.DEFAULT_PUMP_SPEED_RPM` (SR
+0–1 in steps of 0.01 and the coupling point, as ``tcsim design``) go to the core's closed form in
+one call; the isolated take-offs (:func:`tcsim.simulation.transient.simulate_batch`) and the vehicle
+launches (:func:`~tcsim.analysis.design_report.launch_column_runs`) go in batched calls of
+:data:`TAKEOFF_CHUNK` designs (GIL released, ``threads`` workers); their figures are
+:func:`~tcsim.analysis.design_report.takeoff_figures` and
+:func:`~tcsim.analysis.design_report.launch_figures`. A design whose derivation, steady state,
+take-off or launch fails keeps its row, with NaN figures and the one-line reason in ``error``; the
+others are unaffected.
 """
 
 from __future__ import annotations
@@ -27,19 +30,18 @@ import pandas as pd
 from ..errors import InputError
 from ..models.converter import Converter
 from ..models.design import TorusDesign
-from ..models.design_file import DesignFile, derive_converter, load_design_file
+from ..models.design_file import DesignFile, derive_converters, load_design_file
 from ..models.drives import isolated_takeoff
 from ..models.dynamic import dynamic_model
 from ..models.steady import _derived, coupling_point, hrovat_tobler_steady_state, steady_torque_ratio
 from ..simulation.transient import SolverError, TransientResult, simulate_batch
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .design_report import (
-    LAUNCH_COLUMNS,
     SUMMARY_COLUMNS,
     TAKEOFF_END_S,
     TAKEOFF_STEP_S,
+    launch_column_runs,
     launch_figures,
-    launch_runs,
     takeoff_figures,
 )
 
@@ -137,24 +139,25 @@ def _steady_figures(convs: Sequence[Converter]) -> list[_Steady | str]:
             }
         )
     )
+    cols = {c: df[c].to_numpy(dtype=float) for c in ("speed_ratio", "torque_ratio", "k_factor_rpm_per_sqrt_nm")}
+    cols["efficiency"] = df["efficiency"].to_numpy(dtype=float)
     result: list[_Steady | str] = []
     start = 0
     for sr, cp in grids:
-        part = df.iloc[start : start + len(sr)]
+        part = {c: v[start : start + len(sr)] for c, v in cols.items()}
         start += len(sr)
-        if not np.isfinite(part["torque_ratio"].to_numpy()).all():
-            result.append(
-                f"steady state: none at SR {float(part['speed_ratio'][part['torque_ratio'].isna()].iloc[0]):g}"
-            )
+        bad = ~np.isfinite(part["torque_ratio"])
+        if bad.any():
+            result.append(f"steady state: none at SR {float(part['speed_ratio'][bad][0]):g}")
             continue
-        below = part["speed_ratio"] < (cp if cp is not None else np.inf)
+        below = part["efficiency"][part["speed_ratio"] < (cp if cp is not None else np.inf)]
         figures = {
-            "stall_torque_ratio": float(part["torque_ratio"].iloc[0]),
-            "stall_k_factor_rpm_per_sqrt_nm": float(part["k_factor_rpm_per_sqrt_nm"].iloc[0]),
-            "peak_converter_efficiency": float(part["efficiency"][below].max()),
+            "stall_torque_ratio": float(part["torque_ratio"][0]),
+            "stall_k_factor_rpm_per_sqrt_nm": float(part["k_factor_rpm_per_sqrt_nm"][0]),
+            "peak_converter_efficiency": float(below.max()) if below.size else math.nan,
             "coupling_point_speed_ratio": float("nan") if cp is None else float(cp),
         }
-        result.append(_Steady(figures, part["speed_ratio"].to_numpy(), part["torque_ratio"].to_numpy()))
+        result.append(_Steady(figures, part["speed_ratio"], part["torque_ratio"]))
     return result
 
 
@@ -178,25 +181,11 @@ def _takeoffs(convs: Sequence[Converter], threads: int) -> list[TransientResult 
 
 
 def _launches(convs: Sequence[Converter], threads: int) -> list[Mapping[str, np.ndarray] | str]:
-    """The launches of ``convs`` (their :data:`LAUNCH_COLUMNS`) in one core call; when one fails,
-    each again alone so that only the failing ones become their error message."""
+    """The launches of ``convs`` (their :data:`LAUNCH_COLUMNS`) in one core call, each run or the
+    one-line reason it failed."""
     if not convs:
         return []
-
-    def columns(run) -> Mapping[str, np.ndarray]:
-        return {c: run.frame[c].to_numpy(dtype=float) for c in LAUNCH_COLUMNS}
-
-    labels = [str(i) for i in range(len(convs))]
-    try:
-        return [columns(r) for r in launch_runs(convs, labels, threads=threads).values()]
-    except (InputError, SolverError):
-        out: list[Mapping[str, np.ndarray] | str] = []
-        for c in convs:
-            try:
-                out.append(columns(launch_runs([c], ["0"], threads=1)["0"]))
-            except (InputError, SolverError) as e:
-                out.append(f"launch: {e}")
-        return out
+    return [r if isinstance(r, dict) else f"launch: {r}" for r in launch_column_runs(convs, threads=threads)]
 
 
 def pareto_front(stall_tr: np.ndarray, dip: np.ndarray) -> np.ndarray:
@@ -242,12 +231,11 @@ def design_study(
     grid = list(itertools.product(*(np.asarray(sweep[n], dtype=float).tolist() for n in names)))
     rows: list[dict[str, Any]] = []
     convs: list[Converter] = []
-    for combo in grid:
+    files = [replace(file, design=replace(file.design, **dict(zip(names, combo)))) for combo in grid]
+    for combo, derived in zip(grid, derive_converters(files)):
         row: dict[str, Any] = dict(zip(names, combo)) | {"error": ""}
-        try:
-            derived = derive_converter(replace(file, design=replace(file.design, **dict(zip(names, combo)))))
-        except InputError as e:
-            row["error"] = str(e)
+        if isinstance(derived, InputError):
+            row["error"] = str(derived)
         else:
             convs.append(derived.converter)
             row["fluid_length_m"] = derived.geometry.fluid_length_m

@@ -168,23 +168,27 @@ def design_table(
         raise from_core(e, source) from None
 
 
-def design_geometry(design: TorusDesign, points: int = DEFAULT_POINTS, source: str = "design") -> DesignGeometry:
-    """The geometry of one design (:func:`design_table` of one); raises
-    :class:`~tcsim.errors.InputError` naming ``source`` on bad input."""
-    cols = design_table([design], points, True, source)
+def geometry_of_row(cols: dict[str, Any], i: int) -> DesignGeometry:
+    """Design ``i``'s geometry from the columns of :func:`design_table` (NaN for a failed design)."""
     names = [f.name for f in fields(ElementGeometry)]
 
     def element(name: str) -> ElementGeometry:
-        return ElementGeometry(*(float(cols[f"{name}_{q}"][0]) for q in names))
+        return ElementGeometry(*(float(cols[f"{name}_{q}"][i]) for q in names))
 
     return DesignGeometry(
         element("pump"),
         element("turbine"),
         element("stator"),
-        float(cols["fluid_length_m"][0]),
-        float(cols["path_length_m"][0]),
-        float(cols["fluid_mass_kg"][0]),
+        float(cols["fluid_length_m"][i]),
+        float(cols["path_length_m"][i]),
+        float(cols["fluid_mass_kg"][i]),
     )
+
+
+def design_geometry(design: TorusDesign, points: int = DEFAULT_POINTS, source: str = "design") -> DesignGeometry:
+    """The geometry of one design (:func:`design_table` of one); raises
+    :class:`~tcsim.errors.InputError` naming ``source`` on bad input."""
+    return geometry_of_row(design_table([design], points, True, source), 0)
 
 
 def design_of_geometry(
@@ -206,4 +210,5 @@ __all__ = [
     "design_geometry",
     "design_table",
     "design_of_geometry",
+    "geometry_of_row",
 ]

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import tomllib
+from collections.abc import Sequence
 from dataclasses import MISSING, dataclass, fields
 from importlib import resources
 from pathlib import Path
@@ -28,7 +29,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
 from ..errors import InputError
 from .converter import Converter, GeometrySection, InertiaSection, load_converter, parse_converter
-from .design import DEFAULT_POINTS, DesignGeometry, TorusDesign, design_geometry
+from .design import DEFAULT_POINTS, DesignGeometry, TorusDesign, design_geometry, design_table, geometry_of_row
 
 #: The bundled converter whose ``[geometry]`` gives the default loss coefficients (Table D.1).
 LOSS_DEFAULTS_FROM = "li-sunden-2016"
@@ -193,14 +194,43 @@ def _table_d1() -> GeometrySection:
     return geometry
 
 
+def _design_error(e: InputError) -> InputError:
+    """The core's error on a design's field, with the field as the design file writes it."""
+    field = e.field if e.field == "points" else f"[design].{e.field}"
+    return InputError(e.source, field, e.value, e.expected, e.core_source)
+
+
 def derive_converter(file: DesignFile, points: int | None = None) -> DerivedConverter:
     """The converter of a design: its geometry by the core (bad values name the design file), the
     converter TOML document, and the converter validated as any converter file is."""
     try:
         g = design_geometry(file.design, points or DEFAULT_POINTS, file.path)
     except InputError as e:  # the core names the design's field: it lives in [design]
-        field = e.field if e.field == "points" else f"[design].{e.field}"
-        raise InputError(e.source, field, e.value, e.expected, e.core_source) from None
+        raise _design_error(e) from None
+    return _converter_of(file, g)
+
+
+def derive_converters(files: Sequence[DesignFile], points: int | None = None) -> list[DerivedConverter | InputError]:
+    """:func:`derive_converter` of many designs, their geometry in one threaded core call; a design
+    that fails gets its :class:`InputError` in its place (the same error the one-design call raises)."""
+    cols = design_table([f.design for f in files], points or DEFAULT_POINTS, strict=False)
+    out: list[DerivedConverter | InputError] = []
+    for i, file in enumerate(files):
+        if cols["error"][i] is not None:
+            try:  # the one-design call names the field exactly as for a single design
+                out.append(derive_converter(file, points))
+            except InputError as e:
+                out.append(e)
+            continue
+        try:
+            out.append(_converter_of(file, geometry_of_row(cols, i)))
+        except InputError as e:
+            out.append(e)
+    return out
+
+
+def _converter_of(file: DesignFile, g: DesignGeometry) -> DerivedConverter:
+    """The derived converter of ``file`` with its geometry ``g`` (see :func:`derive_converter`)."""
     table_d1 = _table_d1()
     defaults = tuple(k for k in LOSS_KEYS if k not in file.losses)
     d = file.design
@@ -240,6 +270,7 @@ __all__ = [
     "DesignFile",
     "bundled_design_names",
     "derive_converter",
+    "derive_converters",
     "load_design_file",
     "read_design_file",
 ]

@@ -86,6 +86,38 @@ def _unpack(run: _core.LaunchRun, name: str, files: Mapping[str, str]) -> Launch
     return SolverError(f"{name}: {err.message}")
 
 
+def _launch_core(
+    vehicle: Vehicle, scenario: Scenario, models: Sequence[DynamicModel], options: dict | None, threads: int
+) -> list[_core.LaunchRun]:
+    """The one core call of every launch (GIL released); a bad input of the whole call raises."""
+    try:
+        return _core.launch_runs([m.spec for m in models], vehicle.core, scenario.core_spec(), options, threads)
+    except _core.CoreInputError as e:
+        raise from_core(e, _files(vehicle, scenario, models)) from None
+
+
+def launch_columns(
+    vehicle: Vehicle,
+    scenario: Scenario,
+    models: Sequence[DynamicModel],
+    columns: Sequence[str],
+    options: dict | None = None,
+    threads: int = 0,
+) -> list[dict[str, np.ndarray] | Exception]:
+    """Each model's launch as ``columns`` only (float64 arrays, no DataFrame), or its error (an
+    :class:`InputError` naming the file, or a :class:`SolverError`) in its place: the path for
+    thousands of runs (design studies). The models' run warnings are not checked here."""
+    out: list[dict[str, np.ndarray] | Exception] = []
+    for model, run in zip(models, _launch_core(vehicle, scenario, models, options, threads)):
+        if run.error is None:
+            out.append({c: np.asarray(run.columns[c], dtype=float) for c in columns})
+        else:
+            failed = _unpack(run, model.name, _files(vehicle, scenario, [model]))
+            assert isinstance(failed, Exception)
+            out.append(failed)
+    return out
+
+
 def run_launch(
     vehicle: Vehicle,
     scenario: Scenario,
@@ -107,10 +139,7 @@ def run_launch(
     names = list(labels) if labels is not None else [m.name for m in models]
     if len(names) != len(models) or len(set(names)) != len(names):
         raise ValueError(f"one unique label per model needed: {names}")
-    try:
-        raw = _core.launch_runs([m.spec for m in models], vehicle.core, scenario.core_spec(), options, threads)
-    except _core.CoreInputError as e:
-        raise from_core(e, _files(vehicle, scenario, models)) from None
+    raw = _launch_core(vehicle, scenario, models, options, threads)
     results = [_unpack(run, name, _files(vehicle, scenario, [model])) for name, model, run in zip(names, models, raw)]
     failed = next((r for r in results if not isinstance(r, LaunchRun)), None)
     if on_error == "raise" and failed is not None:

@@ -309,8 +309,13 @@ pub fn steady_point_scaled(model: &dyn ConverterDynamics, wp: f64, wt: f64) -> C
     Ok(SteadyPoint { u, pump_torque_nm: p.pump_torque_nm / (k * k) })
 }
 
+/// How far below zero a first turbine speed may lie and still count as a standstill, rad/s: the
+/// rounding of a held turbine in a simulated log (a launch's brake hold leaves about −1e-13 rad/s),
+/// far below any sensor's resolution (1e-9 rad/s is 1e-8 rpm).
+pub const STANDSTILL_ROUNDING_RAD_S: f64 = 1e-9;
+
 /// The pump speed at which the steady-state pump torque equals `pump_torque_nm` at turbine
-/// speed `wt` ≥ 0 (from the input `wt_source`).
+/// speed `wt` ≥ 0 (≥ −[`STANDSTILL_ROUNDING_RAD_S`], taken as 0; from the input `wt_source`).
 ///
 /// With `C(SR)` the steady pump torque at a pump speed of 1 rad/s (homogeneity: `T_p = C(SR)·ω_p²`),
 /// the speed ratio solves `SR·√T_p = ω_t·√C(SR)`, whose left side rises and right side falls with
@@ -339,7 +344,7 @@ fn steady_pump_speed(
              the initial pump speed explicitly",
         ));
     }
-    if wt < 0.0 {
+    if wt < -STANDSTILL_ROUNDING_RAD_S {
         return Err(CoreError::of(
             wt_source,
             "initial turbine_speed_rad_s",
@@ -359,6 +364,7 @@ fn steady_pump_speed(
             ))
         })
     };
+    let wt = wt.max(0.0); // a standstill's rounding below zero is the standstill
     let root_tp = pump_torque_nm.sqrt();
     let h = |sr: f64| -> TransientResult<f64> { Ok(sr * root_tp - wt * unit_torque(sr)?.max(0.0).sqrt()) };
     let sr = if wt == 0.0 {
