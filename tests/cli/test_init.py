@@ -140,6 +140,24 @@ def test_from_vtcc_and_from_a_converter(cli, tmp_path):
         np.testing.assert_array_equal(conv.characteristic.torque_ratio, C1_TR)
 
 
+def test_from_a_torque_dependent_table(cli, tmp_path):
+    rows = [
+        f"{s},{1 + (t - 1) * (1 - k)!r},{c * (1 - k * (1 - s))!r},{torque}"
+        for torque, k in ((100.0, 0.0), (300.0, 0.2))
+        for s, t, c in zip(C1_SR, C1_TR, C1_CF, strict=True)
+    ]
+    table = tmp_path / "two.csv"
+    table.write_text("speed_ratio,torque_ratio,capacity_factor_nm_s2,input_torque_nm\n" + "\n".join(rows) + "\n")
+    assert cli("init", "converter", "--from", table, "--out", "c.toml", cwd=tmp_path).code == 0
+    assert (tmp_path / "c.toml").read_text(encoding="utf-8").count("\n[[characteristic]]\n") == 2
+    read, written = load_converter(table).characteristic, load_converter(tmp_path / "c.toml").characteristic
+    assert len(written.tables()) == 2
+    for a, b in zip(read.tables(), written.tables(), strict=True):
+        assert a.input_torque_nm == b.input_torque_nm
+        np.testing.assert_array_equal(a.torque_ratio, b.torque_ratio)
+        np.testing.assert_allclose(a.capacity_factor_nm_s2, b.capacity_factor_nm_s2, rtol=1e-14)
+
+
 def test_an_existing_file_is_kept_unless_force(cli, tmp_path):
     target = tmp_path / "c.toml"
     target.write_text("# mine\n", encoding="utf-8")

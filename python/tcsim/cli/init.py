@@ -39,10 +39,9 @@ def init(
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..errors import InputError
-    from ..io.templates import DEFAULT_FILES, KINDS, make_template, write_template
+    from ..io.templates import DEFAULT_FILES, check_kind, make_template, write_template
 
-    if kind not in KINDS:
-        raise InputError("command line", "KIND", kind, f"one of {', '.join(KINDS)}")
+    check_kind(kind)
     target = DEFAULT_FILES[kind] if out is None else out
     if not target.strip():
         raise InputError("command line", "--out", target, "a file name (an empty name is not a file)")

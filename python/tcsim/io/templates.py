@@ -8,7 +8,7 @@ key gives its unit (from the key's name), the bounds the schema enforces, the pl
 study the range of Table D.1's parameter study, and the bundled file's source for the value.
 
 ``init converter --from TABLE`` writes the table as ``[characteristic]`` in its own capacity
-convention (the values as read, to 12 significant digits) and the sections the other models need
+convention (the values as read, to 15 significant digits) and the sections the other models need
 (``[inertia]``, ``[geometry]``, ``[quasi_dynamic]``) commented out, with the bundled converter's values
 as placeholders and a ``# TODO`` line that names them: the file runs the ``table`` model at once and
 every other model refuses it with one line naming the missing section.
@@ -295,14 +295,14 @@ def converter_template(out_name: str, study: bool = False) -> Template:
 
 
 def _table_rows(table: Characteristic) -> dict[str, Any]:
-    """One table in its own capacity convention, the values as read (12 significant digits)."""
+    """One table in its own capacity convention, the values as read (15 significant digits)."""
     cap = np.asarray(_core.cf_to_capacity(table.convention, np.ascontiguousarray(table.capacity_factor_nm_s2)))
     out: dict[str, Any] = {}
     if table.input_torque_nm is not None:
         out["input_torque_nm"] = float(table.input_torque_nm)
     out["speed_ratio"] = [float(v) for v in table.speed_ratio]
     out["torque_ratio"] = [float(v) for v in table.torque_ratio]
-    out[table.convention] = [float(f"{v:.12g}") for v in cap]
+    out[table.convention] = [float(f"{v:.15g}") for v in cap]  # without the conversion's last-bit noise
     return out
 
 
@@ -446,11 +446,16 @@ _BUILDERS: dict[str, Callable[[str], Template]] = {
 }
 
 
+def check_kind(kind: str) -> None:
+    """Refuse a ``KIND`` that is not one of :data:`KINDS` (:class:`~tcsim.errors.InputError`)."""
+    if kind not in KINDS:
+        raise InputError("command line", "KIND", kind, f"one of {', '.join(KINDS)}")
+
+
 def make_template(kind: str, out_name: str, table: str | None = None) -> Template:
     """The template of ``kind`` for a file named ``out_name`` (its stem is the file's ``name``); ``table``
     (``--from``) only for a converter."""
-    if kind not in KINDS:
-        raise InputError("command line", "KIND", kind, f"one of {', '.join(KINDS)}")
+    check_kind(kind)
     if table is not None and kind != "converter":
         raise InputError("command line", "--from", table, "no --from: only 'tcsim init converter' reads a table")
     if table is not None:
