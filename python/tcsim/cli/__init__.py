@@ -15,6 +15,7 @@ from . import (
     converters,
     design,
     design_study,
+    discovery,
     drive,
     export_fmu,
     fit,
@@ -25,7 +26,6 @@ from . import (
     replay,
     study,
     torque_estimate,
-    vehicles,
 )
 from .app import app, main
 
@@ -55,10 +55,10 @@ def _register(name: str, command: Callable[..., Any], text: str | None = None) -
     app.command(name, help=f"{text}\n\nExample: {EXAMPLES[name]}")(command)
 
 
-app.callback(help=app.info.help)(vehicles.options)
+app.callback(help=app.info.help)(discovery.options)
 # registered in the order ``tcsim --help`` lists them
 _register("converters", converters.converters)
-_register("vehicles", vehicles.vehicles)
+_register("vehicles", discovery.vehicles)
 _register("init", init.init, init.HELP)
 _register("characterise", characterise.characterise)
 _register("operating-point", operating_point.operating_point, operating_point.HELP)

@@ -1,4 +1,4 @@
-"""``tcsim vehicles``: the bundled vehicles, their converters and sources; ``tcsim --version``."""
+"""Discovery: ``tcsim vehicles`` (the bundled vehicles, their converters and sources) and ``tcsim --version``."""
 
 from __future__ import annotations
 
