@@ -328,7 +328,7 @@ def _pydantic_to_input_error(err: ValidationError, path: str, prefix: tuple[Any,
 
 #: The plausibility range (``tcsim._core.plausibility_ranges()``) of each design value of a converter
 #: file, by section and key suffix.
-_DESIGN_QUANTITIES: tuple[tuple[str, str], ...] = (
+DESIGN_QUANTITIES: tuple[tuple[str, str], ...] = (
     ("_radius_m", "radius_m"),
     ("_angle_deg", "blade_angle_deg"),
     ("fluid_density_kg_m3", "fluid_density_kg_m3"),
@@ -348,7 +348,7 @@ def warn_implausible_design(doc: ConverterFile, path: str) -> None:
         if values is None:
             continue
         for key, value in values.model_dump().items():
-            quantity = next((q for suffix, q in _DESIGN_QUANTITIES if key.endswith(suffix)), None)
+            quantity = next((q for suffix, q in DESIGN_QUANTITIES if key.endswith(suffix)), None)
             if quantity is not None and value is not None:
                 warn_implausible(quantity, value, path, f"[{section}].{key}")
 
