@@ -5,6 +5,7 @@ reference, bad design files exit 2 with one line and nothing written."""
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 from importlib import resources
 from pathlib import Path
@@ -90,7 +91,14 @@ def test_the_report_files_and_the_reference(written):
         "summary.csv",
     } <= names
     assert {"takeoff_effective_torque_ratio.png", "torque_ratio.png", "tcsim-manifest.json"} <= names
-    assert {"launch_effective_torque_ratio.png", "launch_vehicle_speed.png"} <= names
+    assert {"launch_effective_torque_ratio.png", "launch_vehicle_speed.png", "report.md"} <= names
+    # report.md: the summary's figures as the summary holds them, every figure linked and present
+    report = (out / "report.md").read_text(encoding="utf-8")
+    links = re.findall(r"!\[[^]]*\]\(([^)]+)\)", report)
+    assert len(links) == 7 and set(links) <= names
+    table = pd.read_csv(out / "summary.csv")
+    dips = " | ".join(f"{v:.4f}" for v in table["launch_effective_tr_deficit_first_0_5_s"])
+    assert f"| launch: mean effective-TR deficit, first 0.5 s [-] | {dips} |" in report
     summary = pd.read_csv(out / "summary.csv")
     assert tuple(summary.columns) == SUMMARY_COLUMNS
     assert summary["role"].tolist() == ["design", "reference"]

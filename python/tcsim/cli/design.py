@@ -8,8 +8,9 @@ file, its characteristic, its isolated take-off and its vehicle launch against a
 DESIGN is a design ``.toml`` or a bundled design's name (``li-sunden-2016-design``); the schema is in
 docs/design.md ("Design files"). DIR (default ``design``) receives, all at once and nothing on
 error (:mod:`tcsim.io.outputs`): ``converter.toml``, ``characteristic.csv``,
-``reference_characteristic.csv``, ``takeoff.csv``, ``launch.csv``, ``summary.csv`` and the plots
-of the characteristic (design and reference), of the take-off and of the launch. Bad input: exit 2, one line naming the
+``reference_characteristic.csv``, ``takeoff.csv``, ``launch.csv``, ``summary.csv``, the plots of
+the characteristic (design and reference), of the take-off and of the launch, and ``report.md``
+(all of it on one page). Bad input: exit 2, one line naming the
 file, the field and the value.
 """
 
@@ -43,6 +44,7 @@ def design(
     from ..models.design_file import LOSS_DEFAULTS_FROM, load_design_file
     from ..plots.characteristic import plot_characteristic
     from ..plots.design import plot_design_launch, plot_design_takeoff
+    from ..reports.design import report_markdown
 
     check_output_dir(out, [design, reference])
     file = load_design_file(design)
@@ -56,6 +58,8 @@ def design(
         plot_characteristic(curves, stage, f"{title}, Hrovat & Tobler closed form")
         plot_design_takeoff(report.takeoffs, stage, f"{title}: isolated take-off")
         plot_design_launch(report.launches, stage, f"{title}: launch, Hrovat & Tobler")
+        names = {p.name for p in Path(stage).iterdir()}
+        (Path(stage) / "report.md").write_text(report_markdown(report, file, names), encoding="utf-8")
     g = report.derived.geometry
     say(
         f"{file.name}: converter.toml with S_p, S_t, S_s = {g.pump.shape_effect_m2:.6g}, "
