@@ -130,3 +130,39 @@ def test_take_offs_in_chunks_give_the_same_figures(elliptic, monkeypatch):
     chunked = design_study(elliptic, sweep)
     assert (chunked["error"] != "").sum() == 3
     assert chunked.equals(whole)
+
+
+def test_an_axial_width_sweep_is_the_squash_sweep_at_each_designs_radii():
+    """``axial_width_m`` w sweeps the squash ratio 1 − w/(R_p − R_s) (issue 15's "axial length"): the
+    same figures as the squash sweep, thinner tori smaller shape effects and dips; wider than the
+    circle is a row error naming the squash ratio."""
+    circular = load_design_file("li-sunden-2016-design")
+    height = circular.design.pump_exit_radius_m - circular.design.stator_exit_radius_m  # 0.06 m
+    squash = [0.0, 0.25, 0.5]
+    by_width = design_study(circular, {"axial_width_m": [(1.0 - q) * height for q in squash] + [1.2 * height]})
+    by_squash = design_study(circular, {"squash_ratio": squash})
+    for c in FIGURE_COLUMNS:
+        np.testing.assert_allclose(by_width[c][:3], by_squash[c], rtol=1e-12, err_msg=c)
+    assert (np.diff(by_width["turbine_shape_effect_m2"][:3]) < 0).all()
+    assert (np.diff(by_width["takeoff_effective_tr_dip"][:3]) < 0).all()
+    assert "[design].squash_ratio = -0.2: expected a squash ratio in [0, 1)" in by_width["error"].iloc[3]
+    # the width of the radii swept with it: R_p 0.13 m at width 0.06 m is squash 1 − 0.06/0.07
+    both = design_study(circular, {"pump_exit_radius_m": [0.13], "axial_width_m": [0.06]})
+    alone = design_study(circular, {"pump_exit_radius_m": [0.13], "squash_ratio": [1.0 - 0.06 / 0.07]})
+    for c in FIGURE_COLUMNS:
+        assert both[c][0] == pytest.approx(alone[c][0], rel=1e-12), c
+
+
+def test_an_axial_width_sweep_of_a_polyline_design_is_refused():
+    base = load_design_file("li-sunden-2016-design")
+    d = base.design
+    rs, rt, rp, w = d.stator_exit_radius_m, d.turbine_exit_radius_m, d.pump_exit_radius_m, 0.02
+    polyline = replace(
+        d,
+        profile="polyline",
+        pump_path_m=((rs, 0.0), (rs, w), (rp, w), (rp, 0.0)),
+        turbine_path_m=((rp, 0.0), (rp, -w), (rt, -w), (rt, 0.0)),
+        stator_path_m=((rt, 0.0), (rs, 0.0)),
+    )
+    with pytest.raises(InputError, match="axial_width_m.*expected a circular or elliptic design"):
+        design_study(replace(base, design=polyline), {"axial_width_m": [0.03, 0.04]})

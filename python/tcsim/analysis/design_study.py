@@ -45,11 +45,18 @@ from .design_report import (
     takeoff_figures,
 )
 
-#: The parameters a study sweeps: the numeric fields of ``[design]`` (:class:`TorusDesign`).
-SWEEP_PARAMETERS: tuple[str, ...] = tuple(
-    f.name
-    for f in fields(TorusDesign)
-    if f.name.endswith(("_m", "_m2", "_deg", "_kg_m3", "_ratio")) and not f.name.endswith("_path_m")
+#: The torus's axial width, m: not a field of ``[design]`` but swept through the elliptic profile's
+#: squash ratio, ``1 − axial_width_m / (R_p − R_s)`` at each design's radii (docs/design.md).
+AXIAL_WIDTH = "axial_width_m"
+#: The parameters a study sweeps: the numeric fields of ``[design]`` (:class:`TorusDesign`) and
+#: :data:`AXIAL_WIDTH`.
+SWEEP_PARAMETERS: tuple[str, ...] = (
+    *(
+        f.name
+        for f in fields(TorusDesign)
+        if f.name.endswith(("_m", "_m2", "_deg", "_kg_m3", "_ratio")) and not f.name.endswith("_path_m")
+    ),
+    AXIAL_WIDTH,
 )
 #: Values per swept parameter: the fewest and the most; the most designs in one study.
 SWEEP_COUNT_RANGE = (2, 1000)
@@ -112,6 +119,16 @@ class _Steady:
     figures: dict[str, float]
     speed_ratio: np.ndarray
     torque_ratio: np.ndarray
+
+
+def _swept(design: TorusDesign, values: dict[str, float]) -> TorusDesign:
+    """``design`` with the swept ``values``; an axial width becomes the squash ratio at the design's
+    (possibly swept) radii (outside [0, 1) the core refuses the design, naming the squash ratio)."""
+    fields_: dict[str, Any] = {k: v for k, v in values.items() if k != AXIAL_WIDTH}
+    d = replace(design, **fields_)
+    if AXIAL_WIDTH in values:
+        d = replace(d, squash_ratio=1.0 - values[AXIAL_WIDTH] / (d.pump_exit_radius_m - d.stator_exit_radius_m))
+    return d
 
 
 def _steady_figures(convs: Sequence[Converter]) -> list[_Steady | str]:
@@ -211,8 +228,9 @@ def design_study(
         The base design: a read design file, a bundled design's name or a design ``.toml``.
     sweep : mapping
         One or two of :data:`SWEEP_PARAMETERS` → their values (units of the ``[design]`` field: m,
-        m², degrees, kg/m³, or the squash ratio). Sweeping ``squash_ratio`` of a circular design
-        sweeps the elliptic profile (squash 0 is the circle).
+        m², degrees, kg/m³, or the squash ratio; ``axial_width_m`` in m). Sweeping ``squash_ratio``
+        or ``axial_width_m`` of a circular design sweeps the elliptic profile (squash 0, width
+        ``R_p − R_s``, is the circle).
     threads : int
         Core workers for the take-offs (0: all cores).
 
@@ -225,13 +243,17 @@ def design_study(
     """
     file = design if isinstance(design, DesignFile) else load_design_file(design)
     check_sweep(sweep)
-    if "squash_ratio" in sweep and file.design.profile == "circular":  # squash 0 is the circle
-        file = replace(file, design=replace(file.design, profile="elliptic"))
     names = list(sweep)
+    if AXIAL_WIDTH in names and file.design.profile == "polyline":
+        raise InputError(
+            "--sweep", "NAME", AXIAL_WIDTH, "a circular or elliptic design (a polyline's paths set its width)"
+        )
+    if {"squash_ratio", AXIAL_WIDTH} & set(names) and file.design.profile == "circular":  # squash 0: the circle
+        file = replace(file, design=replace(file.design, profile="elliptic", squash_ratio=0.0))
     grid = list(itertools.product(*(np.asarray(sweep[n], dtype=float).tolist() for n in names)))
     rows: list[dict[str, Any]] = []
     convs: list[Converter] = []
-    files = [replace(file, design=replace(file.design, **dict(zip(names, combo)))) for combo in grid]
+    files = [replace(file, design=_swept(file.design, dict(zip(names, combo)))) for combo in grid]
     for combo, derived in zip(grid, derive_converters(files)):
         row: dict[str, Any] = dict(zip(names, combo)) | {"error": ""}
         if isinstance(derived, InputError):
