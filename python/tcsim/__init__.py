@@ -19,15 +19,35 @@ Tiers:
 
 from __future__ import annotations
 
+import importlib
+from typing import TYPE_CHECKING, Any
+
 from .errors import InputError, TcsimWarning
-from .models import operating_point as _operating_point
-from .models import steady as _steady
-from .models.characteristic import Characteristic
-from .models.converter import Converter, bundled_names, load_converter
-from .models.dynamic import dynamic_model
-from .models.steady import coupling_point, hrovat_tobler_steady_state
-from .simulation.transient import simulate, simulate_batch
-from .units import DEFAULT_PUMP_SPEED_RPM
+
+if TYPE_CHECKING:
+    from .api import characterise, operating_point, steady_state
+    from .models.characteristic import Characteristic
+    from .models.converter import Converter, bundled_names, load_converter
+    from .models.dynamic import dynamic_model
+    from .models.steady import coupling_point, hrovat_tobler_steady_state
+    from .simulation.transient import simulate, simulate_batch
+
+#: Where each public name lives: imported on first use, so that ``import tcsim`` and ``tcsim --help``
+#: do not import pandas, SciPy or matplotlib (issue 16).
+_LAZY: dict[str, str] = {
+    "Characteristic": ".models.characteristic",
+    "Converter": ".models.converter",
+    "bundled_names": ".models.converter",
+    "load_converter": ".models.converter",
+    "dynamic_model": ".models.dynamic",
+    "coupling_point": ".models.steady",
+    "hrovat_tobler_steady_state": ".models.steady",
+    "simulate": ".simulation.transient",
+    "simulate_batch": ".simulation.transient",
+    "characterise": ".api",
+    "steady_state": ".api",
+    "operating_point": ".api",
+}
 
 __all__ = [
     "Characteristic",
@@ -47,43 +67,15 @@ __all__ = [
 ]
 
 
-def characterise(
-    converter,
-    model: str = "hrovat-tobler",
-    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
-    speed_ratio=None,
-    input_torque_nm: float | None = None,
-):
-    """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`) at a fixed
-    pump speed, or with ``input_torque_nm`` (N·m) at a fixed pump torque, the pump speed solved
-    (docs/torque_capacity.md)."""
-    conv = converter if isinstance(converter, Converter) else load_converter(converter)
-    return _steady.characterise(conv, model, pump_speed_rpm, speed_ratio, input_torque_nm=input_torque_nm)
+def __getattr__(name: str) -> Any:
+    """A public name of :data:`_LAZY`, imported on first use (PEP 562)."""
+    module = _LAZY.get(name)
+    if module is None:
+        raise AttributeError(f"module 'tcsim' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module, __name__), name)
+    globals()[name] = value
+    return value
 
 
-def steady_state(converter, model: str, pump_speed_rad_s, turbine_speed_rad_s):
-    """Steady states of ``model`` at any pump and turbine speeds, rad/s (arrays, broadcast, any sign):
-    one row per point with the columns of ``characteristic.csv``; see
-    :func:`tcsim.steady.steady_state`. ``converter`` is a bundled name, a path or a :class:`Converter`."""
-    conv = converter if isinstance(converter, Converter) else load_converter(converter)
-    return _steady.steady_state(conv, model, pump_speed_rad_s, turbine_speed_rad_s)
-
-
-def operating_point(
-    converter,
-    turbine_speed_rad_s,
-    turbine_torque_nm=None,
-    model: str = "table",
-    pump_speed_limit_rad_s: float | None = None,
-    *,
-    turbine_power_w=None,
-):
-    """Backward operating points: pump speed and torque of ``model``'s steady state at turbine speeds,
-    rad/s, delivering torques, N·m (or powers ``turbine_power_w``, W), with an optional pump speed
-    limit, rad/s; one row per point with ``valid`` and ``reason``. See
-    :func:`tcsim.models.operating_point.operating_point`. ``converter`` is a bundled name, a path or a
-    :class:`Converter`."""
-    conv = converter if isinstance(converter, Converter) else load_converter(converter)
-    return _operating_point.operating_point(
-        conv, turbine_speed_rad_s, turbine_torque_nm, model, pump_speed_limit_rad_s, turbine_power_w=turbine_power_w
-    )
+def __dir__() -> list[str]:
+    return sorted({*globals(), *_LAZY})

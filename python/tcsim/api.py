@@ -1,0 +1,53 @@
+"""The one-liners of the top-level API (:func:`characterise`, :func:`steady_state`,
+:func:`operating_point`), re-exported by :mod:`tcsim` on first use (``import tcsim`` stays light)."""
+
+from __future__ import annotations
+
+from .models import operating_point as _operating_point
+from .models import steady as _steady
+from .models.converter import Converter, load_converter
+from .units import DEFAULT_PUMP_SPEED_RPM
+
+__all__ = ["characterise", "operating_point", "steady_state"]
+
+
+def characterise(
+    converter,
+    model: str = "hrovat-tobler",
+    pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
+    speed_ratio=None,
+    input_torque_nm: float | None = None,
+):
+    """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`) at a fixed
+    pump speed, or with ``input_torque_nm`` (N·m) at a fixed pump torque, the pump speed solved
+    (docs/torque_capacity.md)."""
+    conv = converter if isinstance(converter, Converter) else load_converter(converter)
+    return _steady.characterise(conv, model, pump_speed_rpm, speed_ratio, input_torque_nm=input_torque_nm)
+
+
+def steady_state(converter, model: str, pump_speed_rad_s, turbine_speed_rad_s):
+    """Steady states of ``model`` at any pump and turbine speeds, rad/s (arrays, broadcast, any sign):
+    one row per point with the columns of ``characteristic.csv``; see
+    :func:`tcsim.steady.steady_state`. ``converter`` is a bundled name, a path or a :class:`Converter`."""
+    conv = converter if isinstance(converter, Converter) else load_converter(converter)
+    return _steady.steady_state(conv, model, pump_speed_rad_s, turbine_speed_rad_s)
+
+
+def operating_point(
+    converter,
+    turbine_speed_rad_s,
+    turbine_torque_nm=None,
+    model: str = "table",
+    pump_speed_limit_rad_s: float | None = None,
+    *,
+    turbine_power_w=None,
+):
+    """Backward operating points: pump speed and torque of ``model``'s steady state at turbine speeds,
+    rad/s, delivering torques, N·m (or powers ``turbine_power_w``, W), with an optional pump speed
+    limit, rad/s; one row per point with ``valid`` and ``reason``. See
+    :func:`tcsim.models.operating_point.operating_point`. ``converter`` is a bundled name, a path or a
+    :class:`Converter`."""
+    conv = converter if isinstance(converter, Converter) else load_converter(converter)
+    return _operating_point.operating_point(
+        conv, turbine_speed_rad_s, turbine_torque_nm, model, pump_speed_limit_rad_s, turbine_power_w=turbine_power_w
+    )
