@@ -234,3 +234,24 @@ def test_the_bundled_design_is_table_d1_with_the_bundled_total_inertias():
         total = getattr(file.metal_inertia, f"{e}_kg_m2") + getattr(g, e).fluid_inertia_kg_m2
         assert math.isclose(total, getattr(conv.inertia, f"{e}_kg_m2"), abs_tol=1e-6)
     assert Path(file.path).name == f"{BUNDLED}.toml" and file.name == BUNDLED
+
+
+def test_the_launch_runs_on_the_vehicle_given(tmp_path, cli):
+    """``--vehicle``: the launch runs on that vehicle with the design's converter swapped in (a
+    heavier car reaches 50 km/h later); a vehicle that is neither bundled nor a file exits 2, one
+    line, nothing written."""
+    bundled = resources.files("tcsim") / "data" / "vehicles" / "midsize-awd-8at.toml"
+    heavy = tmp_path / "heavy.toml"
+    heavy.write_text(_edit(bundled.read_text(encoding="utf-8"), "mass_kg = 1930.0", "mass_kg = 2500.0"))
+    r = cli("design", BUNDLED, "--vehicle", heavy, "--out", tmp_path / "heavy")
+    assert r.code == 0, r.stderr
+    summary = pd.read_csv(tmp_path / "heavy" / "summary.csv")
+    default = design_report(load_design_file(BUNDLED)).summary
+    assert (summary["launch_time_0_50_km_h_s"] > default["launch_time_0_50_km_h_s"] + 0.3).all()
+    # the take-off does not involve the vehicle
+    assert summary["takeoff_effective_tr_dip"].tolist() == pytest.approx(default["takeoff_effective_tr_dip"].tolist())
+    bad = cli("design", BUNDLED, "--vehicle", "nope", "--out", tmp_path / "bad")
+    assert bad.code == 2 and not (tmp_path / "bad").exists()
+    assert bad.stderr.strip().splitlines() == [
+        "error: nope: vehicle = 'nope': expected a bundled vehicle (midsize-awd-8at) or an existing vehicle .toml file"
+    ]

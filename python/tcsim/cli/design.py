@@ -3,7 +3,7 @@ file, its characteristic, its isolated take-off and its vehicle launch against a
 
 ::
 
-    tcsim design DESIGN [--out DIR] [--reference CONVERTER]
+    tcsim design DESIGN [--out DIR] [--reference CONVERTER] [--vehicle VEHICLE]
 
 DESIGN is a design ``.toml`` or a bundled design's name (``li-sunden-2016-design``); the schema is in
 docs/design.md ("Design files"). DIR (default ``design``) receives, all at once and nothing on
@@ -36,20 +36,30 @@ def design(
     reference: Annotated[
         str, typer.Option("--reference", help="reference converter with [geometry]: bundled name or .toml")
     ] = "li-sunden-2016",
+    vehicle: Annotated[
+        str | None,
+        typer.Option(
+            "--vehicle",
+            help="vehicle of the launch, its converter swapped: bundled name or .toml "
+            "(default: the bundled vehicle, tcsim vehicles)",
+        ),
+    ] = None,
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.design_report import design_report
     from ..io.design_outputs import write_design_files
     from ..io.outputs import check_output_dir, output_dir
     from ..models.design_file import LOSS_DEFAULTS_FROM, load_design_file
+    from ..models.vehicle import load_vehicle
     from ..plots.characteristic import plot_characteristic
     from ..plots.design import plot_design_launch, plot_design_takeoff
     from ..reports.design import report_markdown
 
-    check_output_dir(out, [design, reference])
+    check_output_dir(out, [design, reference, *([vehicle] if vehicle else [])])
     file = load_design_file(design)
-    report = design_report(file, reference)
-    inputs = [design, file.path, reference, report.reference.path]
+    veh = load_vehicle(vehicle)
+    report = design_report(file, reference, vehicle=veh)
+    inputs = [design, file.path, reference, report.reference.path, veh.path, *([vehicle] if vehicle else [])]
     check_output_dir(out, inputs)
     with output_dir(out, inputs) as stage:
         write_design_files(report, file.path, stage)
