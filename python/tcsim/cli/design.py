@@ -20,7 +20,7 @@ from typing import Annotated
 
 import typer
 
-from .app import OutOpt, say
+from .app import FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 #: The command's ``--help`` text.
 HELP = (
@@ -35,6 +35,8 @@ def design(
     reference: Annotated[
         str, typer.Option("--reference", help="reference converter with [geometry]: bundled name or .toml")
     ] = "li-sunden-2016",
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.design_report import design_report
@@ -44,13 +46,14 @@ def design(
     from ..plots.characteristic import plot_characteristic
     from ..plots.design import plot_design_takeoff
 
+    tf = table_format(file_format, speed_unit)
     check_output_dir(out, [design, reference])
     file = load_design_file(design)
     report = design_report(file, reference)
     inputs = [design, file.path, reference, report.reference.path]
     check_output_dir(out, inputs)
     with output_dir(out, inputs) as stage:
-        write_design_files(report, file.path, stage)
+        write_design_files(report, file.path, stage, tf)
         title = f"{file.name} against {report.reference.name}"
         curves = {f"{name} (hrovat-tobler)": df for name, df in report.characteristics.items()}
         plot_characteristic(curves, stage, f"{title}, Hrovat & Tobler closed form")
