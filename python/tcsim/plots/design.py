@@ -9,6 +9,7 @@ from pathlib import Path
 import pandas as pd
 
 from .common import finish_figure, mpl_text, plt
+from .styles import model_line
 
 #: The take-off figures: column, axis label, file name.
 TAKEOFF_FIGURES = (
@@ -27,7 +28,8 @@ def plot_design_takeoff(takeoffs: Mapping[str, pd.DataFrame], out_dir: Path, tit
         fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
         for i, (name, df) in enumerate(takeoffs.items()):
             frame = df[df["time_s"] <= DIP_WINDOW_S[1]] if column == "effective_torque_ratio" else df
-            ax.plot(frame["time_s"], frame[column], lw=1.4, ls="-" if i == 0 else "--", label=mpl_text(name))
+            y = frame[column]
+            ax.plot(frame["time_s"], y, **model_line(name, i, label=mpl_text(name), y=y))
         ax.set_ylabel(label)
         paths.append(finish_figure(fig, ax, Path(out_dir) / filename, title))
     return paths
