@@ -16,8 +16,10 @@ import scipy.io
 import test_signals
 
 from tcsim import transient
+from tcsim.errors import TcsimWarning
 from tcsim.io import tables
 from tcsim.io.measurement import read_measurement
+from tcsim.io.results import write_frames
 from tcsim.io.tables import FORMATS, SPEED_UNITS, TableFormat, mat_variables, matlab_name, to_speed_unit
 from tcsim.units import RAD_S_PER_RPM
 
@@ -206,6 +208,14 @@ def test_rpm_results_round_trip_to_rad_s(cli, tmp_path, measurement, file_format
         np.testing.assert_allclose(got[tables.column_in_unit(c, "rpm")] * factor, ref[c], rtol=1e-14, atol=0)
     back = read_measurement(run, {}, required=("pump_speed_rad_s", "turbine_speed_rad_s"), optional=())
     np.testing.assert_allclose(back.channels["turbine_speed_rad_s"], ref["turbine_speed_rad_s"], rtol=1e-14)
+
+
+def test_the_warning_of_non_finite_values_names_the_column_as_written(tmp_path):
+    df = pd.DataFrame({"time_s": [0.0, 1.0], "pump_speed_rad_s": [1.0, np.inf]})
+    with pytest.warns(TcsimWarning, match=r"^run\.mat: .* in pump_speed_rpm \(1\)"):
+        paths = write_frames({"run.csv": df}, tmp_path, TableFormat("mat", "rpm"))
+    assert [p.name for p in paths] == ["run.mat"]
+    assert np.isinf(loadmat_columns(tmp_path / "run.mat")["pump_speed_rpm"][1])
 
 
 # ---------------------------------------------------------------------------------------------
