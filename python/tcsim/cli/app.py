@@ -14,13 +14,16 @@ import sys
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 from rich.console import Console
 
 from ..errors import InputError, TcsimWarning
 from ..reports.format import rich_text
+
+if TYPE_CHECKING:
+    from ..io.tables import TableFormat
 
 app = typer.Typer(
     add_completion=False,
@@ -61,6 +64,27 @@ AllowImplausibleOpt = Annotated[
     ),
 ]
 ChannelOpt = Annotated[list[str] | None, typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")]
+#: ``--format`` and ``--speed-unit`` of the commands that write result tables (tcsim.io.tables owns
+#: the choices; tests/cli/test_result_formats.py checks that the help lists them).
+FormatOpt = Annotated[
+    str, typer.Option("--format", help="file format of the result tables: csv | parquet | mat (MATLAB)")
+]
+SpeedUnitOpt = Annotated[
+    str,
+    typer.Option(
+        "--speed-unit",
+        help="unit of the angular speed columns of the result tables: rad/s | rpm "
+        "(rpm: *_rad_s columns become *_rpm, *_rad_s2 become *_rpm_per_s)",
+    ),
+]
+
+
+def table_format(file_format: str, speed_unit: str) -> TableFormat:
+    """``--format`` and ``--speed-unit`` checked (an :class:`InputError` of the command line names
+    the option), before anything is read or computed."""
+    from ..io.tables import TableFormat
+
+    return TableFormat(file_format, speed_unit)
 
 
 def say(line: str) -> None:

@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from ..units import DEFAULT_PUMP_SPEED_RPM
-from .app import AllowImplausibleOpt, ModelOpt, OutOpt, say
+from .app import AllowImplausibleOpt, FormatOpt, ModelOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 
 def characterise(
@@ -35,6 +35,8 @@ def characterise(
             "negative and above 1 allowed, |SR| <= 100, at most 100001 points",
         ),
     ] = None,
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
     from ..errors import InputError
@@ -45,6 +47,7 @@ def characterise(
     from ..models.steady import coupling_point, speed_ratio_sweep, sweep_speed_ratios
     from ..plots.characteristic import plot_characteristic
 
+    tf = table_format(file_format, speed_unit)
     if pump_speed_rpm is not None and input_torque_nm is not None:
         raise InputError(
             "command line",
@@ -67,7 +70,7 @@ def characterise(
     if cp is not None and sr is not None and not sr[0] <= cp <= sr[-1]:
         cp = None
     with output_dir(out, inputs) as stage:
-        write_frames({"characteristic.csv": df}, stage)
+        write_frames({"characteristic.csv": df}, stage, tf)
         table = conv.characteristic if model == "hrovat-tobler" else None
         plot_characteristic(
             {f"{model} model": df},
@@ -78,7 +81,7 @@ def characterise(
             table=table,
             coupling_point=cp,
         )
-    msg = f"{model}: {len(df)} points written to {out}/characteristic.csv and plots"
+    msg = f"{model}: {len(df)} points written to {out}/{tf.file_name('characteristic.csv')} and plots"
     if cp is not None:
         msg += f"; coupling point at SR {cp:.4f}"
     say(msg)

@@ -21,7 +21,7 @@ from typing import Annotated
 
 import typer
 
-from .app import OutOpt, say
+from .app import FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 #: The command's ``--help`` text.
 HELP = (
@@ -44,6 +44,8 @@ def design(
             "(default: the bundled vehicle, tcsim vehicles)",
         ),
     ] = None,
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.design_report import design_report
@@ -55,6 +57,7 @@ def design(
     from ..plots.design import plot_design_launch, plot_design_takeoff
     from ..reports.design import report_markdown
 
+    tf = table_format(file_format, speed_unit)
     check_output_dir(out, [design, reference, *([vehicle] if vehicle else [])])
     file = load_design_file(design)
     veh = load_vehicle(vehicle)
@@ -62,7 +65,7 @@ def design(
     inputs = [design, file.path, reference, report.reference.path, veh.path, *([vehicle] if vehicle else [])]
     check_output_dir(out, inputs)
     with output_dir(out, inputs) as stage:
-        write_design_files(report, file.path, stage)
+        write_design_files(report, file.path, stage, tf)
         title = f"{file.name} against {report.reference.name}"
         curves = {f"{name} (hrovat-tobler)": df for name, df in report.characteristics.items()}
         plot_characteristic(curves, stage, f"{title}, Hrovat & Tobler closed form")

@@ -16,7 +16,7 @@ from typing import Annotated
 
 import typer
 
-from .app import OutOpt, say
+from .app import FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 #: The command's ``--help`` text.
 HELP = (
@@ -31,14 +31,18 @@ def design_study(
         list[str], typer.Option("--sweep", help="NAME=MIN:MAX:N, N values from MIN to MAX; once or twice")
     ],
     out: OutOpt = Path("design-study"),
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.design_study import check_sweep, design_study, parse_sweep
     from ..errors import InputError
     from ..io.outputs import check_output_dir, output_dir
+    from ..io.tables import write_table
     from ..models.design_file import load_design_file
     from ..plots.design_study import plot_design_pareto
 
+    tf = table_format(file_format, speed_unit)
     parsed = [parse_sweep(s) for s in sweep]
     names = [n for n, _ in parsed]
     if len(set(names)) != len(names):
@@ -50,7 +54,7 @@ def design_study(
     study = design_study(file, values)
     inputs = [design, file.path]
     with output_dir(out, inputs) as stage:
-        study.to_csv(stage / "study.csv", index=False)
+        write_table(study, stage, "study.csv", tf)
         plot_design_pareto(study, stage, f"{file.name}: design study of {' × '.join(names)}")
     failed = int((study["error"] != "").sum())
     say(f"{file.name}: {len(study)} designs of {' × '.join(names)}, {failed} without figures, written to {out}")

@@ -28,7 +28,7 @@ from typing import Annotated
 
 import typer
 
-from .app import ModelsOpt, OutOpt, stdout
+from .app import FormatOpt, ModelsOpt, OutOpt, SpeedUnitOpt, stdout, table_format
 
 #: The command's ``--help`` text.
 HELP = (
@@ -50,6 +50,8 @@ def drive(
     ] = "us06",
     model: ModelsOpt = None,
     out: OutOpt = Path("drive"),
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.drive import BUNDLED_CYCLES
@@ -62,6 +64,7 @@ def drive(
     from ..reports.drive import drive_report
     from ..reports.format import rich_text
 
+    tf = table_format(file_format, speed_unit)
     trace_file = None if cycle in BUNDLED_CYCLES else cycle
     check_output_dir(out, [p for p in (vehicle, trace_file) if p])
     veh = load_vehicle(vehicle)
@@ -71,6 +74,6 @@ def drive(
         result = run(veh, trace, model or [])
     inputs = [p for p in (vehicle, trace_file, veh.path, veh.converter.path) if p]
     with output_dir(out, inputs) as stage:
-        write_drive_files(result, stage)
+        write_drive_files(result, stage, tf)
         plot_drive(result, stage)
-    stdout.print(drive_report(result, out))
+    stdout.print(drive_report(result, out, tf.format))

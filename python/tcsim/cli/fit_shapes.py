@@ -8,11 +8,23 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .app import AllowImplausibleOpt, ChannelOpt, ModelOpt, OutOpt, say
+from .app import (
+    AllowImplausibleOpt,
+    ChannelOpt,
+    FormatOpt,
+    ModelOpt,
+    OutOpt,
+    SpeedUnitOpt,
+    say,
+    table_format,
+)
+
+if TYPE_CHECKING:
+    from ..io.tables import TableFormat
 
 #: The command's ``--help`` text.
 HELP = "Fit the pump and turbine shape effects to a transient measurement; sweep plots like thesis figs 4.1–4.2."
@@ -28,6 +40,7 @@ def shape_fit_command(
     drive: str = "pump-torque",
     equal: bool = False,
     allow_implausible: bool = False,
+    tf: TableFormat | None = None,
 ) -> str:
     """Fit the shape effects of ``converter``'s ``model`` to ``measurement``.
 
@@ -35,20 +48,23 @@ def shape_fit_command(
     ``speeds`` (b): time_s, pump_speed_rad_s, turbine_speed_rad_s. The target needs
     turbine_torque_nm (and pump_torque_nm, pump_speed_rad_s for the effective TR). Writes
     DIR/shape_fit.json, DIR/shape_fit.md, DIR/shape_sweep.csv and the sweep plots (with the fitted
-    pair), all or nothing. Returns a one-line summary. Measured values outside the plausibility
-    ranges are refused unless ``allow_implausible``.
+    pair), all or nothing; ``tf``: the sweep table's format and speed unit (default CSV in rad/s).
+    Returns a one-line summary. Measured values outside the plausibility ranges are refused unless
+    ``allow_implausible``.
     """
     from ..analysis import shape_fit as sf
     from ..analysis.effective import measured_effective_torques
     from ..io.measurement import parse_channel_map, read_measurement
     from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_frames, write_text_files
+    from ..io.tables import CSV
     from ..models.converter import load_converter
     from ..models.dynamic import dynamic_model
     from ..models.shape_effects import sweep_values
     from ..plots.shape_sweep import plot_shape_effect_sweep
     from ..reports.shape_fit import report_markdown, shape_fit_json
 
+    tf = tf or CSV
     check_output_dir(out, [converter, measurement])
     sf.check_choice("--model", model, sf.MODELS)
     sf.check_choice("--target", target, sf.TARGETS)
@@ -80,7 +96,7 @@ def shape_fit_command(
     with output_dir(out, inputs) as stage:
         title = f"{conv.name}, {result.model}: shape effects"
         plots = plot_shape_effect_sweep(sweep, stage, title, measured=measured, steady=steady)
-        write_frames({"shape_sweep.csv": sweep}, stage)
+        write_frames({"shape_sweep.csv": sweep}, stage, tf)
         write_text_files(
             {
                 "shape_fit.json": shape_fit_json(result, conv, meas, drive, minima, plots),
@@ -88,7 +104,8 @@ def shape_fit_command(
             },
             stage,
         )
-    return f"{result.one_line()}. Written to {out}/: shape_fit.json, shape_fit.md, shape_sweep.csv and plots."
+    sweep_file = tf.file_name("shape_sweep.csv")
+    return f"{result.one_line()}. Written to {out}/: shape_fit.json, shape_fit.md, {sweep_file} and plots."
 
 
 def fit_shapes(
@@ -103,6 +120,13 @@ def fit_shapes(
     drive: Annotated[str, typer.Option("--drive", help="pump-torque | speeds")] = "pump-torque",
     equal: Annotated[bool, typer.Option("--equal", help="fit one shape effect, S_p = S_t")] = False,
     allow_implausible: AllowImplausibleOpt = False,
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """The command; its help is :data:`HELP`."""
-    say(shape_fit_command(converter, measurement, out, model, target, channel or [], drive, equal, allow_implausible))
+    tf = table_format(file_format, speed_unit)
+    say(
+        shape_fit_command(
+            converter, measurement, out, model, target, channel or [], drive, equal, allow_implausible, tf
+        )
+    )

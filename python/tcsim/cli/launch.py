@@ -67,10 +67,11 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .app import AllowImplausibleOpt, ModelsOpt, OutOpt, stdout
+from .app import AllowImplausibleOpt, FormatOpt, ModelsOpt, OutOpt, SpeedUnitOpt, stdout, table_format
 
 if TYPE_CHECKING:
     from ..analysis.launch import Launch
+    from ..io.tables import TableFormat
     from ..models.vehicle import Vehicle
     from ..simulation.scenarios import Scenario
 
@@ -111,13 +112,15 @@ def launch_files(
         )
 
 
-def write_launch(result: Launch, out_dir: Path) -> list[Path]:
-    """The CSV files and figures of a launch into ``out_dir`` (a staging directory)."""
+def write_launch(result: Launch, out_dir: Path, tf: TableFormat | None = None) -> list[Path]:
+    """The tables (``tf``: format and speed unit, default CSV in rad/s) and figures of a launch into
+    ``out_dir`` (a staging directory)."""
     from ..io.results import write_launch_files
+    from ..io.tables import CSV
     from ..plots.launch import plot_launch, plot_sweep
 
     out_dir = Path(out_dir)
-    paths = write_launch_files(result, out_dir)
+    paths = write_launch_files(result, out_dir, tf or CSV)
     first_events = next(iter(result.runs.values())).events if result.runs else []
     release = result.scenario.brake_release_time_s
     paths += plot_launch(result.frames, first_events, release, result.scenario.name, out_dir, result.summary)
@@ -143,12 +146,15 @@ def launch(
         ),
     ] = False,
     allow_implausible: AllowImplausibleOpt = False,
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..io.outputs import check_output_dir, output_dir
     from ..reports.console import launch_report, progress_display
     from ..reports.format import rich_text
 
+    tf = table_format(file_format, speed_unit)
     check_output_dir(out, [p for p in (vehicle, scenario) if p])
     result = launch_files(
         vehicle, scenario, model or [], sweep_shape_effects, progress=True, allow_implausible=allow_implausible
@@ -156,5 +162,5 @@ def launch(
     inputs = [p for p in (vehicle, scenario, result.vehicle.path, result.vehicle.converter.path) if p]
     with output_dir(out, inputs) as stage, progress_display(True) as display:
         display.add_task(rich_text(f"writing {out}/ (files and plots)"), total=None)
-        write_launch(result, stage)
-    stdout.print(launch_report(result, Path(out)))
+        write_launch(result, stage, tf)
+    stdout.print(launch_report(result, Path(out), tf.format))

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .app import ModelOpt, OutOpt, say
+from .app import FormatOpt, ModelOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 HELP = (
     "Backward operating points: from turbine speed and torque (or power) to pump speed and torque. "
@@ -33,6 +33,8 @@ def operating_point(
         ),
     ] = None,
     out: OutOpt = Path("operating_points"),
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """Backward operating points of one model: DIR/operating_points.csv with valid and reason per point."""
     from ..io.outputs import check_output_dir, output_dir
@@ -42,6 +44,7 @@ def operating_point(
     from ..models.operating_point import check_pump_speed_limit, operating_point
     from ..units import RAD_S_PER_RPM
 
+    tf = table_format(file_format, speed_unit)
     limit = check_pump_speed_limit("command line", "--pump-speed-limit-rpm", pump_speed_limit_rpm)
     check_output_dir(out, [converter, points])
     conv = load_converter(converter)
@@ -54,9 +57,9 @@ def operating_point(
     limit_rad_s = None if limit is None else limit * RAD_S_PER_RPM
     df = operating_point(conv, data.turbine_speed_rad_s, torque, model, limit_rad_s, turbine_power_w=power)
     with output_dir(out, inputs) as stage:
-        write_frames({"operating_points.csv": df}, stage)
+        write_frames({"operating_points.csv": df}, stage, tf)
     flagged = int((~df["valid"]).sum())
-    msg = f"{model}: {len(df)} operating points written to {out}/operating_points.csv"
+    msg = f"{model}: {len(df)} operating points written to {out}/{tf.file_name('operating_points.csv')}"
     if flagged:
         counts = df.loc[~df["valid"], "reason"].value_counts()
         msg += f"; {flagged} flagged (" + ", ".join(f"{n} {r}" for r, n in counts.items() if n) + ")"

@@ -12,10 +12,20 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .app import AllowImplausibleOpt, ChannelOpt, ModelsOpt, OutOpt, stdout
+from .app import (
+    AllowImplausibleOpt,
+    ChannelOpt,
+    FormatOpt,
+    ModelsOpt,
+    OutOpt,
+    SpeedUnitOpt,
+    stdout,
+    table_format,
+)
 
 if TYPE_CHECKING:
     from ..analysis.replay import Replay
+    from ..io.tables import TableFormat
 
 
 def replay_files(
@@ -57,16 +67,18 @@ def replay_files(
     return replay_measurement(conv, meas, models, kind, initial, window_s, metrics_window_s)
 
 
-def write_replay(replay: Replay, out_dir: Path) -> list[Path]:
-    """The CSV files and figures of a replay into ``out_dir`` (a staging directory)."""
+def write_replay(replay: Replay, out_dir: Path, tf: TableFormat | None = None) -> list[Path]:
+    """The tables (``tf``: format and speed unit, default CSV in rad/s) and figures of a replay into
+    ``out_dir`` (a staging directory)."""
     from ..io.results import write_replay_files
+    from ..io.tables import CSV
     from ..plots.replay import plot_replay
 
     meas = replay.measurement
     measured = {**meas.channels, **replay.measured_effective}
     runs = {name: result.columns for name, result in replay.results.items()}
     title = f"Inputs (drive {replay.drive.name}): {Path(meas.source).name}"
-    paths = write_replay_files(replay, Path(out_dir))
+    paths = write_replay_files(replay, Path(out_dir), tf or CSV)
     return paths + plot_replay(
         meas.time_s, measured, runs, replay.drive.inputs, replay.drive.outputs, title, Path(out_dir)
     )
@@ -101,6 +113,8 @@ def replay(
         ),
     ] = 1.0,
     allow_implausible: AllowImplausibleOpt = False,
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """Isolated converter driven by measured signals: DIR/<model>.csv, events, metrics, plots."""
     from ..analysis.replay import parse_initial
@@ -108,6 +122,7 @@ def replay(
     from ..io.outputs import check_output_dir, output_dir
     from ..reports.console import replay_report
 
+    tf = table_format(file_format, speed_unit)
     check_output_dir(out, [converter, measurement])
     result = replay_files(
         converter,
@@ -122,5 +137,5 @@ def replay(
     )
     inputs = [converter, measurement, result.measurement.source]
     with output_dir(out, inputs) as stage:
-        write_replay(result, stage)
-    stdout.print(replay_report(result, Path(out)))
+        write_replay(result, stage, tf)
+    stdout.print(replay_report(result, Path(out), tf.format))

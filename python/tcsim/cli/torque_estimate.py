@@ -22,10 +22,11 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from .app import AllowImplausibleOpt, OutOpt, say
+from .app import AllowImplausibleOpt, FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 if TYPE_CHECKING:
     from ..analysis.torque_estimate import TorqueComparison, TorqueSignal
+    from ..io.tables import TableFormat
 
 #: The most steps the command prints (steps.csv lists all).
 MAX_STEP_LINES = 10
@@ -70,10 +71,13 @@ def torque_estimate_files(
     return compare_torques(est, meas, max_delay_s)
 
 
-def write_torque_estimate(comparison: TorqueComparison, out_dir: Path) -> list[Path]:
-    """The CSV files and figures of a comparison into ``out_dir`` (a staging directory). The aligned
-    columns are empty where the shifted time lies outside the estimate's record, by design (so not
-    through :func:`tcsim.io.results.write_frames`, which warns of NaN in a result)."""
+def write_torque_estimate(comparison: TorqueComparison, out_dir: Path, tf: TableFormat | None = None) -> list[Path]:
+    """The tables (``tf``: format and speed unit, default CSV in rad/s) and figures of a comparison
+    into ``out_dir`` (a staging directory). The aligned columns are empty where the shifted time lies
+    outside the estimate's record, by design (so without the warning of
+    :func:`tcsim.io.results.write_frames` of NaN in a result)."""
+    from ..io.results import write_frames
+    from ..io.tables import CSV
     from ..plots.torque_estimate import plot_torque_estimate
 
     files = {
@@ -81,10 +85,7 @@ def write_torque_estimate(comparison: TorqueComparison, out_dir: Path) -> list[P
         "steps.csv": comparison.steps_frame(),
         "timeseries.csv": comparison.timeseries(),
     }
-    paths = []
-    for name, frame in files.items():
-        paths.append(Path(out_dir) / name)
-        frame.to_csv(paths[-1], index=False)
+    paths = write_frames(files, Path(out_dir), tf or CSV, warn=False)
     return paths + plot_torque_estimate(comparison, Path(out_dir))
 
 
@@ -126,14 +127,17 @@ def torque_estimate(
     ] = 1.0,
     allow_implausible: AllowImplausibleOpt = False,
     out: OutOpt = Path("torque-estimate"),
+    file_format: FormatOpt = "csv",
+    speed_unit: SpeedUnitOpt = "rad/s",
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..io.outputs import check_output_dir, output_dir
 
+    tf = table_format(file_format, speed_unit)
     check_output_dir(out, [estimate, dyno])
     result = torque_estimate_files(estimate, dyno, estimate_column, measured_column, max_delay, allow_implausible)
     with output_dir(out, [estimate, dyno]) as stage:
-        write_torque_estimate(result, stage)
+        write_torque_estimate(result, stage, tf)
     for line in report_lines(result):
         say(line)
     say(f"written to {out}/")

@@ -22,6 +22,7 @@ from ..analysis.drive import BUNDLED_CYCLES, Cycle, Drive
 from ..errors import InputError
 from .measurement import check_column, reader_for, refuse_duplicates
 from .results import write_frames
+from .tables import CSV, TableFormat
 
 _REQUIRED = ("time_s", "vehicle_speed_m_s")
 _OPTIONAL = ("grade_percent",)
@@ -106,12 +107,13 @@ def cycle_from_option(option: str) -> Cycle:
     return read_cycle(option)
 
 
-def write_drive_files(result: Drive, out_dir: Path) -> list[Path]:
-    """The CSV files of a drive: ``<model>.csv``, ``summary.csv``, ``events.csv``, ``cycle.csv``."""
+def write_drive_files(result: Drive, out_dir: Path, table_format: TableFormat = CSV) -> list[Path]:
+    """The tables of a drive (``table_format``, default CSV): ``<model>.csv``, ``summary.csv``,
+    ``events.csv``, ``cycle.csv``."""
     c = result.cycle
     trace = {"time_s": c.time_s, "vehicle_speed_m_s": c.vehicle_speed_m_s}
     if c.grade_percent is not None:
         trace["grade_percent"] = c.grade_percent
     files: dict[str, pd.DataFrame] = {f"{name}.csv": run.frame for name, run in result.runs.items()}
     files.update({"summary.csv": result.summary, "events.csv": result.events(), "cycle.csv": pd.DataFrame(trace)})
-    return write_frames(files, out_dir)
+    return write_frames(files, out_dir, table_format)

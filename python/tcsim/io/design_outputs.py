@@ -1,7 +1,7 @@
 """The files of ``tcsim design`` (docs/design.md, "tcsim design"), written into a staging folder
 of :func:`tcsim.io.outputs.output_dir`: ``converter.toml``, ``characteristic.csv`` (the design's),
 ``reference_characteristic.csv``, ``takeoff.csv`` and ``launch.csv`` (both converters, a
-``converter`` column) and ``summary.csv``."""
+``converter`` column) and ``summary.csv`` (or ``.parquet``, ``.mat``: :mod:`tcsim.io.tables`)."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ import tomli_w
 
 from ..analysis.design_report import DesignReport
 from .results import write_frames
+from .tables import CSV, TableFormat
 
 #: The header of the written ``converter.toml``.
 CONVERTER_HEADER = (
@@ -26,8 +27,11 @@ def _stacked(runs: dict[str, pd.DataFrame]) -> pd.DataFrame:
     return frame[["converter", *(c for c in frame.columns if c != "converter")]]
 
 
-def write_design_files(report: DesignReport, design_path: str, out_dir: Path) -> list[Path]:
-    """The converter file and the CSV files of ``report`` into ``out_dir``; the paths written."""
+def write_design_files(
+    report: DesignReport, design_path: str, out_dir: Path, table_format: TableFormat = CSV
+) -> list[Path]:
+    """The converter file and the tables of ``report`` (``table_format``, default CSV) into
+    ``out_dir``; the paths written."""
     out_dir = Path(out_dir)
     toml = out_dir / "converter.toml"
     header = CONVERTER_HEADER.format(name=Path(design_path).name)
@@ -40,4 +44,4 @@ def write_design_files(report: DesignReport, design_path: str, out_dir: Path) ->
         "launch.csv": _stacked(report.launches),
         "summary.csv": report.summary,
     }
-    return [toml, *write_frames(frames, out_dir)]
+    return [toml, *write_frames(frames, out_dir, table_format)]

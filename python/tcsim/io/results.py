@@ -1,6 +1,6 @@
-"""Result files of the commands (CSV, TOML, JSON, Markdown), written into a staging directory of
-:func:`tcsim.io.outputs.output_dir`. Figures are written by :mod:`tcsim.plots`, reports' text by
-:mod:`tcsim.reports`."""
+"""Result files of the commands (tables as CSV, Parquet or ``.mat`` by :mod:`tcsim.io.tables`; TOML,
+JSON, Markdown), written into a staging directory of :func:`tcsim.io.outputs.output_dir`. Figures are
+written by :mod:`tcsim.plots`, reports' text by :mod:`tcsim.reports`."""
 
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ from ..errors import TcsimWarning
 from ..models.characteristic import Characteristic
 from ..models.converter import Converter, parse_converter
 from ..simulation.transient import INFINITE_ALLOWED, NAN_NOT_EXPECTED
+from .tables import CSV, TableFormat, column_in_unit, write_table
 
 
 def _partly_nan(df: pd.DataFrame, name: str) -> np.ndarray:
@@ -61,29 +62,33 @@ def non_finite_columns(df: pd.DataFrame) -> dict[str, int]:
     return out
 
 
-def write_frames(files: dict[str, pd.DataFrame], out_dir: Path) -> list[Path]:
-    """Each frame as ``out_dir/<name>`` (CSV, no index), in order; the paths written. A frame with
-    values a result must not hold silently (:func:`non_finite_columns`) is written as it is, with a
-    :class:`~tcsim.errors.TcsimWarning` naming the file, the columns and the count."""
+def write_frames(
+    files: dict[str, pd.DataFrame], out_dir: Path, table_format: TableFormat = CSV, warn: bool = True
+) -> list[Path]:
+    """Each frame as ``out_dir/<name>`` in order, by :func:`tcsim.io.tables.write_table` (``name``
+    ends in ``.csv``; the suffix is ``table_format``'s); the paths written. With ``warn``, a frame
+    with values a result must not hold silently (:func:`non_finite_columns`) is written as it is,
+    with a :class:`~tcsim.errors.TcsimWarning` naming the file, the columns and the count."""
     paths = []
-    for filename, df in files.items():
-        paths.append(Path(out_dir) / filename)
-        bad = non_finite_columns(df)
+    for name, df in files.items():
+        filename = table_format.file_name(name)
+        bad = non_finite_columns(df) if warn else {}
         if bad:
-            listed = ", ".join(f"{k} ({n})" for k, n in bad.items())
+            listed = ", ".join(f"{column_in_unit(k, table_format.speed_unit)} ({n})" for k, n in bad.items())
             warnings.warn(
                 f"{filename}: non-finite values (inf, or NaN in a physical quantity) in {listed}: the run overflowed "
                 "or its inputs were outside the model's range; check them before using the file",
                 TcsimWarning,
                 stacklevel=2,
             )
-        df.to_csv(paths[-1], index=False)
+        paths.append(write_table(df, Path(out_dir), name, table_format))
     return paths
 
 
-def write_launch_files(result: Launch, out_dir: Path) -> list[Path]:
-    """The CSV files of a launch: ``<model>.csv``, ``summary.csv``, ``timeseries.csv``, ``events.csv``,
-    ``scenario.csv`` and, with the sweep, ``shape_sweep.csv`` and ``shape_sweep_summary.csv``."""
+def write_launch_files(result: Launch, out_dir: Path, table_format: TableFormat = CSV) -> list[Path]:
+    """The tables of a launch (``table_format``, default CSV): ``<model>.csv``, ``summary.csv``,
+    ``timeseries.csv``, ``events.csv``, ``scenario.csv`` and, with the sweep, ``shape_sweep.csv``
+    and ``shape_sweep_summary.csv``."""
     files: dict[str, pd.DataFrame] = {f"{name}.csv": f for name, f in result.frames.items()}
     files.update(
         {
@@ -96,17 +101,17 @@ def write_launch_files(result: Launch, out_dir: Path) -> list[Path]:
     if result.sweep is not None and result.sweep_summary is not None:
         files["shape_sweep.csv"] = result.sweep
         files["shape_sweep_summary.csv"] = result.sweep_summary
-    return write_frames(files, out_dir)
+    return write_frames(files, out_dir, table_format)
 
 
-def write_replay_files(replay: Replay, out_dir: Path) -> list[Path]:
-    """The CSV files of a replay: ``<model>.csv``, ``events.csv``, ``measurement.csv`` and, when the
-    measurement has reference outputs, ``metrics.csv``."""
+def write_replay_files(replay: Replay, out_dir: Path, table_format: TableFormat = CSV) -> list[Path]:
+    """The tables of a replay (``table_format``, default CSV): ``<model>.csv``, ``events.csv``,
+    ``measurement.csv`` and, when the measurement has reference outputs, ``metrics.csv``."""
     files = {f"{name}.csv": result.frame() for name, result in replay.results.items()}
     files.update({"events.csv": replay.events, "measurement.csv": replay.measured_frame()})
     if len(replay.metrics):
         files["metrics.csv"] = replay.metrics
-    return write_frames(files, out_dir)
+    return write_frames(files, out_dir, table_format)
 
 
 def write_fit_files(

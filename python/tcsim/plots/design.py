@@ -10,6 +10,7 @@ from pathlib import Path
 import pandas as pd
 
 from .common import finish_figure, mpl_text, plt
+from .styles import model_line
 
 #: The take-off figures: column, axis label, file name.
 TAKEOFF_FIGURES = (
@@ -23,8 +24,6 @@ LAUNCH_FIGURES = (
 )
 #: The time window of the take-off's effective-torque-ratio figure, s (the dip is in the first seconds).
 DIP_WINDOW_S = (0.0, 3.0)
-#: Line style and marker per converter, in order (design, reference): told apart without colour.
-STYLES = (("-", None), ("--", "o"))
 
 
 def _plot_runs(runs: Mapping[str, pd.DataFrame], figures, window_s: float, out_dir: Path, title: str) -> list[Path]:
@@ -33,11 +32,10 @@ def _plot_runs(runs: Mapping[str, pd.DataFrame], figures, window_s: float, out_d
     paths = []
     for column, label, filename in figures:
         fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
-        for (name, df), (ls, marker) in zip(runs.items(), STYLES):
+        for i, (name, df) in enumerate(runs.items()):
             frame = df[df["time_s"] <= window_s] if column == "effective_torque_ratio" else df
-            ax.plot(
-                frame["time_s"], frame[column], lw=1.4, ls=ls, marker=marker, markevery=0.1, ms=4, label=mpl_text(name)
-            )
+            y = frame[column]
+            ax.plot(frame["time_s"], y, **model_line(name, i, label=mpl_text(name), y=y))
         ax.set_ylabel(label)
         paths.append(finish_figure(fig, ax, Path(out_dir) / filename, title))
     return paths

@@ -8,7 +8,6 @@ legend counts them. The fitted range SR 0–SR_max is shaded.
 
 from __future__ import annotations
 
-import itertools
 from pathlib import Path
 
 import numpy as np
@@ -17,10 +16,10 @@ import pandas as pd
 from ..models.characteristic import Characteristic
 from .characteristic import QUANTITIES, table_columns
 from .common import mpl_text, plt
+from .styles import model_line
 
 #: The speed-ratio span of the figures: the drive range the fit's model covers.
 SR_SPAN = (0.0, 1.0)
-_STYLES = ("-", "--", "-.", ":")
 
 
 def _limits(values: list[np.ndarray]) -> tuple[float, float] | None:
@@ -41,18 +40,19 @@ def fit_figure(
     coupling_point: float | None = None,
 ):
     """The figure of one quantity (a key of :data:`~.characteristic.QUANTITIES`) against SR 0–1, open:
-    model curves as lines of distinct styles, the table's rows in SR 0–1 as markers (the legend counts
-    those left out), the fitted range SR 0–``speed_ratio_max`` shaded, the y-axis fitted to what is shown."""
+    model curves as lines of distinct styles (:mod:`tcsim.plots.styles`), the table's rows in SR 0–1
+    as markers (the legend counts those left out), the fitted range SR 0–``speed_ratio_max`` shaded,
+    the y-axis fitted to what is shown."""
     ref = table_columns(table)
     sr = ref["speed_ratio"].to_numpy(dtype=float)
     inside = (sr >= SR_SPAN[0]) & (sr <= SR_SPAN[1])
     left_out = int((~inside).sum())
     fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
     shown = []
-    for (name, df), ls in zip(curves.items(), itertools.cycle(_STYLES)):
+    for i, (name, df) in enumerate(curves.items()):
         x, y = df["speed_ratio"].to_numpy(dtype=float), df[column].to_numpy(dtype=float)
         y = np.where(np.isfinite(y) & (x >= SR_SPAN[0]) & (x <= SR_SPAN[1]), y, np.nan)
-        ax.plot(x, y, ls=ls, label=mpl_text(name))
+        ax.plot(x, y, **model_line(name, i, label=mpl_text(name), y=y))
         shown.append(y)
     y = ref[column].to_numpy(dtype=float)[inside]
     rows = f"Target table ({left_out} rows outside SR 0–1 not shown)" if left_out else "Target table"

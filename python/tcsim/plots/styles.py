@@ -1,6 +1,6 @@
 """The one owner of how a converter model looks in a figure: colour, line style, marker and marker
 spacing per model, used by every figure that overlays the models (launch, replay, characterise,
-the launch's shape-effect sweep).
+drive, the launch's shape-effect sweep) and by the other lines of a figure (fit, design).
 
 Lines of the three models often lie on top of each other (the stall phase, after the coupling
 point), so they differ in line style and marker as well as in colour, and the colours are from the

@@ -76,30 +76,35 @@ def _launch_table(result: Launch) -> Table:
     return table
 
 
-def launch_report(result: Launch, out: Path) -> Group:
-    """A rich table of the launch summary (docs/launch_summary.md) and where the files are."""
+def launch_report(result: Launch, out: Path, ext: str = "csv") -> Group:
+    """A rich table of the launch summary (docs/launch_summary.md) and where the files are (tables
+    with the suffix ``ext``)."""
     lines = [
         "–: not reached or nothing to compare with; times are from the brake release",
         f"compute {result.compute_s * 1e3:.0f} ms for {len(result.runs)} models"
         + (f", sweep {result.sweep_compute_s * 1e3:.0f} ms" if result.sweep is not None else ""),
         rich_text(
-            f"written to {out}/: summary.csv, {', '.join(f'{m}.csv' for m in result.runs)}, timeseries.csv, "
-            f"events.csv, scenario.csv{', shape_sweep*.csv' if result.sweep is not None else ''} and plots"
+            f"written to {out}/: summary.{ext}, {', '.join(f'{m}.{ext}' for m in result.runs)}, timeseries.{ext}, "
+            f"events.{ext}, scenario.{ext}{f', shape_sweep*.{ext}' if result.sweep is not None else ''} and plots"
         ),
     ]
     return Group(_launch_table(result), *lines)
 
 
-def replay_report(replay: Replay, out: Path) -> Group:
-    """A short rich summary: per model the events and the turbine-torque RMSE, then where the files are."""
+def replay_report(replay: Replay, out: Path, ext: str = "csv") -> Group:
+    """A short rich summary: per model the events and the turbine-torque RMSE, then where the files
+    are (tables with the suffix ``ext``). Model names and numbers are never cut; the events wrap."""
     table = Table(
         title=rich_text(
             f"replay of {replay.measurement.source} on {replay.converter}, drive {replay.drive.name}, "
             f"{len(replay.measurement.time_s)} samples"
         )
     )
-    for col in ("model", "events", "turbine torque RMSE [N·m]", "NRMSE"):
-        table.add_column(col)
+    names = [str(name) for name in replay.results]
+    table.add_column("model", no_wrap=True, min_width=max(map(len, names), default=5))
+    table.add_column("events", overflow="fold")
+    table.add_column("turbine torque RMSE [N·m]", justify="right", min_width=9)
+    table.add_column("NRMSE [-]", justify="right", min_width=9)
     metrics = replay.metrics
     rows = metrics[(metrics["channel"] == "turbine_torque_nm") & (metrics["window"] == "all")]
     for name, result in replay.results.items():
@@ -110,19 +115,20 @@ def replay_report(replay: Replay, out: Path) -> Group:
     return Group(
         table,
         rich_text(
-            f"written to {out}/: {', '.join(f'{m}.csv' for m in replay.results)}, events.csv, "
-            f"measurement.csv{', metrics.csv' if len(metrics) else ''} and plots"
+            f"written to {out}/: {', '.join(f'{m}.{ext}' for m in replay.results)}, events.{ext}, "
+            f"measurement.{ext}{f', metrics.{ext}' if len(metrics) else ''} and plots"
         ),
     )
 
 
-def study_line(df: pd.DataFrame, definition: StudyDefinition, out: Path) -> str:
-    """The one line ``tcsim study`` prints (plain text: escape it with :func:`rich_text` for rich)."""
+def study_line(df: pd.DataFrame, definition: StudyDefinition, out: Path, ext: str = "csv") -> str:
+    """The one line ``tcsim study`` prints, the table with the suffix ``ext`` (plain text: escape it
+    with :func:`rich_text` for rich)."""
     n_values = df.groupby("parameter", sort=False)["parameter_value"].nunique().sum()
     solved = int(np.isfinite(df["torque_ratio"]).sum())
     free = int(df["stator_mode"].isin(["free-wheeling", "no-flow"]).sum())
     return (
         f"study: {len(definition.parameters)} parameters, {n_values} values, {len(df)} points "
-        f"({solved} with a steady state, {free} of them past the coupling point) written to {out}/study.csv "
+        f"({solved} with a steady state, {free} of them past the coupling point) written to {out}/study.{ext} "
         f"and {len(definition.parameters)} figures"
     )

@@ -45,7 +45,9 @@ def _drive_table(result: Drive) -> Table:
     return table
 
 
-def drive_report(result: Drive, out: Path) -> Group:
-    """A rich table of the drive's summary (docs/drive.md) and where the files are."""
-    files = ["summary.csv", *(f"{m}.csv" for m in result.runs), "events.csv", "cycle.csv", "speed.png", "losses.png"]
+def drive_report(result: Drive, out: Path, ext: str = "csv") -> Group:
+    """A rich table of the drive's summary (docs/drive.md) and where the files are (tables with the
+    suffix ``ext``)."""
+    tables = ["summary", *result.runs, "events", "cycle"]
+    files = [*(f"{name}.{ext}" for name in tables), "speed.png", "losses.png"]
     return Group(_drive_table(result), rich_text(f"written to {out}/: {', '.join(files)}"))
