@@ -19,7 +19,7 @@ element the blade angle varies linearly from the inlet angle to the exit angle.
 
 With these definitions the Cauchy–Schwarz inequality gives ``ρ² S_x² / I_x ≤ (ρ/A) ∫_x tan²α dl``
 for each element, so the mass matrix of eqs 2.12–2.15 is positive definite whenever each element's
-inertia includes the fluid it carries (physics notes §4). The literal reading has no such bound
+inertia includes the fluid it carries (docs/physics.md §4). The literal reading has no such bound
 (docs/design.md, "Mass-matrix bound").
 """
 

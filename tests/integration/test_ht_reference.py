@@ -1,7 +1,7 @@
 """Hrovat & Tobler steady states in every quadrant against a plain reference (issue 11).
 
 ``ht_reference.py`` was written by a second engineer without reading tcsim's core: the forward
-equations straight from the thesis (eqs 2.12–2.25), the reverse-flow form of physics notes §8 derived
+equations straight from the thesis (eqs 2.12–2.25), the reverse-flow form of docs/physics.md §8 derived
 again from the angular-momentum balance, and the steady states found by scanning the net head over
 both flow directions and refining every sign change (not the core's closed-form quadratics), with the
 one-way clutch rule: locked while the holding torque T_s ≥ 0, else free-wheeling with ω_s ≥ 0, else

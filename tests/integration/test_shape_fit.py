@@ -74,7 +74,7 @@ def test_fit_recovers_the_shape_effects(drive_a, model, truth, target):
 
 def test_fit_bounds_follow_the_mass_matrix(drive_a):
     """H&T defaults: ±0.98 · the admissible bound of each S with the other at 0 (≈ 0.061 m² for the
-    pump, physics notes §4); the quasi-dynamic model has no bound."""
+    pump, docs/physics.md §4); the quasi-dynamic model has no bound."""
     m = dynamic_model(CONVERTER, "hrovat-tobler")
     measured = simulate(m.with_shape_effects(0.03, 0.02), drive_a)
     r = fit_shape_effects(

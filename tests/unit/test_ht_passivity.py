@@ -1,7 +1,7 @@
 """Passivity of the Hrovat & Tobler steady state in every quadrant (issue 11; docs/models.md).
 
 At every steady state the converter absorbs power, ``T_p·ω_p + T_t·ω_t + T_s·ω_s ≥ 0`` with the
-external torques of physics notes §2 (the ``turbine_torque_nm`` column is the delivered torque
+external torques of docs/physics.md §2 (the ``turbine_torque_nm`` column is the delivered torque
 ``−T_t``), for every sign of the speeds and speed ratios up to ±5, and the one-way clutch is
 respected: locked means ``ω_s = 0`` and ``T_s ≥ 0``, free-wheeling ``ω_s ≥ 0`` and ``T_s = 0``.
 Random points (hypothesis, profile ``ci``) through the public steady API.

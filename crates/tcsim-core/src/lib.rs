@@ -2,7 +2,7 @@
 //!
 //! The core holds the models and their solvers and knows nothing of Python, so that the same code
 //! builds the Python extension (`tcsim-py`) and the FMU (`tcsim-fmu`). Units are SI throughout
-//! (rad/s, N·m, m, m², m³/s, kg, kg/m³, s; angles in radians); signs follow the tcsim physics notes
+//! (rad/s, N·m, m, m², m³/s, kg, kg/m³, s; angles in radians); signs follow the docs/physics.md
 //! §2. Errors in the user's input are [`CoreError`]s (the Python layer raises them as
 //! `CoreInputError`).
 //!

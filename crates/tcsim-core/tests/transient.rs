@@ -26,7 +26,7 @@ fn trapezoid(t: &[f64], y: &[f64]) -> f64 {
     (1..t.len()).map(|i| 0.5 * (y[i] + y[i - 1]) * (t[i] - t[i - 1])).sum()
 }
 
-/// Residual of the energy identity (physics notes §4) relative to the energy that passed through
+/// Residual of the energy identity (docs/physics.md §4) relative to the energy that passed through
 /// the converter: Δ stored − ∫(input power − loss power).
 fn energy_residual(cols: &[Vec<f64>]) -> (f64, f64) {
     let t = col(cols, "time_s");

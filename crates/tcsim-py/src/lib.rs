@@ -1304,7 +1304,7 @@ fn reference_pump_speed_rad_s() -> f64 {
     tcsim_core::units::REFERENCE_PUMP_SPEED_RAD_S
 }
 
-/// The Hrovat & Tobler mass-matrix admissibility bound on the shape effects (physics notes §4): `M`
+/// The Hrovat & Tobler mass-matrix admissibility bound on the shape effects (docs/physics.md §4): `M`
 /// is positive definite iff `ρL_f/A > Σ ρ²S_x²/I_x`. Arguments: `geometry` (row 0 of an (n, 15)
 /// array), `fluid_length_m` (m), `inertia_kg_m2` (pump, turbine, stator; kg·m²), `shape_effect_m2`
 /// (pump, turbine, stator; m²). Returns a dict: `density_kg_m3`, `inertance_kg_m4` (ρL_f/A),

@@ -10,12 +10,12 @@ match the drop in effective torque ratio during a take-off (§4.1, figures 4.1�
 * runs the thesis's sweep over S_p = S_t (:func:`shape_effect_sweep`), plotted like figures
   4.1/4.2 by :func:`tcsim.plots.shape_sweep.plot_shape_effect_sweep`.
 
-Sign convention (eqs 2.12–2.18, physics notes §4): the effective turbine output torque is
+Sign convention (eqs 2.12–2.18, docs/physics.md §4): the effective turbine output torque is
 ``T_transfer,t − ρS_t·Q̇`` and the effective pump input torque ``T_transfer,p + ρS_p·Q̇``, so a
 positive S deepens the drop in effective TR while the flow builds up (the thesis's chapter 4).
 
 The Hrovat & Tobler model accepts only shape effects that keep its mass matrix positive definite,
-``ρL_f/A > Σ ρ²S_x²/I_x`` (physics notes §4); the quasi-dynamic model has no such bound. See
+``ρL_f/A > Σ ρ²S_x²/I_x`` (docs/physics.md §4); the quasi-dynamic model has no such bound. See
 ``docs/shape_fit.md``.
 """
 
@@ -215,7 +215,7 @@ def _check_bounds(name: str, given, default: tuple[float, float], bound: float |
             name,
             f"{lo:g}:{hi:g}",
             f"bounds within the admissible ±{bound:.4g} m² of the Hrovat & Tobler model "
-            "(mass matrix positive definite, physics notes §4)",
+            "(mass matrix positive definite, docs/physics.md §4)",
         )
     return lo, hi
 

@@ -26,7 +26,7 @@ class CoreRules(TypedDict, total=False):
 CAPACITY_KEYS = tuple(_core.capacity_conventions())
 
 #: Stall torque at 2000 rpm outside this range (N·m) suggests a capacity read in the wrong
-#: convention (physics notes §1).
+#: convention (docs/physics.md §1).
 PLAUSIBLE_STALL_TORQUE_NM = (20.0, 2000.0)
 
 

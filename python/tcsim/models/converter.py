@@ -114,7 +114,7 @@ class GeometrySection(_Section):
 
 
 class QuasiDynamicSection(_Section):
-    """tcsim's quasi-dynamic model (physics notes §5, docs/transient.md). The density and pump
+    """tcsim's quasi-dynamic model (docs/physics.md §5, docs/transient.md). The density and pump
     radius set the Euler flow estimate; they default to the [geometry] values."""
 
     pump_shape_effect_m2: float = Field(allow_inf_nan=False)

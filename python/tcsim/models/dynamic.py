@@ -123,7 +123,7 @@ def default_flow_time_constant_s(conv: Converter) -> float:
     """Default τ_Q of the quasi-dynamic model, from the core
     (``tcsim._core.default_flow_time_constant_s``): the fluid's inertance over the slope of the net
     head with respect to the flow, ``τ_Q = (ρL_f/A) / |∂F_Q/∂Q|``, for the Hrovat & Tobler geometry
-    at stall (locked stator) and the reference pump speed (2000 rpm, physics notes §5). It scales as
+    at stall (locked stator) and the reference pump speed (2000 rpm, docs/physics.md §5). It scales as
     1/ω_p."""
     g = _require(conv, "geometry", "quasi-dynamic (default flow time constant)")
     try:

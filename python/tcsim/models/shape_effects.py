@@ -18,7 +18,7 @@ THESIS_PAIR_M2 = (0.4, 0.3)
 
 
 # ---------------------------------------------------------------------------------------------
-# the mass-matrix bound of the Hrovat & Tobler model (physics notes §4)
+# the mass-matrix bound of the Hrovat & Tobler model (docs/physics.md §4)
 
 
 @dataclass(frozen=True)
@@ -93,7 +93,7 @@ def inadmissible_note(bound: MassMatrixBound, pump_m2: float, turbine_m2: float)
     return (
         f"inadmissible for hrovat-tobler: ρ²S_p²/I_p + ρ²S_t²/I_t = {bound.load(pump_m2, turbine_m2):.6g} "
         f"must stay below ρL_f/A − ρ²S_s²/I_s = {bound.room:.6g} kg/m⁴ (mass matrix positive definite, "
-        f"physics notes §4); largest S_p = S_t is {bound.equal():.4g} m²"
+        f"docs/physics.md §4); largest S_p = S_t is {bound.equal():.4g} m²"
     )
 
 

@@ -4,7 +4,7 @@
 * :func:`characterise_hrovat_tobler`: the closed-form steady state of Hrovat & Tobler (1985),
   Li & Sundén (2016) eqs 2.12–2.25 with zero left-hand sides, one-way stator clutch included.
 * :func:`characterise_quasi_dynamic`: the quasi-dynamic model, whose steady state is its table
-  by construction (tcsim physics notes §5, property 2).
+  by construction (docs/physics.md §5, property 2).
 
 Each returns a :class:`pandas.DataFrame` with the columns of ``characteristic.csv``
 (``conventions.md``). Speeds are in rad/s in the core; ``pump_speed_rpm`` is for people.

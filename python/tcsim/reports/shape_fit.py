@@ -49,11 +49,11 @@ def report_markdown(
     """``shape_fit.md``: fitted values, RMSE against S = 0, bounds, and the sweep's minima."""
     gain = 100.0 * (1.0 - r.rmse / r.rmse_at_zero) if r.rmse_at_zero > 0 else math.nan
     bound = (
-        "none (the quasi-dynamic model has no mass-matrix bound, physics notes §5)"
+        "none (the quasi-dynamic model has no mass-matrix bound, docs/physics.md §5)"
         if r.bound_m2 is None
         else f"|S_p| < {r.bound_m2[0]:.4g} m², |S_t| < {r.bound_m2[1]:.4g} m² (each with the other at 0"
         + (", S_p = S_t" if r.equal else "")
-        + "; mass matrix positive definite, physics notes §4)"
+        + "; mass matrix positive definite, docs/physics.md §4)"
     )
     lines = [
         f"# Shape effects of {conv.name} ({r.model}) fitted to a transient measurement",

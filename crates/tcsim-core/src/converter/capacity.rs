@@ -2,7 +2,7 @@
 //!
 //! tcsim works internally with the capacity factor `CF = T_pump / ω_pump²` in
 //! N·m/(rad/s)² (`capacity_factor_nm_s2`). Tables arrive in six conventions
-//! (docs `conventions.md`, physics notes §1); each converts to and from CF exactly.
+//! (docs `conventions.md`, docs/physics.md §1); each converts to and from CF exactly.
 
 use crate::error::{CoreError, CoreResult};
 use crate::units::{NM_PER_LBF_FT, RPM_PER_RAD_S};

@@ -16,9 +16,9 @@
 //!
 //! * [`TableDynamics`]: the steady-state table with pump and turbine inertias, eqs 2.8–2.11.
 //! * [`HtDynamics`]: Hrovat & Tobler, eqs 2.12–2.25.
-//! * [`QuasiDynamics`](super::quasi_dynamic::QuasiDynamics): tcsim's quasi-dynamic model (tables plus fluid inertia), physics notes §5.
+//! * [`QuasiDynamics`](super::quasi_dynamic::QuasiDynamics): tcsim's quasi-dynamic model (tables plus fluid inertia), docs/physics.md §5.
 //!
-//! Sign conventions follow physics notes §2: `T_ext` holds the external torques on pump, turbine
+//! Sign conventions follow docs/physics.md §2: `T_ext` holds the external torques on pump, turbine
 //! and stator; the torque delivered to the transmission is `−T_ext[TURBINE]`.
 
 use super::hrovat_tobler::{steady_state, HtGeometry, HtParam};
@@ -60,7 +60,7 @@ pub trait ConverterDynamics: Sync {
         (-f[PUMP], f[TURBINE])
     }
     /// Power dissipated in the fluid given the forces `f = F(u)`: `−u·F`, which is `Q·P_loss`
-    /// (≥ 0) for Hrovat & Tobler (the flow terms cancel, physics notes §4) and the power the
+    /// (≥ 0) for Hrovat & Tobler (the flow terms cancel, docs/physics.md §4) and the power the
     /// table's torques absorb, `T_p,tr ω_p − T_t,tr ω_t`, for the table models.
     fn loss_power_w(&self, u: &Vec4, f: &Vec4) -> f64 {
         -(u[0] * f[0] + u[1] * f[1] + u[2] * f[2] + u[3] * f[3])
@@ -355,7 +355,7 @@ struct ReverseConst {
 }
 
 impl HtDynamics {
-    /// Check the parameters and the positive definiteness of the mass matrix (physics notes §4).
+    /// Check the parameters and the positive definiteness of the mass matrix (docs/physics.md §4).
     /// An inadmissible shape effect is refused with the largest admissible magnitude.
     pub fn new(
         geometry: HtGeometry<f64>,
@@ -420,7 +420,7 @@ impl HtDynamics {
             SHAPE_KEYS[i],
             self.shape_effect_m2[i],
             format!(
-                "|S| < {shown} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (physics notes §4)",
+                "|S| < {shown} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (docs/physics.md §4)",
                 sig(b.inertance_kg_m4),
                 sig(terms.iter().sum::<f64>())
             ),

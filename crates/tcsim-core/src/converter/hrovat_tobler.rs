@@ -2,7 +2,7 @@
 //!
 //! References: D. Hrovat and W. E. Tobler (1985), "Bond graph modelling and computer simulation
 //! of automotive torque converters", J. Franklin Inst. 319(1/2):93–114; Li & Sundén (2016)
-//! §2.2.2, eqs 2.12–2.25. Signs and units: tcsim physics notes §2 and §4.
+//! §2.2.2, eqs 2.12–2.25. Signs and units: docs/physics.md §2 and §4.
 //!
 //! With the left-hand sides of eqs 2.12–2.15 zero and Q > 0, the right-hand side of eq 2.15 is
 //! a quadratic in `q = Q/A`: the Euler head gives a constant and a linear term, the shock
@@ -21,7 +21,7 @@
 //!   steady state with a small positive flow. tcsim then reports Q = 0 and zero torques (the
 //!   Filippov solution of the sgn Q discontinuity), TR = 1 by continuity, and the stator speed,
 //!   which the equations leave undetermined at Q = 0, equal to the turbine speed. At SR = 1
-//!   this is physics notes §4's ω_s = ω_p, Q = 0.
+//!   this is docs/physics.md §4's ω_s = ω_p, Q = 0.
 //! * **Reverse flow** (Q < 0, docs/models.md "Reverse flow"): the fluid leaves each element across
 //!   its inlet edge; the same structure with the reverse geometry gives a quadratic in q for the
 //!   locked and the free-wheeling stator (`solve_reverse`).
@@ -366,7 +366,7 @@ pub fn steady_torque_ratio(stator_mode: i8, pump_torque_nm: f64, turbine_torque_
     }
 }
 
-/// A steady state of the Hrovat & Tobler model. Torques follow physics notes §2: the pump and
+/// A steady state of the Hrovat & Tobler model. Torques follow docs/physics.md §2: the pump and
 /// stator torques are the external torques on those elements, the turbine torque is the torque
 /// delivered to the transmission (−T_t).
 #[derive(Debug, Clone, Copy)]

@@ -7,7 +7,7 @@ use crate::error::{CoreError, CoreResult};
 use crate::interp;
 use crate::units::REFERENCE_PUMP_SPEED_RAD_S;
 
-/// tcsim's quasi-dynamic model: the steady-state tables plus fluid inertia (physics notes §5;
+/// tcsim's quasi-dynamic model: the steady-state tables plus fluid inertia (docs/physics.md §5;
 /// derivation in docs/models.md, "Quasi-dynamic model"). States ω_p, ω_t, Q:
 ///
 /// ```text

@@ -175,7 +175,7 @@ pub fn quasi_dynamic_model(spec: &dyn ModelSpec) -> CoreResult<QuasiDynamics> {
 /// The default flow time constant τ_Q of the quasi-dynamic model, s: the fluid's inertance over the
 /// slope of the net head with respect to the flow, `τ_Q = (ρL_f/A) / |∂F_Q/∂Q|`, for the Hrovat &
 /// Tobler `geometry` with fluid length `fluid_length_m` (m) at stall (locked stator, ω_t = 0) and
-/// the reference pump speed [`REFERENCE_PUMP_SPEED_RAD_S`] (2000 rpm), physics notes §5. It scales
+/// the reference pump speed [`REFERENCE_PUMP_SPEED_RAD_S`] (2000 rpm), docs/physics.md §5. It scales
 /// as 1/ω_p. The arithmetic is that of the Python copy it replaces (`tcsim.transient`), term for
 /// term: `L_f / |∂(eq 2.15 right-hand side / ρ)/∂q|` with `q = Q/A`.
 pub fn default_flow_time_constant_s(geometry: &HtGeometry<f64>, fluid_length_m: f64) -> CoreResult<f64> {

@@ -1,7 +1,7 @@
 //! Steady-state look-up-table model, Li & Sundén (2016) §2.2.1, eqs 2.8–2.11, in every quadrant.
 //!
 //! In drive `T_p = CF(SR)·ω_p·|ω_p|` and `T_del = TR(SR)·T_p` (torque delivered to the
-//! transmission), with ω in rad/s and CF in N·m/(rad/s)² (physics notes §1, §3).
+//! transmission), with ω in rad/s and CF in N·m/(rad/s)² (docs/physics.md §1, §3).
 //!
 //! **Interpolation** is piecewise linear in SR between the table's points, in the capacity factor
 //! (default) or in the K-factor `K = 1/√CF` ([`Interpolation`]).
@@ -146,7 +146,7 @@ pub struct TableTorques {
     pub extension: bool,
 }
 
-/// Steady-state torques of the table model at one operating point (physics notes §2 signs).
+/// Steady-state torques of the table model at one operating point (docs/physics.md §2 signs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TableOperatingPoint {
     pub speed_ratio: f64,
