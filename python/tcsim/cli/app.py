@@ -78,6 +78,17 @@ SpeedUnitOpt = Annotated[
     ),
 ]
 
+#: ``--plots/--no-plots`` of the commands that draw figures (issue 16: a start-up that fits the job).
+PlotsOpt = Annotated[
+    bool,
+    typer.Option("--plots/--no-plots", help="draw the figures (PNG); --no-plots writes the tables and files only"),
+]
+
+
+def and_plots(plots: bool) -> str:
+    """`` and plots`` when the command drew its figures, else nothing (for the written-to lines)."""
+    return " and plots" if plots else ""
+
 
 def table_format(file_format: str, speed_unit: str) -> TableFormat:
     """``--format`` and ``--speed-unit`` checked (an :class:`InputError` of the command line names

@@ -8,7 +8,17 @@ from typing import Annotated
 import typer
 
 from ..units import DEFAULT_PUMP_SPEED_RPM
-from .app import AllowImplausibleOpt, FormatOpt, ModelOpt, OutOpt, SpeedUnitOpt, say, table_format
+from .app import (
+    AllowImplausibleOpt,
+    FormatOpt,
+    ModelOpt,
+    OutOpt,
+    PlotsOpt,
+    SpeedUnitOpt,
+    and_plots,
+    say,
+    table_format,
+)
 
 
 def characterise(
@@ -37,6 +47,7 @@ def characterise(
     ] = None,
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    plots: PlotsOpt = True,
 ) -> None:
     """Steady-state sweep: DIR/characteristic.csv and plots of TR, CF, K-factor and efficiency."""
     from ..errors import InputError
@@ -72,16 +83,17 @@ def characterise(
     with output_dir(out, inputs) as stage:
         write_frames({"characteristic.csv": df}, stage, tf)
         table = conv.characteristic if model == "hrovat-tobler" else None
-        plot_characteristic(
-            {f"{model} model": df},
-            stage,
-            f"{conv.name}, pump at {rpm:g} rpm"
-            if input_torque_nm is None
-            else f"{conv.name}, input torque {input_torque_nm:g} N·m",
-            table=table,
-            coupling_point=cp,
-        )
-    msg = f"{model}: {len(df)} points written to {out}/{tf.file_name('characteristic.csv')} and plots"
+        if plots:
+            plot_characteristic(
+                {f"{model} model": df},
+                stage,
+                f"{conv.name}, pump at {rpm:g} rpm"
+                if input_torque_nm is None
+                else f"{conv.name}, input torque {input_torque_nm:g} N·m",
+                table=table,
+                coupling_point=cp,
+            )
+    msg = f"{model}: {len(df)} points written to {out}/{tf.file_name('characteristic.csv')}{and_plots(plots)}"
     if cp is not None:
         msg += f"; coupling point at SR {cp:.4f}"
     say(msg)

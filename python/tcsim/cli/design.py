@@ -21,7 +21,7 @@ from typing import Annotated
 
 import typer
 
-from .app import FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
+from .app import FormatOpt, OutOpt, PlotsOpt, SpeedUnitOpt, say, table_format
 
 #: The command's ``--help`` text.
 HELP = (
@@ -46,6 +46,7 @@ def design(
     ] = None,
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    plots: PlotsOpt = True,
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.design_report import design_report
@@ -68,9 +69,10 @@ def design(
         write_design_files(report, file.path, stage, tf)
         title = f"{file.name} against {report.reference.name}"
         curves = {f"{name} (hrovat-tobler)": df for name, df in report.characteristics.items()}
-        plot_characteristic(curves, stage, f"{title}, Hrovat & Tobler closed form")
-        plot_design_takeoff(report.takeoffs, stage, f"{title}: isolated take-off")
-        plot_design_launch(report.launches, stage, f"{title}: launch, Hrovat & Tobler")
+        if plots:
+            plot_characteristic(curves, stage, f"{title}, Hrovat & Tobler closed form")
+            plot_design_takeoff(report.takeoffs, stage, f"{title}: isolated take-off")
+            plot_design_launch(report.launches, stage, f"{title}: launch, Hrovat & Tobler")
         names = {p.name for p in Path(stage).iterdir()}
         (Path(stage) / "report.md").write_text(report_markdown(report, file, names), encoding="utf-8")
     g = report.derived.geometry

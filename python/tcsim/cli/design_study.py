@@ -16,7 +16,7 @@ from typing import Annotated
 
 import typer
 
-from .app import FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
+from .app import FormatOpt, OutOpt, PlotsOpt, SpeedUnitOpt, say, table_format
 
 #: The command's ``--help`` text.
 HELP = (
@@ -33,6 +33,7 @@ def design_study(
     out: OutOpt = Path("design-study"),
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    plots: PlotsOpt = True,
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.design_study import check_sweep, design_study, parse_sweep
@@ -55,7 +56,8 @@ def design_study(
     inputs = [design, file.path]
     with output_dir(out, inputs) as stage:
         write_table(study, stage, "study.csv", tf)
-        plot_design_pareto(study, stage, f"{file.name}: design study of {' × '.join(names)}")
+        if plots:
+            plot_design_pareto(study, stage, f"{file.name}: design study of {' × '.join(names)}")
     failed = int((study["error"] != "").sum())
     say(f"{file.name}: {len(study)} designs of {' × '.join(names)}, {failed} without figures, written to {out}")
     front = study[study["pareto_front"]]

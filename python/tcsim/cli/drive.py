@@ -28,7 +28,7 @@ from typing import Annotated
 
 import typer
 
-from .app import FormatOpt, ModelsOpt, OutOpt, SpeedUnitOpt, stdout, table_format
+from .app import FormatOpt, ModelsOpt, OutOpt, PlotsOpt, SpeedUnitOpt, stdout, table_format
 
 #: The command's ``--help`` text.
 HELP = (
@@ -52,6 +52,7 @@ def drive(
     out: OutOpt = Path("drive"),
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    plots: PlotsOpt = True,
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..analysis.drive import BUNDLED_CYCLES
@@ -75,5 +76,6 @@ def drive(
     inputs = [p for p in (vehicle, trace_file, veh.path, veh.converter.path) if p]
     with output_dir(out, inputs) as stage:
         write_drive_files(result, stage, tf)
-        plot_drive(result, stage)
-    stdout.print(drive_report(result, out, tf.format))
+        if plots:
+            plot_drive(result, stage)
+    stdout.print(drive_report(result, out, tf.format, plots))

@@ -8,13 +8,20 @@ from typing import Annotated
 
 import typer
 
-from .app import OutOpt, say
+from .app import OutOpt, PlotsOpt, and_plots, say
 
 
 def fit_command(
-    converter: str, target: str, out: Path, free: str | None, bounds: list[str], speed_ratio_max: float | None
+    converter: str,
+    target: str,
+    out: Path,
+    free: str | None,
+    bounds: list[str],
+    speed_ratio_max: float | None,
+    plots: bool = True,
 ) -> str:
-    """Fit ``converter``'s [geometry] to the table of ``target``; write ``out``; the line to print."""
+    """Fit ``converter``'s [geometry] to the table of ``target``; write ``out`` (the figures if
+    ``plots``); the line to print."""
     from ..analysis import fitting
     from ..errors import InputError, TcsimWarning
     from ..io.outputs import check_output_dir, output_dir
@@ -51,13 +58,14 @@ def fit_command(
             "start Hrovat & Tobler": fitting.model_curve(start),
         }
         title = f"Fit to {Path(table.source).name or table.source} (SR 0–{result.speed_ratio_max:g})"
-        plot_fit(curves, stage, title, table, result.speed_ratio_max, coupling_point(fitted))
+        if plots:
+            plot_fit(curves, stage, title, table, result.speed_ratio_max, coupling_point(fitted))
     kept = [p for p in outcome.provenance if p.startswith(("[inertia]", "[quasi_dynamic]"))]
     return "\n".join(
         [
             f"{result.one_line()}.",
             *kept,
-            f"Written to {out}/: fitted.toml, fit_report.md, fit_report.json and plots.",
+            f"Written to {out}/: fitted.toml, fit_report.md, fit_report.json{and_plots(plots)}.",
         ]
     )
 
@@ -75,6 +83,7 @@ def fit(
     speed_ratio_max: Annotated[
         float | None, typer.Option(help="fit SR from 0 up to this (default: the table's coupling point)")
     ] = None,
+    plots: PlotsOpt = True,
 ) -> None:
     """Fit Hrovat & Tobler parameters to a characteristic table: DIR/fitted.toml, report, plots."""
-    say(fit_command(converter, target, out, free, bound or [], speed_ratio_max))
+    say(fit_command(converter, target, out, free, bound or [], speed_ratio_max, plots))

@@ -67,7 +67,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
-from .app import AllowImplausibleOpt, FormatOpt, ModelsOpt, OutOpt, SpeedUnitOpt, stdout, table_format
+from .app import AllowImplausibleOpt, FormatOpt, ModelsOpt, OutOpt, PlotsOpt, SpeedUnitOpt, stdout, table_format
 
 if TYPE_CHECKING:
     from ..analysis.launch import Launch
@@ -112,15 +112,17 @@ def launch_files(
         )
 
 
-def write_launch(result: Launch, out_dir: Path, tf: TableFormat | None = None) -> list[Path]:
-    """The tables (``tf``: format and speed unit, default CSV in rad/s) and figures of a launch into
-    ``out_dir`` (a staging directory)."""
+def write_launch(result: Launch, out_dir: Path, tf: TableFormat | None = None, plots: bool = True) -> list[Path]:
+    """The tables (``tf``: format and speed unit, default CSV in rad/s) and, if ``plots``, the figures
+    of a launch into ``out_dir`` (a staging directory)."""
     from ..io.results import write_launch_files
     from ..io.tables import CSV
     from ..plots.launch import plot_launch, plot_sweep
 
     out_dir = Path(out_dir)
     paths = write_launch_files(result, out_dir, tf or CSV)
+    if not plots:
+        return paths
     first_events = next(iter(result.runs.values())).events if result.runs else []
     release = result.scenario.brake_release_time_s
     paths += plot_launch(result.frames, first_events, release, result.scenario.name, out_dir, result.summary)
@@ -148,6 +150,7 @@ def launch(
     allow_implausible: AllowImplausibleOpt = False,
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    plots: PlotsOpt = True,
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..io.outputs import check_output_dir, output_dir
@@ -161,6 +164,6 @@ def launch(
     )
     inputs = [p for p in (vehicle, scenario, result.vehicle.path, result.vehicle.converter.path) if p]
     with output_dir(out, inputs) as stage, progress_display(True) as display:
-        display.add_task(rich_text(f"writing {out}/ (files and plots)"), total=None)
-        write_launch(result, stage, tf)
-    stdout.print(launch_report(result, Path(out), tf.format))
+        display.add_task(rich_text(f"writing {out}/ (files{' and plots' if plots else ''})"), total=None)
+        write_launch(result, stage, tf, plots)
+    stdout.print(launch_report(result, Path(out), tf.format, plots))

@@ -18,6 +18,7 @@ from .app import (
     FormatOpt,
     ModelsOpt,
     OutOpt,
+    PlotsOpt,
     SpeedUnitOpt,
     stdout,
     table_format,
@@ -67,9 +68,9 @@ def replay_files(
     return replay_measurement(conv, meas, models, kind, initial, window_s, metrics_window_s)
 
 
-def write_replay(replay: Replay, out_dir: Path, tf: TableFormat | None = None) -> list[Path]:
-    """The tables (``tf``: format and speed unit, default CSV in rad/s) and figures of a replay into
-    ``out_dir`` (a staging directory)."""
+def write_replay(replay: Replay, out_dir: Path, tf: TableFormat | None = None, plots: bool = True) -> list[Path]:
+    """The tables (``tf``: format and speed unit, default CSV in rad/s) and, if ``plots``, the figures
+    of a replay into ``out_dir`` (a staging directory)."""
     from ..io.results import write_replay_files
     from ..io.tables import CSV
     from ..plots.replay import plot_replay
@@ -79,6 +80,8 @@ def write_replay(replay: Replay, out_dir: Path, tf: TableFormat | None = None) -
     runs = {name: result.columns for name, result in replay.results.items()}
     title = f"Inputs (drive {replay.drive.name}): {Path(meas.source).name}"
     paths = write_replay_files(replay, Path(out_dir), tf or CSV)
+    if not plots:
+        return paths
     return paths + plot_replay(
         meas.time_s, measured, runs, replay.drive.inputs, replay.drive.outputs, title, Path(out_dir)
     )
@@ -115,6 +118,7 @@ def replay(
     allow_implausible: AllowImplausibleOpt = False,
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    plots: PlotsOpt = True,
 ) -> None:
     """Isolated converter driven by measured signals: DIR/<model>.csv, events, metrics, plots."""
     from ..analysis.replay import parse_initial
@@ -137,5 +141,5 @@ def replay(
     )
     inputs = [converter, measurement, result.measurement.source]
     with output_dir(out, inputs) as stage:
-        write_replay(result, stage, tf)
-    stdout.print(replay_report(result, Path(out), tf.format))
+        write_replay(result, stage, tf, plots)
+    stdout.print(replay_report(result, Path(out), tf.format, plots))

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from .app import AllowImplausibleOpt, FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
+from .app import AllowImplausibleOpt, FormatOpt, OutOpt, PlotsOpt, SpeedUnitOpt, say, table_format
 
 if TYPE_CHECKING:
     from ..analysis.torque_estimate import TorqueComparison, TorqueSignal
@@ -71,8 +71,10 @@ def torque_estimate_files(
     return compare_torques(est, meas, max_delay_s)
 
 
-def write_torque_estimate(comparison: TorqueComparison, out_dir: Path, tf: TableFormat | None = None) -> list[Path]:
-    """The tables (``tf``: format and speed unit, default CSV in rad/s) and figures of a comparison
+def write_torque_estimate(
+    comparison: TorqueComparison, out_dir: Path, tf: TableFormat | None = None, plots: bool = True
+) -> list[Path]:
+    """The tables (``tf``: format and speed unit, default CSV in rad/s) and (if ``plots``) figures of a comparison
     into ``out_dir`` (a staging directory). The aligned columns are empty where the shifted time lies
     outside the estimate's record, by design (so without the warning of
     :func:`tcsim.io.results.write_frames` of NaN in a result)."""
@@ -86,7 +88,7 @@ def write_torque_estimate(comparison: TorqueComparison, out_dir: Path, tf: Table
         "timeseries.csv": comparison.timeseries(),
     }
     paths = write_frames(files, Path(out_dir), tf or CSV, warn=False)
-    return paths + plot_torque_estimate(comparison, Path(out_dir))
+    return paths + plot_torque_estimate(comparison, Path(out_dir)) if plots else paths
 
 
 def report_lines(comparison: TorqueComparison) -> list[str]:
@@ -129,6 +131,7 @@ def torque_estimate(
     out: OutOpt = Path("torque-estimate"),
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    plots: PlotsOpt = True,
 ) -> None:
     """The command; its help is :data:`HELP`."""
     from ..io.outputs import check_output_dir, output_dir
@@ -137,7 +140,7 @@ def torque_estimate(
     check_output_dir(out, [estimate, dyno])
     result = torque_estimate_files(estimate, dyno, estimate_column, measured_column, max_delay, allow_implausible)
     with output_dir(out, [estimate, dyno]) as stage:
-        write_torque_estimate(result, stage, tf)
+        write_torque_estimate(result, stage, tf, plots)
     for line in report_lines(result):
         say(line)
     say(f"written to {out}/")

@@ -76,22 +76,23 @@ def _launch_table(result: Launch) -> Table:
     return table
 
 
-def launch_report(result: Launch, out: Path, ext: str = "csv") -> Group:
+def launch_report(result: Launch, out: Path, ext: str = "csv", plots: bool = True) -> Group:
     """A rich table of the launch summary (docs/launch_summary.md) and where the files are (tables
-    with the suffix ``ext``)."""
+    with the suffix ``ext``; and plots if ``plots``)."""
     lines = [
         "–: not reached or nothing to compare with; times are from the brake release",
         f"compute {result.compute_s * 1e3:.0f} ms for {len(result.runs)} models"
         + (f", sweep {result.sweep_compute_s * 1e3:.0f} ms" if result.sweep is not None else ""),
         rich_text(
             f"written to {out}/: summary.{ext}, {', '.join(f'{m}.{ext}' for m in result.runs)}, timeseries.{ext}, "
-            f"events.{ext}, scenario.{ext}{f', shape_sweep*.{ext}' if result.sweep is not None else ''} and plots"
+            f"events.{ext}, scenario.{ext}{f', shape_sweep*.{ext}' if result.sweep is not None else ''}"
+            + (" and plots" if plots else "")
         ),
     ]
     return Group(_launch_table(result), *lines)
 
 
-def replay_report(replay: Replay, out: Path, ext: str = "csv") -> Group:
+def replay_report(replay: Replay, out: Path, ext: str = "csv", plots: bool = True) -> Group:
     """A short rich summary: per model the events and the turbine-torque RMSE, then where the files
     are (tables with the suffix ``ext``). Model names and numbers are never cut; the events wrap."""
     table = Table(
@@ -116,7 +117,7 @@ def replay_report(replay: Replay, out: Path, ext: str = "csv") -> Group:
         table,
         rich_text(
             f"written to {out}/: {', '.join(f'{m}.{ext}' for m in replay.results)}, events.{ext}, "
-            f"measurement.{ext}{f', metrics.{ext}' if len(metrics) else ''} and plots"
+            f"measurement.{ext}{f', metrics.{ext}' if len(metrics) else ''}" + (" and plots" if plots else "")
         ),
     )
 

@@ -45,9 +45,9 @@ def _drive_table(result: Drive) -> Table:
     return table
 
 
-def drive_report(result: Drive, out: Path, ext: str = "csv") -> Group:
+def drive_report(result: Drive, out: Path, ext: str = "csv", plots: bool = True) -> Group:
     """A rich table of the drive's summary (docs/drive.md) and where the files are (tables with the
-    suffix ``ext``)."""
+    suffix ``ext``; the figures if ``plots``)."""
     tables = ["summary", *result.runs, "events", "cycle"]
-    files = [*(f"{name}.{ext}" for name in tables), "speed.png", "losses.png"]
+    files = [*(f"{name}.{ext}" for name in tables), *(("speed.png", "losses.png") if plots else ())]
     return Group(_drive_table(result), rich_text(f"written to {out}/: {', '.join(files)}"))
