@@ -25,7 +25,6 @@ converters. The summary gives, per converter (:data:`SUMMARY_COLUMNS`):
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 
@@ -38,11 +37,13 @@ from ..models.drives import isolated_takeoff
 from ..models.dynamic import dynamic_model
 from ..models.steady import characterise, coupling_point
 from ..models.vehicle import Vehicle, load_vehicle
+from ..simulation.launch import LAUNCH_COLUMNS as RUN_LAUNCH_COLUMNS
 from ..simulation.launch import LaunchRun, launch_columns, run_launch
 from ..simulation.scenarios import SPEED_50_KM_H_M_S, Scenario, flip_flop
 from ..simulation.transient import simulate
 from ..units import DEFAULT_PUMP_SPEED_RPM
 from .launch import FIRST_WINDOW_S, time_to_speed, window_mean
+from .launch_metrics import time_back_in_band
 
 #: The reference converter by default.
 DEFAULT_REFERENCE = "li-sunden-2016"
@@ -54,16 +55,8 @@ TAKEOFF_COLUMNS = ("time_s", "speed_ratio", "effective_torque_ratio", "turbine_s
 TAKEOFF_RECOVERY_BAND = 0.01
 #: The launch: brake held this long, s; the run's longest span after the release, s; output step, s.
 LAUNCH_HOLD_S, LAUNCH_SPAN_S, LAUNCH_STEP_S = 1.0, 10.0, 0.01
-#: The launch columns the figures read (and ``launch.csv`` keeps).
-LAUNCH_COLUMNS = (
-    "time_s",
-    "vehicle_speed_m_s",
-    "vehicle_accel_m_s2",
-    "pump_speed_rad_s",
-    "turbine_speed_rad_s",
-    "speed_ratio",
-    "effective_torque_ratio",
-)
+#: The launch columns the figures read and ``launch.csv`` keeps: every launch run's columns.
+LAUNCH_COLUMNS = RUN_LAUNCH_COLUMNS
 #: The columns of the summary, one row per converter.
 SUMMARY_COLUMNS = (
     "converter",
@@ -103,20 +96,6 @@ def takeoff_frame(conv: Converter) -> pd.DataFrame:
     return simulate(conv, isolated_takeoff(), model="hrovat-tobler", times_s=times).frame()
 
 
-def recovery_after(time_s: np.ndarray, gap: np.ndarray, start_s: float, band: float) -> float:
-    """Time from ``start_s`` until ``|gap|`` stays within ``band`` to the last sample (the crossing
-    interpolated linearly), s; 0 if it never leaves the band, NaN if it is outside at the end."""
-    out = np.flatnonzero(~(np.abs(gap) <= band))  # NaN counts as outside
-    if not out.size:
-        return 0.0
-    k = int(out[-1])
-    if k == len(gap) - 1:
-        return math.nan
-    g0, g1 = abs(gap[k]), abs(gap[k + 1])
-    frac = (g0 - band) / (g0 - g1) if g0 > g1 else 1.0
-    return float(time_s[k] + frac * (time_s[k + 1] - time_s[k]) - start_s)
-
-
 def _gap(run: Mapping[str, np.ndarray], steady_sr: np.ndarray, steady_tr: np.ndarray) -> np.ndarray:
     """The converter's steady-state TR at the run's speed ratio less the run's effective TR."""
     sr = np.asarray(run["speed_ratio"], dtype=float)
@@ -138,7 +117,7 @@ def takeoff_figures(
         "takeoff_effective_tr_dip": float(gap[k]),
         "takeoff_effective_tr_dip_time_s": float(t[after][k]),
         "takeoff_turbine_speed_1s_rad_s": float(np.interp(RAMP_START_S + 1.0, t, takeoff["turbine_speed_rad_s"])),
-        "takeoff_effective_tr_recovery_time_s": recovery_after(t[after], gap, RAMP_START_S, TAKEOFF_RECOVERY_BAND),
+        "takeoff_effective_tr_recovery_time_s": time_back_in_band(t[after], gap, TAKEOFF_RECOVERY_BAND, RAMP_START_S),
     }
 
 

@@ -149,15 +149,22 @@ def recovery_time(time_s, etr, ref_time_s, ref_etr, release_s: float, phase_end_
     tw, delta = tw[:-1], delta[:-1]  # samples before the phase's end (the next shift's first)
     if len(tw) < 2:
         return math.nan
-    out = np.flatnonzero(~(np.abs(delta) <= RECOVERY_BAND))  # NaN counts as outside
+    return time_back_in_band(tw, delta, RECOVERY_BAND, release_s)
+
+
+def time_back_in_band(time_s: np.ndarray, gap: np.ndarray, band: float, start_s: float) -> float:
+    """Time from ``start_s`` until ``|gap|`` stays within ``band`` to the last sample, the crossing
+    interpolated linearly, s; 0 if it never leaves the band, NaN if it is outside at the last sample
+    (a NaN gap counts as outside)."""
+    out = np.flatnonzero(~(np.abs(gap) <= band))
     if not out.size:
         return 0.0
     k = int(out[-1])
-    if k == len(tw) - 1:
+    if k == len(gap) - 1:
         return math.nan
-    d0, d1 = abs(delta[k]), abs(delta[k + 1])
-    frac = (d0 - RECOVERY_BAND) / (d0 - d1) if math.isfinite(d0) and d0 > d1 else 1.0
-    return float(tw[k] + frac * (tw[k + 1] - tw[k]) - release_s)
+    d0, d1 = abs(gap[k]), abs(gap[k + 1])
+    frac = (d0 - band) / (d0 - d1) if math.isfinite(d0) and d0 > d1 else 1.0
+    return float(time_s[k] + frac * (time_s[k + 1] - time_s[k]) - start_s)
 
 
 def deficit_series(time_s, etr, ref_time_s, ref_etr) -> np.ndarray:
