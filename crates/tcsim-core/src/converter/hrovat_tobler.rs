@@ -1105,6 +1105,101 @@ mod tests {
         assert!(largest_real_root(Quad { c: [1.0, 0.0, 1.0] }).is_none());
     }
 
+    /// A scalar that counts the tangents taken (issue 16: the steady state took the six blade-angle
+    /// tangents 2–4 times per point, 54 % of its time).
+    #[derive(Debug, Clone, Copy)]
+    struct Counted(f64);
+
+    thread_local! {
+        static TANGENTS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    }
+
+    impl std::ops::Add for Counted {
+        type Output = Self;
+        fn add(self, o: Self) -> Self {
+            Self(self.0 + o.0)
+        }
+    }
+    impl std::ops::Sub for Counted {
+        type Output = Self;
+        fn sub(self, o: Self) -> Self {
+            Self(self.0 - o.0)
+        }
+    }
+    impl std::ops::Mul for Counted {
+        type Output = Self;
+        fn mul(self, o: Self) -> Self {
+            Self(self.0 * o.0)
+        }
+    }
+    impl std::ops::Div for Counted {
+        type Output = Self;
+        fn div(self, o: Self) -> Self {
+            Self(self.0 / o.0)
+        }
+    }
+    impl std::ops::Neg for Counted {
+        type Output = Self;
+        fn neg(self) -> Self {
+            Self(-self.0)
+        }
+    }
+    impl Scalar for Counted {
+        fn cst(v: f64) -> Self {
+            Self(v)
+        }
+        fn re(self) -> f64 {
+            self.0
+        }
+        fn sqrt(self) -> Self {
+            Self(self.0.sqrt())
+        }
+        fn tan(self) -> Self {
+            TANGENTS.with(|c| c.set(c.get() + 1));
+            Self(self.0.tan())
+        }
+    }
+
+    /// One steady state takes the six tangents once, and a geometry's constants serve any number
+    /// of points without another: the same numbers, bit for bit, as the plain `f64` path.
+    #[test]
+    fn a_steady_state_takes_the_six_tangents_once_per_geometry() {
+        let g = HtGeometry::appendix_d();
+        let counted = HtGeometry { values: g.values.map(Counted) };
+        let taken = || TANGENTS.with(|c| c.get());
+        let before = taken();
+        steady_state(&counted, Counted(WP), Counted(0.5 * WP)).unwrap();
+        assert_eq!(taken() - before, 6, "tangents of one steady state");
+        let k = HtConstants::new(&counted);
+        let before = taken();
+        for wp in [-WP, 0.0, WP] {
+            for sr in [-3.0, -0.5, 0.0, 0.5, 0.95, 0.995, 1.0, 1.02, 1.2, 3.0] {
+                let s = steady_state_with(&k, Counted(wp), Counted(sr * WP)).unwrap();
+                let f = steady_state(&g, wp, sr * WP).unwrap();
+                let bits = |v: [f64; 5]| v.map(f64::to_bits);
+                assert_eq!(
+                    bits([
+                        s.flow_m3_s.0,
+                        s.stator_speed_rad_s.0,
+                        s.pump_torque_nm.0,
+                        s.turbine_torque_nm.0,
+                        s.stator_torque_nm.0
+                    ]),
+                    bits([
+                        f.flow_m3_s,
+                        f.stator_speed_rad_s,
+                        f.pump_torque_nm,
+                        f.turbine_torque_nm,
+                        f.stator_torque_nm
+                    ]),
+                    "{wp} {sr}"
+                );
+                assert_eq!(s.mode, f.mode);
+            }
+        }
+        assert_eq!(taken(), before, "tangents of 30 steady states from the constants");
+    }
+
     #[test]
     fn steady_mode_codes_names_and_the_no_flow_torque_ratio() {
         assert_eq!(
