@@ -724,11 +724,12 @@ pub fn try_steady_state<T: Scalar>(
     if !wt.re().is_finite() {
         return Err(SteadyFailure::TurbineSpeed);
     }
-    // the locked balances in both directions: their constant terms are F_Q(0±) with the stator at
-    // rest, which decide the direction, and they are the locked states' own balances
+    // the locked balances: their constant terms are F_Q(0±) with the stator at rest, which decide
+    // the direction; the forward one is the drive state's own balance (the reverse one is built
+    // again where it is needed, so that only its constant term is computed here once inlined)
     let zero = Quad::cst(T::cst(0.0));
-    let (fw_locked, bw_locked) = (balance(k, wp, wt, zero), reverse_balance(k, wp, wt, zero));
-    let (forward, reverse) = (fw_locked.residual.c[0].re(), bw_locked.residual.c[0].re());
+    let fw_locked = balance(k, wp, wt, zero);
+    let (forward, reverse) = (fw_locked.residual.c[0].re(), reverse_balance(k, wp, wt, zero).residual.c[0].re());
     if !(forward.is_finite() && reverse.is_finite()) {
         return Err(SteadyFailure::Overflow);
     }
@@ -738,11 +739,15 @@ pub fn try_steady_state<T: Scalar>(
     }
     let solve = |sign: i8, mode: StatorMode| match (sign > 0, mode) {
         (true, StatorMode::Locked) => forward_state(k, wp, wt, mode, fw_locked),
-        (false, StatorMode::Locked) => reverse_state(k, wp, wt, mode, bw_locked),
         (true, _) => solve_mode(k, wp, wt, mode),
         (false, _) => reverse_state(k, wp, wt, mode, reverse_balance(k, wp, wt, stator_speed(k, wp, wt, mode, true))),
     };
-    let locked = solve(direction, StatorMode::Locked).ok_or(SteadyFailure::Overflow)?;
+    let locked = if direction > 0 {
+        forward_state(k, wp, wt, StatorMode::Locked, fw_locked)
+    } else {
+        reverse_state(k, wp, wt, StatorMode::Locked, reverse_balance(k, wp, wt, zero))
+    };
+    let locked = locked.ok_or(SteadyFailure::Overflow)?;
     let first = with_clutch(locked, || solve(direction, StatorMode::FreeWheeling), wt)?;
     // where the direction the flow starts in has no flowing steady state, the other direction's is
     // taken if it has one: the free-wheeling stator spins up while the flow dies away and the flow
