@@ -243,9 +243,6 @@ impl<T: Scalar> Quad<T> {
     fn affine(c0: T, c1: T) -> Self {
         Self { c: [c0, c1, T::cst(0.0)] }
     }
-    fn times(self, k: T) -> Self {
-        Self { c: self.c.map(|x| x * k) }
-    }
     fn eval(self, q: T) -> T {
         self.c[0] + q * (self.c[1] + q * self.c[2])
     }
@@ -378,11 +375,11 @@ pub struct HtConstants<T> {
     /// angles (reverse friction).
     friction: T,
     reverse_friction: T,
-    /// The free-wheeling stator's speed `ω_s = k₀ ω + k₁ x`: forwards `ω = ω_t`, `x = q`
-    /// (`k₀ = R_t²/R_s²`, `k₁ = (R_t tan α_t − R_s tan α_s)/R_s²`); backwards `ω = ω_p`, `x = −q`
-    /// (`k₀ = R_s²/R_t²`, `k₁ = (R_t tan α_ss − R_s tan α_pp)/R_t²`).
-    free: [T; 2],
-    reverse_free: [T; 2],
+    /// The slope `k₁` of the free-wheeling stator's speed `ω_s = ω R²/R'² + k₁ x`: forwards
+    /// (`ω = ω_t`, `x = q`) `k₁ = (R_t tan α_t − R_s tan α_s)/R_s²`; backwards (`ω = ω_p`, `x = −q`)
+    /// `k₁ = (R_t tan α_ss − R_s tan α_pp)/R_t²`.
+    free: T,
+    reverse_free: T,
 }
 
 impl<T: Scalar> HtConstants<T> {
@@ -409,8 +406,8 @@ impl<T: Scalar> HtConstants<T> {
             reverse_shock_slope: [ttt - tp, tss - tt, tpp - ts],
             friction: f * (one + tp * tp + one + tt * tt + one + ts * ts),
             reverse_friction: f * (one + tpp * tpp + one + ttt * ttt + one + tss * tss),
-            free: [r2[1] / r2[2], (rt * tt - rs * ts) / r2[2]],
-            reverse_free: [r2[2] / r2[1], (rt * tss - rs * tpp) / r2[1]],
+            free: (rt * tt - rs * ts) / r2[2],
+            reverse_free: (rt * tss - rs * tpp) / r2[1],
         }
     }
 }
@@ -442,42 +439,44 @@ fn balance<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, stator_speed: Quad<T>) -
     let [rp, rt, rs] = k.r;
     let [rp2, rt2, rs2] = k.r2;
     let [mp, mt, ms] = k.exit_swirl;
-    // ω_s = a + b q
+    // ω_s = a + b q. The coefficients are the products of the affine factors written out, in the
+    // order of the polynomial arithmetic they replace, so that they are the same to the last bit.
     let [a, b, _] = stator_speed.c;
-    // Euler head, eq 2.15 first three lines: the ω_s-free terms, then R_s²ω_s² − (R_s²ω_p + R_t²ω_t) ω_s
+    // Euler head, eq 2.15 first three lines: the ω_s-free terms, + R_s²ω_s² − (R_s²ω_p + R_t²ω_t) ω_s,
+    // + q [ω_p(R_p tan α_p − R_s tan α_s) + ω_t(R_t tan α_t − R_p tan α_p) + ω_s(R_s tan α_s − R_t tan α_t)]
     let cross = rs2 * wp + rt2 * wt;
-    let mut c0 = rp2 * wp * wp + rt2 * wt * wt - rp2 * wt * wp + rs2 * a * a - cross * a;
-    let mut c1 = (rs2 * a + rs2 * a - cross) * b;
-    let mut c2 = rs2 * b * b;
-    // q [ω_p(R_p tan α_p − R_s tan α_s) + ω_t(R_t tan α_t − R_p tan α_p) + ω_s(R_s tan α_s − R_t tan α_t)]
     let (e, f) = (wp * (mp - ms) + wt * (mt - mp), ms - mt);
-    c1 = c1 + e + f * a;
-    c2 = c2 + f * b;
-    // shock velocities, eqs 2.20–2.22, as u + v q: ½ C_sh (u + v q)² each
+    let head = [
+        rp2 * wp * wp + rt2 * wt * wt - rp2 * wt * wp + a * a * rs2 - a * cross,
+        (a * b + b * a) * rs2 - b * cross + (e + a * f),
+        b * b * rs2 + b * f,
+    ];
+    // shock velocities, eqs 2.20–2.22, as u + v q: Σ C_sh (u + v q)²
     let [bp, bt, bs] = k.shock_slope;
-    let shocks = [(rs * (a - wp), rs * b + bp), (rp * (wp - wt), bt), (rt * (wt - a), bs - rt * b)];
+    let shocks = [((a - wp) * rs, b * rs + bp), ((wp - wt) * rp, bt), ((wt - a) * rt, bs - b * rt)];
+    let squares = |x: usize| {
+        let (u, v) = shocks[x];
+        [u * u * k.shock[x], (u * v + v * u) * k.shock[x], v * v * k.shock[x]]
+    };
+    let (sp, st, ss) = (squares(0), squares(1), squares(2));
+    let shock: [T; 3] = std::array::from_fn(|i| sp[i] + st[i] + ss[i]);
+    // friction, eqs 2.19 and 2.23–2.25: Σ|V_re,x|² = q² Σ(1 + tan²α_x); the loss is halved
     let half = T::cst(0.5);
-    for (x, (u, v)) in shocks.into_iter().enumerate() {
-        let hc = half * k.shock[x];
-        c0 = c0 - hc * u * u;
-        c1 = c1 - (hc * u * v + hc * u * v);
-        c2 = c2 - hc * v * v;
-    }
-    // friction, eqs 2.19 and 2.23–2.25: Σ|V_re,x|² = q² Σ(1 + tan²α_x)
-    c2 = c2 - half * k.friction;
-    Balance { residual: Quad { c: [c0, c1, c2] }.times(k.rho), stator_speed }
+    let loss = [shock[0] * half, shock[1] * half, (shock[2] + k.friction) * half];
+    let residual = Quad { c: std::array::from_fn(|i| (head[i] - loss[i]) * k.rho) };
+    Balance { residual, stator_speed }
 }
 
 /// Torques of eqs 2.12–2.14 with zero left-hand sides, at flow `q = Q/A`.
 #[inline]
 fn torques<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, ws: T, q: T) -> (T, T, T) {
-    let [rp2, rt2, rs2] = k.r2;
+    let [rp, rt, rs] = k.r;
     let [mp, mt, ms] = k.exit_swirl;
     let flow = q * k.area;
     // angular momentum leaving each element per unit mass flow
-    let hp = wp * rp2 + mp * q;
-    let ht = wt * rt2 + mt * q;
-    let hs = ws * rs2 + ms * q;
+    let hp = wp * rp * rp + mp * q;
+    let ht = wt * rt * rt + mt * q;
+    let hs = ws * rs * rs + ms * q;
     let pump = k.rho * (hp - hs) * flow;
     let turbine_external = k.rho * (ht - hp) * flow;
     let stator = k.rho * (hs - ht) * flow;
@@ -489,10 +488,10 @@ fn torques<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, ws: T, q: T) -> (T, T, T
 fn stator_speed<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, mode: StatorMode, reverse: bool) -> Quad<T> {
     match (mode, reverse) {
         (StatorMode::Locked, _) => Quad::cst(T::cst(0.0)),
-        (_, false) => Quad::affine(wt * k.free[0], k.free[1]),
+        (_, false) => Quad::affine(wt * k.r[1] * k.r[1] / k.r2[2], k.free),
         // T_s = 0: the stator passes on the angular momentum it receives from the pump,
         // ω_s R_t² + R_t tan α_ss q = ω_p R_s² + R_s tan α_pp q, with q = −p
-        (_, true) => Quad::affine(wp * k.reverse_free[0], k.reverse_free[1]),
+        (_, true) => Quad::affine(wp * k.r[2] * k.r[2] / k.r2[1], k.reverse_free),
     }
 }
 
@@ -578,21 +577,25 @@ fn reverse_balance<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, stator_speed: Qu
     let (ht0, ht1) = (wt * rp2, -it);
     let (hs0, hs1) = (a * rt2, b * rt2 - is);
     // head = ω_p (h_t − h_p) + ω_t (h_s − h_t) + ω_s (h_p − h_s)
-    let mut c0 = wp * (ht0 - hp0) + wt * (hs0 - ht0) + a * (hp0 - hs0);
-    let mut c1 = wp * (ht1 - hp1) + wt * (hs1 - ht1) + a * (hp1 - hs1) + b * (hp0 - hs0);
-    let mut c2 = b * (hp1 - hs1);
+    // (in the order of the polynomial arithmetic they replace, so that they are the same to the bit)
+    let head = [
+        wp * (ht0 - hp0) + wt * (hs0 - ht0) + a * (hp0 - hs0),
+        wp * (ht1 - hp1) + wt * (hs1 - ht1) + (a * (hp1 - hs1) + b * (hp0 - hs0)),
+        b * (hp1 - hs1),
+    ];
     // shock at the entry of each element, from its source (pump ← turbine ← stator ← pump), u + v p
     let [bp, bt, bs] = k.reverse_shock_slope;
-    let shocks = [(rp * (wt - wp), -bp), (rt * (a - wt), rt * b - bt), (rs * (wp - a), -(rs * b) - bs)];
+    let shocks = [((wt - wp) * rp, -bp), ((a - wt) * rt, b * rt - bt), ((wp - a) * rs, -b * rs - bs)];
+    let squares = |x: usize| {
+        let (u, v) = shocks[x];
+        [u * u * k.shock[x], (u * v + v * u) * k.shock[x], v * v * k.shock[x]]
+    };
+    let (sp, st, ss) = (squares(0), squares(1), squares(2));
+    let shock: [T; 3] = std::array::from_fn(|i| sp[i] + st[i] + ss[i]);
     let half = T::cst(0.5);
-    for (x, (u, v)) in shocks.into_iter().enumerate() {
-        let hc = half * k.shock[x];
-        c0 = c0 + hc * u * u;
-        c1 = c1 + (hc * u * v + hc * u * v);
-        c2 = c2 + hc * v * v;
-    }
-    c2 = c2 + half * k.reverse_friction;
-    Balance { residual: Quad { c: [c0, c1, c2] }.times(k.rho), stator_speed }
+    let loss = [shock[0] * half, shock[1] * half, (shock[2] + k.reverse_friction) * half];
+    let residual = Quad { c: std::array::from_fn(|i| (head[i] + loss[i]) * k.rho) };
+    Balance { residual, stator_speed }
 }
 
 /// The reverse steady state of `mode` from its balance `b`: the root in `p = −q > 0` of largest
@@ -611,11 +614,11 @@ fn reverse_state<T: Scalar>(
     }
     let (ws, q) = (b.stator_speed.eval(p), -p);
     let flow = q * k.area;
-    let [rp2, rt2, rs2] = k.r2;
+    let [rp, rt, rs] = k.r;
     let [mp, mt, ms] = k.inlet_swirl;
-    let hp = wp * rs2 + mp * q;
-    let ht = wt * rp2 + mt * q;
-    let hs = ws * rt2 + ms * q;
+    let hp = wp * rs * rs + mp * q;
+    let ht = wt * rp * rp + mt * q;
+    let hs = ws * rt * rt + ms * q;
     Some(HtSteadyState {
         flow_m3_s: flow,
         stator_speed_rad_s: ws,
