@@ -80,17 +80,21 @@ def reference_locked(g: dict, wp: float, wt: float) -> tuple[float, float, float
     return Q, pump, turbine, stator
 
 
-def interleaved_medians(fns: dict, repeats: int) -> dict[str, float]:
+def interleaved_medians(fns: dict, repeats: int, cpu: dict | None = None) -> dict[str, float]:
     """Median wall time (s) of each of ``fns`` over ``repeats`` rounds, one call of each per round,
-    after one warm-up call of each."""
+    after one warm-up call of each; ``cpu``, if given, gets the median CPU time of the process (s)."""
     for fn in fns.values():
         fn()
     times: dict[str, list[float]] = {k: [] for k in fns}
+    cpu_times: dict[str, list[float]] = {k: [] for k in fns}
     for _ in range(repeats):
         for k, fn in fns.items():
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), time.process_time()
             fn()
             times[k].append(time.perf_counter() - t0)
+            cpu_times[k].append(time.process_time() - c0)
+    if cpu is not None:
+        cpu.update({k: statistics.median(v) for k, v in cpu_times.items()})
     return {k: statistics.median(v) for k, v in times.items()}
 
 
@@ -128,13 +132,20 @@ def compare_peers(geometry: np.ndarray, wp: np.ndarray, wt: np.ndarray, label: s
         "NumPy closed form, every quadrant": lambda: peer.steady_state(geometry, wp, wt),
         "NumPy locked stator alone": lambda: peer.locked_drive(geometry, wp, wt),
     }
-    t = interleaved_medians(fns, REPEATS)
+    cpu: dict[str, float] = {}
+    t = interleaved_medians(fns, REPEATS, cpu)
     n = len(wp)
     one, many = t["core, 1 thread"], t[f"core, {cores} threads"]
     print(f"\n{label}: {n:,} points, median of {REPEATS} (load average {os.getloadavg()[0]:.2f} before)")
-    print(f"{'implementation':<36}{'ms':>9}{'ns/point':>10}")
+    print(f"{'implementation':<36}{'ms':>9}{'ns/point':>10}{'CPU ns/point':>14}")
     for k, v in t.items():
-        print(f"{k:<36}{1e3 * v:>9.2f}{1e9 * v / n:>10.1f}")
+        print(f"{k:<36}{1e3 * v:>9.2f}{1e9 * v / n:>10.1f}{1e9 * cpu[k] / n:>14.1f}")
+    # CPU time of the process: the work done, whatever share of a core the machine's load left it
+    c_one = cpu["core, 1 thread"]
+    print(
+        f"CPU-time ratio NumPy every quadrant / core: {cpu['NumPy closed form, every quadrant'] / c_one:.2f}x, "
+        f"NumPy locked alone / core: {cpu['NumPy locked stator alone'] / c_one:.2f}x (core on 1 thread)"
+    )
     print(
         f"ratio NumPy every quadrant / core: {t['NumPy closed form, every quadrant'] / one:.2f}x (1 thread), "
         f"{t['NumPy closed form, every quadrant'] / many:.2f}x ({cores} threads)"
