@@ -6,13 +6,13 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::converter::hrovat_tobler::{
-    drive_steady_state, steady_state, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE,
+    drive_steady_state, steady_state, try_steady_state, HtConstants, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE,
 };
 use crate::error::CoreError;
 use crate::scalar::{Dual, Scalar};
 
 /// Column-wise steady states of the Hrovat & Tobler model.
-#[derive(Debug, Clone, Default)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct HtSteadyColumns {
     pub flow_m3_s: Vec<f64>,
     pub stator_speed_rad_s: Vec<f64>,
@@ -24,17 +24,41 @@ pub struct HtSteadyColumns {
 }
 
 impl HtSteadyColumns {
-    fn with_capacity(n: usize) -> Self {
-        let v = || Vec::with_capacity(n);
+    fn zeros(n: usize) -> Self {
+        let v = || vec![0.0; n];
         Self {
             flow_m3_s: v(),
             stator_speed_rad_s: v(),
             pump_torque_nm: v(),
             turbine_torque_nm: v(),
             stator_torque_nm: v(),
-            stator_mode: Vec::with_capacity(n),
+            stator_mode: vec![0; n],
         }
     }
+
+    /// The columns cut into consecutive pieces of `len` rows (the last one shorter).
+    fn pieces(&mut self, len: usize) -> Vec<SteadyRows<'_>> {
+        let mut flow = self.flow_m3_s.chunks_mut(len);
+        let mut ws = self.stator_speed_rad_s.chunks_mut(len);
+        let mut tp = self.pump_torque_nm.chunks_mut(len);
+        let mut tt = self.turbine_torque_nm.chunks_mut(len);
+        let mut ts = self.stator_torque_nm.chunks_mut(len);
+        let mut mode = self.stator_mode.chunks_mut(len);
+        let mut out = Vec::new();
+        while let (Some(flow), Some(ws), Some(tp), Some(tt), Some(ts), Some(mode)) =
+            (flow.next(), ws.next(), tp.next(), tt.next(), ts.next(), mode.next())
+        {
+            out.push(SteadyRows { values: [flow, ws, tp, tt, ts], mode });
+        }
+        out
+    }
+}
+
+/// Consecutive rows of [`HtSteadyColumns`] that one worker fills: flow, stator speed, pump,
+/// turbine and stator torque, and the mode.
+struct SteadyRows<'a> {
+    values: [&'a mut [f64]; 5],
+    mode: &'a mut [i8],
 }
 
 /// A failed point: its index in the batch and the reason.
@@ -45,8 +69,8 @@ pub struct PointError {
 }
 
 /// Steady states at `pump[i], turbine[i]` with parameter set `geometry[i]` (or `geometry[0]`
-/// for every point when one set is given). `strict` stops at the first point without a steady
-/// state; otherwise such points are NaN with mode −1.
+/// for every point when one set is given), on one thread. `strict` stops at the first point
+/// without a steady state; otherwise such points are NaN with mode −1.
 pub fn ht_steady_states(
     geometry: &[HtGeometry<f64>],
     pump_speed_rad_s: &[f64],
@@ -54,20 +78,27 @@ pub fn ht_steady_states(
     strict: bool,
 ) -> Result<HtSteadyColumns, PointError> {
     let never = AtomicBool::new(false);
-    ht_steady_states_cancellable(geometry, pump_speed_rad_s, turbine_speed_rad_s, strict, &never)
+    ht_steady_states_cancellable(geometry, pump_speed_rad_s, turbine_speed_rad_s, strict, 1, &never)
         .map(|cols| cols.unwrap_or_default())
 }
 
 /// Points between two looks at the cancel flag of [`ht_steady_states_cancellable`].
 const CANCEL_CHECK_POINTS: usize = 4096;
 
-/// [`ht_steady_states`] that stops early, returning `Ok(None)`, once `cancel` is set (looked at
-/// every [`CANCEL_CHECK_POINTS`] points).
+/// The fewest points a worker thread of [`ht_steady_states_cancellable`] is given: smaller batches
+/// run on fewer threads (a thread costs tens of µs to start; 16 384 points take about 1 ms).
+pub const STEADY_POINTS_PER_THREAD: usize = 16_384;
+
+/// [`ht_steady_states`] on `threads` worker threads (0: one per core; never more than one per
+/// [`STEADY_POINTS_PER_THREAD`] points), each on consecutive points, that stops early, returning
+/// `Ok(None)`, once `cancel` is set (looked at every [`CANCEL_CHECK_POINTS`] points). The results do
+/// not depend on the number of threads; with `strict` the error is the first failed point's.
 pub fn ht_steady_states_cancellable(
     geometry: &[HtGeometry<f64>],
     pump_speed_rad_s: &[f64],
     turbine_speed_rad_s: &[f64],
     strict: bool,
+    threads: usize,
     cancel: &AtomicBool,
 ) -> Result<Option<HtSteadyColumns>, PointError> {
     let n = pump_speed_rad_s.len();
@@ -75,37 +106,67 @@ pub fn ht_steady_states_cancellable(
         turbine_speed_rad_s.len() == n && (geometry.len() == 1 || geometry.len() == n),
         "batch shapes are checked by the caller"
     );
-    let mut out = HtSteadyColumns::with_capacity(n);
-    for i in 0..n {
+    let cores = if threads == 0 { std::thread::available_parallelism().map_or(1, |c| c.get()) } else { threads };
+    let workers = cores.min(n / STEADY_POINTS_PER_THREAD).max(1);
+    let mut out = HtSteadyColumns::zeros(n);
+    let len = n.div_ceil(workers).max(1);
+    let pieces = out.pieces(len);
+    let run = |(j, rows): (usize, SteadyRows<'_>)| {
+        let start = j * len;
+        let end = start + rows.mode.len();
+        let g = if geometry.len() == 1 { geometry } else { &geometry[start..end] };
+        let speeds = (&pump_speed_rad_s[start..end], &turbine_speed_rad_s[start..end]);
+        fill_steady_rows(g, speeds, strict, cancel, rows).map_err(|e| PointError { index: start + e.index, ..e })
+    };
+    let results: Vec<Result<bool, PointError>> = if workers == 1 {
+        pieces.into_iter().enumerate().map(run).collect()
+    } else {
+        std::thread::scope(|scope| {
+            let handles: Vec<_> = pieces.into_iter().enumerate().map(|piece| scope.spawn(move || run(piece))).collect();
+            handles.into_iter().map(|h| h.join().expect("a steady-state worker does not panic")).collect()
+        })
+    };
+    // in point order: the first failed point's error, else whether any worker was cancelled
+    let mut complete = true;
+    for r in results {
+        complete &= r?;
+    }
+    Ok(complete.then_some(out))
+}
+
+/// Fill `rows` with the steady states of consecutive points (`geometry`: one row, or one per
+/// point); false if `cancel` was set, the error of the first failed point with `strict`.
+fn fill_steady_rows(
+    geometry: &[HtGeometry<f64>],
+    (pump, turbine): (&[f64], &[f64]),
+    strict: bool,
+    cancel: &AtomicBool,
+    rows: SteadyRows<'_>,
+) -> Result<bool, PointError> {
+    let SteadyRows { values: [flow, ws, tp, tt, ts], mode } = rows;
+    // a parameter row's constants once: for all points, or while consecutive points repeat the row
+    let mut k = HtConstants::new(&geometry[0]);
+    let mut row = &geometry[0];
+    for i in 0..mode.len() {
         if i % CANCEL_CHECK_POINTS == 0 && cancel.load(Ordering::Relaxed) {
-            return Ok(None);
+            return Ok(false);
         }
-        let g = &geometry[if geometry.len() == 1 { 0 } else { i }];
-        match steady_state(g, pump_speed_rad_s[i], turbine_speed_rad_s[i]) {
+        if geometry.len() > 1 && geometry[i].values != row.values {
+            (row, k) = (&geometry[i], HtConstants::new(&geometry[i]));
+        }
+        match try_steady_state(&k, pump[i], turbine[i]) {
             Ok(s) => {
-                out.flow_m3_s.push(s.flow_m3_s);
-                out.stator_speed_rad_s.push(s.stator_speed_rad_s);
-                out.pump_torque_nm.push(s.pump_torque_nm);
-                out.turbine_torque_nm.push(s.turbine_torque_nm);
-                out.stator_torque_nm.push(s.stator_torque_nm);
-                out.stator_mode.push(s.mode.code());
+                (flow[i], ws[i], tp[i]) = (s.flow_m3_s, s.stator_speed_rad_s, s.pump_torque_nm);
+                (tt[i], ts[i], mode[i]) = (s.turbine_torque_nm, s.stator_torque_nm, s.mode.code());
             }
-            Err(error) if strict => return Err(PointError { index: i, error }),
+            Err(e) if strict => return Err(PointError { index: i, error: e.error(pump[i], turbine[i]) }),
             Err(_) => {
-                for col in [
-                    &mut out.flow_m3_s,
-                    &mut out.stator_speed_rad_s,
-                    &mut out.pump_torque_nm,
-                    &mut out.turbine_torque_nm,
-                    &mut out.stator_torque_nm,
-                ] {
-                    col.push(f64::NAN);
-                }
-                out.stator_mode.push(NO_STEADY_STATE);
+                (flow[i], ws[i], tp[i], tt[i], ts[i]) = (f64::NAN, f64::NAN, f64::NAN, f64::NAN, f64::NAN);
+                mode[i] = NO_STEADY_STATE;
             }
         }
     }
-    Ok(Some(out))
+    Ok(true)
 }
 
 /// Iterations of [`ht_pump_speed_at_pump_torque`] at most.
@@ -318,6 +379,79 @@ mod tests {
         assert!(coast.flow_m3_s[0] < 0.0 && coast.pump_torque_nm[0] < 0.0);
     }
 
+    /// The bits of every column, NaN included.
+    fn bits(c: &HtSteadyColumns) -> Vec<Vec<u64>> {
+        let mut v: Vec<Vec<u64>> = [&c.flow_m3_s, &c.stator_speed_rad_s, &c.pump_torque_nm, &c.turbine_torque_nm]
+            .iter()
+            .map(|col| col.iter().map(|x| x.to_bits()).collect())
+            .collect();
+        v.push(c.stator_torque_nm.iter().map(|x| x.to_bits()).collect());
+        v.push(c.stator_mode.iter().map(|&m| m as u64).collect());
+        v
+    }
+
+    /// Issue 16: the batch computes a geometry's constants once (for one row, or while consecutive
+    /// points repeat a row) and shares the points among threads; neither may change a result: each
+    /// point is bit for bit `steady_state` of its own row, whatever the number of threads, and with
+    /// `strict` the error is the first failed point's, not the first failing worker's.
+    #[test]
+    fn batch_results_do_not_depend_on_threads_or_shared_constants() {
+        let n = 3 * STEADY_POINTS_PER_THREAD + 17;
+        let mut fitted = HtGeometry::appendix_d().values;
+        fitted[HtParam::FrictionLoss.index()] = 0.35;
+        fitted[HtParam::StatorShockLoss.index()] = 1.6;
+        let rows = [HtGeometry::appendix_d(), HtGeometry::new(fitted).unwrap()];
+        // every quadrant: SR −3 to 5, both pump directions, the pump at rest; rows in runs of 7
+        let wp: Vec<f64> = (0..n)
+            .map(|i| {
+                if i % 5 == 0 {
+                    -200.0
+                } else if i % 11 == 0 {
+                    0.0
+                } else {
+                    210.0
+                }
+            })
+            .collect();
+        let mut wt: Vec<f64> = (0..n).map(|i| (-3.0 + 8.0 * (i as f64 * 0.618_034).fract()) * 200.0).collect();
+        let geometry: Vec<HtGeometry<f64>> = (0..n).map(|i| rows[(i / 7) % 2]).collect();
+        for (i, w) in [(n / 2, f64::NAN), (n - 3, f64::INFINITY)] {
+            wt[i] = w;
+        }
+        let never = AtomicBool::new(false);
+        let run = |g: &[HtGeometry<f64>], threads, strict| {
+            ht_steady_states_cancellable(g, &wp, &wt, strict, threads, &never).map(Option::unwrap)
+        };
+        for g in [&geometry[..], &rows[..1]] {
+            let one = run(g, 1, false).unwrap();
+            for threads in [2, 3, 4] {
+                assert_eq!(bits(&run(g, threads, false).unwrap()), bits(&one), "{threads} threads");
+                let e = run(g, threads, true).unwrap_err();
+                assert_eq!((e.index, e.error.field.as_str()), (n / 2, "turbine_speed_rad_s"), "{threads} threads");
+            }
+            for i in (0..n).step_by(97).chain([n / 2, n - 3]) {
+                let row = if g.len() == 1 { &g[0] } else { &g[i] };
+                match steady_state(row, wp[i], wt[i]) {
+                    Ok(s) => {
+                        let got = [one.flow_m3_s[i], one.stator_speed_rad_s[i], one.pump_torque_nm[i]];
+                        let want = [s.flow_m3_s, s.stator_speed_rad_s, s.pump_torque_nm];
+                        assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "point {i}");
+                        assert_eq!(one.turbine_torque_nm[i].to_bits(), s.turbine_torque_nm.to_bits());
+                        assert_eq!(one.stator_torque_nm[i].to_bits(), s.stator_torque_nm.to_bits());
+                        assert_eq!(one.stator_mode[i], s.mode.code());
+                    }
+                    Err(_) => assert_eq!(one.stator_mode[i], NO_STEADY_STATE, "point {i}"),
+                }
+            }
+        }
+        // the modes met include every stator mode and both flow directions
+        let one = run(&geometry, 1, false).unwrap();
+        for m in [0, 1, 2, -1] {
+            assert!(one.stator_mode.contains(&m), "mode {m}");
+        }
+        assert!(one.flow_m3_s.iter().any(|&q| q < 0.0) && one.flow_m3_s.iter().any(|&q| q > 0.0));
+    }
+
     #[test]
     fn a_set_cancel_flag_stops_the_batches() {
         let cancel = AtomicBool::new(true);
@@ -325,7 +459,11 @@ mod tests {
         assert!(parallel_map_cancellable(&jobs, 2, &cancel, |j| j * 2).iter().all(Option::is_none));
         assert!(parallel_map_cancellable(&jobs, 1, &cancel, |j| j * 2).iter().all(Option::is_none));
         let g = HtGeometry::appendix_d();
-        assert!(ht_steady_states_cancellable(&[g], &[200.0], &[0.0], true, &cancel).unwrap().is_none());
+        assert!(ht_steady_states_cancellable(&[g], &[200.0], &[0.0], true, 1, &cancel).unwrap().is_none());
+        let n = 3 * STEADY_POINTS_PER_THREAD;
+        assert!(ht_steady_states_cancellable(&[g], &vec![200.0; n], &vec![0.0; n], true, 3, &cancel)
+            .unwrap()
+            .is_none());
         let go = AtomicBool::new(false);
         let all = parallel_map_cancellable(&jobs, 2, &go, |j| j * 2);
         assert_eq!(all, vec![Some(2), Some(4), Some(6), Some(8)]);

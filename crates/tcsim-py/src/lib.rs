@@ -214,15 +214,17 @@ fn ht_check_geometry(geometry: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
 
 /// Closed-form steady states at `pump[i], turbine[i]` (rad/s) with parameter row `geometry[i]`,
 /// or row 0 for all points. Returns a dict of arrays. With `strict`, the first point without a
-/// steady state raises CoreInputError (its `field` gets the point index).
+/// steady state raises CoreInputError (its `field` gets the point index). `threads` workers (0: one
+/// per core), at least 16 384 points each; the results do not depend on it.
 #[pyfunction]
-#[pyo3(signature = (geometry, pump_speed_rad_s, turbine_speed_rad_s, strict=true))]
+#[pyo3(signature = (geometry, pump_speed_rad_s, turbine_speed_rad_s, strict=true, threads=0))]
 fn ht_steady_states<'py>(
     py: Python<'py>,
     geometry: PyReadonlyArray2<'py, f64>,
     pump_speed_rad_s: PyReadonlyArray1<'py, f64>,
     turbine_speed_rad_s: PyReadonlyArray1<'py, f64>,
     strict: bool,
+    threads: usize,
 ) -> PyResult<Bound<'py, PyDict>> {
     guard(|| {
         let g = geometry_rows(&geometry)?;
@@ -233,7 +235,7 @@ fn ht_steady_states<'py>(
                 "pump and turbine speeds need equal lengths, and geometry one row or one row per point",
             ));
         }
-        let cols = cancellable(py, |cancel| match core_steady_states(&g, wp, wt, strict, cancel) {
+        let cols = cancellable(py, |cancel| match core_steady_states(&g, wp, wt, strict, threads, cancel) {
             Ok(cols) => cols.map(Ok),
             Err(e) => Some(Err(e)),
         })?

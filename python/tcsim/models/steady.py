@@ -150,18 +150,20 @@ def characterise_quasi_dynamic(
 
 
 def hrovat_tobler_steady_state(
-    geometry: np.ndarray, pump_speed_rad_s, turbine_speed_rad_s, strict: bool = True
+    geometry: np.ndarray, pump_speed_rad_s, turbine_speed_rad_s, strict: bool = True, threads: int = 0
 ) -> dict[str, np.ndarray]:
     """Closed-form steady states, batched in the core (GIL released).
 
     ``geometry`` is one row of the fifteen core parameters (``tcsim._core.ht_parameter_names()``,
-    angles in radians) or one row per point. Returns flow, stator speed, the three torques
-    (pump and stator external, turbine delivered) and the stator mode per point.
+    angles in radians) or one row per point. Returns flow (m³/s), stator speed (rad/s), the three
+    torques (N·m; pump and stator external, turbine delivered) and the stator mode per point.
+    ``threads`` workers share the points (0: one per core; a worker gets at least 16 384 points,
+    so smaller batches run on fewer threads); the results do not depend on it.
     """
     geometry = np.ascontiguousarray(np.atleast_2d(geometry), dtype=float)
     wp = np.ascontiguousarray(pump_speed_rad_s, dtype=float).reshape(-1)
     wt = np.ascontiguousarray(turbine_speed_rad_s, dtype=float).reshape(-1)
-    return _core.ht_steady_states(geometry, wp, wt, strict)
+    return _core.ht_steady_states(geometry, wp, wt, strict, threads)
 
 
 def steady_torque_ratio(out: dict[str, np.ndarray]) -> np.ndarray:

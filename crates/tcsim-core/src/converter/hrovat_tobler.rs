@@ -147,7 +147,8 @@ impl HtGeometry<f64> {
         }
         let g = Self { values };
         g.check_finite()?;
-        let dissipation = g.dissipation_coefficient();
+        let k = HtConstants::new(&g);
+        let dissipation = k.dissipation_coefficient();
         if dissipation <= 0.0 {
             return Err(CoreError::new(
                 "friction_loss",
@@ -155,7 +156,7 @@ impl HtGeometry<f64> {
                 "a positive friction loss or shock losses with non-zero incidence: without losses the flow is unbounded",
             ));
         }
-        if g.reverse_dissipation_coefficient() <= 0.0 {
+        if k.reverse_dissipation_coefficient() <= 0.0 {
             return Err(CoreError::new(
                 "friction_loss",
                 values[HtParam::FrictionLoss.index()],
@@ -174,7 +175,7 @@ impl HtGeometry<f64> {
             Ok(s) => s.is_finite(),
             Err(e) => e.source != InputSource::Drive, // no steady state is the dissipation check's
         });
-        if finite && self.dissipation_coefficient().is_finite() {
+        if finite && HtConstants::new(self).dissipation_coefficient().is_finite() {
             return Ok(());
         }
         let quantity = |p: HtParam| match p {
@@ -227,36 +228,6 @@ impl HtGeometry<f64> {
     pub fn to_dual(&self) -> HtGeometry<Dual> {
         HtGeometry { values: self.values.map(Dual::cst) }
     }
-
-    /// The coefficient of q² in the reverse-flow locked-stator residual divided by ρ/2 (the
-    /// reverse shock velocities and friction with the inlet angles); positive when the losses bound
-    /// a reverse flow.
-    fn reverse_dissipation_coefficient(&self) -> f64 {
-        let [tp, tt, ts, tpp, ttt, tss] = tangents(self);
-        let c =
-            [self.get(HtParam::PumpShockLoss), self.get(HtParam::TurbineShockLoss), self.get(HtParam::StatorShockLoss)];
-        let b = [ttt - tp, tss - tt, tpp - ts];
-        let friction = 3.0 + tpp * tpp + ttt * ttt + tss * tss;
-        c.iter().zip(b).map(|(c, b)| c * b * b).sum::<f64>() + self.get(HtParam::FrictionLoss) * friction
-    }
-
-    /// The coefficient of −q² in the locked-stator residual divided by ρ/2; positive when the
-    /// losses bound the flow.
-    fn dissipation_coefficient(&self) -> f64 {
-        let t = |p: HtParam| self.get(p).tan();
-        let b = [
-            t(HtParam::StatorExitAngle) - t(HtParam::PumpInletAngle),
-            t(HtParam::PumpExitAngle) - t(HtParam::TurbineInletAngle),
-            t(HtParam::TurbineExitAngle) - t(HtParam::StatorInletAngle),
-        ];
-        let c =
-            [self.get(HtParam::PumpShockLoss), self.get(HtParam::TurbineShockLoss), self.get(HtParam::StatorShockLoss)];
-        let friction = 3.0
-            + t(HtParam::PumpExitAngle).powi(2)
-            + t(HtParam::TurbineExitAngle).powi(2)
-            + t(HtParam::StatorExitAngle).powi(2);
-        c.iter().zip(b).map(|(c, b)| c * b * b).sum::<f64>() + self.get(HtParam::FrictionLoss) * friction
-    }
 }
 
 /// A polynomial of degree ≤ 2 in q: `c[0] + c[1] q + c[2] q²`.
@@ -272,29 +243,13 @@ impl<T: Scalar> Quad<T> {
     fn affine(c0: T, c1: T) -> Self {
         Self { c: [c0, c1, T::cst(0.0)] }
     }
-    fn q() -> Self {
-        Self::affine(T::cst(0.0), T::cst(1.0))
-    }
-    fn add(self, o: Self) -> Self {
-        Self { c: [self.c[0] + o.c[0], self.c[1] + o.c[1], self.c[2] + o.c[2]] }
-    }
-    fn sub(self, o: Self) -> Self {
-        self.add(o.times(T::cst(-1.0)))
-    }
-    fn times(self, k: T) -> Self {
-        Self { c: self.c.map(|x| x * k) }
-    }
-    /// Product of two affine polynomials (the q² terms of the factors must be zero).
-    fn mul_affine(self, o: Self) -> Self {
-        debug_assert!(self.c[2].re() == 0.0 && o.c[2].re() == 0.0);
-        Self { c: [self.c[0] * o.c[0], self.c[0] * o.c[1] + self.c[1] * o.c[0], self.c[1] * o.c[1]] }
-    }
     fn eval(self, q: T) -> T {
         self.c[0] + q * (self.c[1] + q * self.c[2])
     }
 }
 
 /// Largest real root of `c0 + c1 q + c2 q²`, computed without cancellation; None if no real root.
+#[inline]
 fn largest_real_root<T: Scalar>(p: Quad<T>) -> Option<T> {
     let [c0, c1, c2] = p.c;
     if c2.re() == 0.0 {
@@ -390,84 +345,173 @@ impl<T: Scalar> HtSteadyState<T> {
     }
 }
 
+/// Per-geometry constants of the steady state: the six blade-angle tangents and what the balances
+/// and torques build from them and the radii, computed once per parameter set (issue 16: the
+/// tangents were computed 2–4 times per point). [`crate::batch::ht_steady_states`] makes one per
+/// parameter row; [`steady_state_with`] takes it.
+#[derive(Debug, Clone, Copy)]
+pub struct HtConstants<T> {
+    /// Fluid density ρ, kg/m³, and flow area A, m².
+    rho: T,
+    area: T,
+    /// Exit radii R_p, R_t, R_s, m, and their squares, m².
+    r: [T; 3],
+    r2: [T; 3],
+    /// Shock loss coefficients C_sh,p, C_sh,t, C_sh,s.
+    shock: [T; 3],
+    /// `R tan α` at the edges the forward flow leaves (exit edges): R_p tan α_p, R_t tan α_t,
+    /// R_s tan α_s, m.
+    exit_swirl: [T; 3],
+    /// `R tan α` at the edges the reverse flow leaves (inlet edges, at the radius of the element
+    /// before): R_s tan α_pp, R_p tan α_tt, R_t tan α_ss, m.
+    inlet_swirl: [T; 3],
+    /// q-coefficients of the forward shock velocities (eqs 2.20–2.22): tan α_s − tan α_pp,
+    /// tan α_p − tan α_tt, tan α_t − tan α_ss.
+    shock_slope: [T; 3],
+    /// q-coefficients of the reverse shock velocities (docs/models.md, "Reverse flow"):
+    /// tan α_tt − tan α_p, tan α_ss − tan α_t, tan α_pp − tan α_s.
+    reverse_shock_slope: [T; 3],
+    /// `f Σ(1 + tan² α)` over the exit angles (forward friction, eqs 2.23–2.25) and over the inlet
+    /// angles (reverse friction).
+    friction: T,
+    reverse_friction: T,
+    /// The slope `k₁` of the free-wheeling stator's speed `ω_s = ω R²/R'² + k₁ x`: forwards
+    /// (`ω = ω_t`, `x = q`) `k₁ = (R_t tan α_t − R_s tan α_s)/R_s²`; backwards (`ω = ω_p`, `x = −q`)
+    /// `k₁ = (R_t tan α_ss − R_s tan α_pp)/R_t²`.
+    free: T,
+    reverse_free: T,
+}
+
+impl<T: Scalar> HtConstants<T> {
+    /// The constants of parameter set `g` (six tangents, no check of the parameters).
+    pub fn new(g: &HtGeometry<T>) -> Self {
+        use HtParam::*;
+        let r = [g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius)];
+        let [rp, rt, rs] = r;
+        let [tp, tt, ts, tpp, ttt, tss] =
+            [PumpExitAngle, TurbineExitAngle, StatorExitAngle, PumpInletAngle, TurbineInletAngle, StatorInletAngle]
+                .map(|p| g.get(p).tan());
+        let one = T::cst(1.0);
+        let f = g.get(FrictionLoss);
+        let r2 = r.map(|x| x * x);
+        Self {
+            rho: g.get(FluidDensity),
+            area: g.get(FlowArea),
+            r,
+            r2,
+            shock: [g.get(PumpShockLoss), g.get(TurbineShockLoss), g.get(StatorShockLoss)],
+            exit_swirl: [rp * tp, rt * tt, rs * ts],
+            inlet_swirl: [rs * tpp, rp * ttt, rt * tss],
+            shock_slope: [ts - tpp, tp - ttt, tt - tss],
+            reverse_shock_slope: [ttt - tp, tss - tt, tpp - ts],
+            friction: f * (one + tp * tp + one + tt * tt + one + ts * ts),
+            reverse_friction: f * (one + tpp * tpp + one + ttt * ttt + one + tss * tss),
+            free: (rt * tt - rs * ts) / r2[2],
+            reverse_free: (rt * tss - rs * tpp) / r2[1],
+        }
+    }
+}
+
+impl HtConstants<f64> {
+    /// The coefficient of q² in the reverse-flow locked-stator residual divided by ρ/2; positive
+    /// when the losses bound a reverse flow.
+    fn reverse_dissipation_coefficient(&self) -> f64 {
+        (0..3).map(|x| self.shock[x] * self.reverse_shock_slope[x].powi(2)).sum::<f64>() + self.reverse_friction
+    }
+
+    /// The coefficient of −q² in the locked-stator residual divided by ρ/2; positive when the
+    /// losses bound the flow.
+    fn dissipation_coefficient(&self) -> f64 {
+        (0..3).map(|x| self.shock[x] * self.shock_slope[x].powi(2)).sum::<f64>() + self.friction
+    }
+}
+
 /// The right-hand side of eq 2.15 at steady state as a quadratic in q, for a stator speed that is
 /// affine in q (zero when locked).
+#[derive(Debug, Clone, Copy)]
 struct Balance<T> {
     residual: Quad<T>,
     stator_speed: Quad<T>,
 }
 
-fn tangents<T: Scalar>(g: &HtGeometry<T>) -> [T; 6] {
-    use HtParam::*;
-    [PumpExitAngle, TurbineExitAngle, StatorExitAngle, PumpInletAngle, TurbineInletAngle, StatorInletAngle]
-        .map(|p| g.get(p).tan())
-}
-
-fn balance<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
-    use HtParam::*;
-    let rho = g.get(FluidDensity);
-    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
-    let [tp, tt, ts, tpp, ttt, tss] = tangents(g);
-    let (cwp, cwt, ws) = (Quad::cst(wp), Quad::cst(wt), stator_speed);
-    let q = Quad::q();
-    // Euler head, eq 2.15 first three lines
-    let head0 = Quad::cst(rp * rp * wp * wp + rt * rt * wt * wt - rp * rp * wt * wp)
-        .add(ws.mul_affine(ws).times(rs * rs))
-        .sub(ws.times(rs * rs * wp + rt * rt * wt));
-    let head1 =
-        q.mul_affine(Quad::cst(wp * (rp * tp - rs * ts) + wt * (rt * tt - rp * tp)).add(ws.times(rs * ts - rt * tt)));
-    // shock velocities, eqs 2.20–2.22
-    let sh_p = ws.sub(cwp).times(rs).add(q.times(ts - tpp));
-    let sh_t = cwp.sub(cwt).times(rp).add(q.times(tp - ttt));
-    let sh_s = cwt.sub(ws).times(rt).add(q.times(tt - tss));
-    let shock = sh_p
-        .mul_affine(sh_p)
-        .times(g.get(PumpShockLoss))
-        .add(sh_t.mul_affine(sh_t).times(g.get(TurbineShockLoss)))
-        .add(sh_s.mul_affine(sh_s).times(g.get(StatorShockLoss)));
-    // friction, eqs 2.19 and 2.23–2.25: Σ|V_re,x|² = q² Σ(1 + tan²α_x)
-    let one = T::cst(1.0);
-    let friction = q.mul_affine(q).times(g.get(FrictionLoss) * (one + tp * tp + one + tt * tt + one + ts * ts));
-    let residual = head0.add(head1).sub(shock.add(friction).times(T::cst(0.5))).times(rho);
+#[inline]
+fn balance<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
+    let [rp, rt, rs] = k.r;
+    let [rp2, rt2, rs2] = k.r2;
+    let [mp, mt, ms] = k.exit_swirl;
+    // ω_s = a + b q. The coefficients are the products of the affine factors written out, in the
+    // order of the polynomial arithmetic they replace, so that they are the same to the last bit.
+    let [a, b, _] = stator_speed.c;
+    // Euler head, eq 2.15 first three lines: the ω_s-free terms, + R_s²ω_s² − (R_s²ω_p + R_t²ω_t) ω_s,
+    // + q [ω_p(R_p tan α_p − R_s tan α_s) + ω_t(R_t tan α_t − R_p tan α_p) + ω_s(R_s tan α_s − R_t tan α_t)]
+    let cross = rs2 * wp + rt2 * wt;
+    let (e, f) = (wp * (mp - ms) + wt * (mt - mp), ms - mt);
+    let head = [
+        rp2 * wp * wp + rt2 * wt * wt - rp2 * wt * wp + a * a * rs2 - a * cross,
+        (a * b + b * a) * rs2 - b * cross + (e + a * f),
+        b * b * rs2 + b * f,
+    ];
+    // shock velocities, eqs 2.20–2.22, as u + v q: Σ C_sh (u + v q)²
+    let [bp, bt, bs] = k.shock_slope;
+    let shocks = [((a - wp) * rs, b * rs + bp), ((wp - wt) * rp, bt), ((wt - a) * rt, bs - b * rt)];
+    let squares = |x: usize| {
+        let (u, v) = shocks[x];
+        [u * u * k.shock[x], (u * v + v * u) * k.shock[x], v * v * k.shock[x]]
+    };
+    let (sp, st, ss) = (squares(0), squares(1), squares(2));
+    let shock: [T; 3] = std::array::from_fn(|i| sp[i] + st[i] + ss[i]);
+    // friction, eqs 2.19 and 2.23–2.25: Σ|V_re,x|² = q² Σ(1 + tan²α_x); the loss is halved
+    let half = T::cst(0.5);
+    let loss = [shock[0] * half, shock[1] * half, (shock[2] + k.friction) * half];
+    let residual = Quad { c: std::array::from_fn(|i| (head[i] - loss[i]) * k.rho) };
     Balance { residual, stator_speed }
 }
 
 /// Torques of eqs 2.12–2.14 with zero left-hand sides, at flow `q = Q/A`.
-fn torques<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, ws: T, q: T) -> (T, T, T) {
-    use HtParam::*;
-    let rho = g.get(FluidDensity);
-    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
-    let [tp, tt, ts, ..] = tangents(g);
-    let flow = q * g.get(FlowArea);
+#[inline]
+fn torques<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, ws: T, q: T) -> (T, T, T) {
+    let [rp, rt, rs] = k.r;
+    let [mp, mt, ms] = k.exit_swirl;
+    let flow = q * k.area;
     // angular momentum leaving each element per unit mass flow
-    let hp = wp * rp * rp + rp * tp * q;
-    let ht = wt * rt * rt + rt * tt * q;
-    let hs = ws * rs * rs + rs * ts * q;
-    let pump = rho * (hp - hs) * flow;
-    let turbine_external = rho * (ht - hp) * flow;
-    let stator = rho * (hs - ht) * flow;
+    let hp = wp * rp * rp + mp * q;
+    let ht = wt * rt * rt + mt * q;
+    let hs = ws * rs * rs + ms * q;
+    let pump = k.rho * (hp - hs) * flow;
+    let turbine_external = k.rho * (ht - hp) * flow;
+    let stator = k.rho * (hs - ht) * flow;
     (pump, -turbine_external, stator)
 }
 
-fn solve_mode<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, mode: StatorMode) -> Option<HtSteadyState<T>> {
-    use HtParam::*;
-    let stator_speed = match mode {
-        StatorMode::Locked => Quad::cst(T::cst(0.0)),
-        _ => {
-            let (rt, rs) = (g.get(TurbineExitRadius), g.get(StatorExitRadius));
-            let [_, tt, ts, ..] = tangents(g);
-            Quad::affine(wt * rt * rt / (rs * rs), (rt * tt - rs * ts) / (rs * rs))
-        }
-    };
-    let b = balance(g, wp, wt, stator_speed);
+/// The stator speed of `mode` as a polynomial in the flow variable: zero when locked, the
+/// free-wheeling one of [`HtConstants::free`] otherwise (`reverse`: of `reverse_free`, x = −q).
+fn stator_speed<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, mode: StatorMode, reverse: bool) -> Quad<T> {
+    match (mode, reverse) {
+        (StatorMode::Locked, _) => Quad::cst(T::cst(0.0)),
+        (_, false) => Quad::affine(wt * k.r[1] * k.r[1] / k.r2[2], k.free),
+        // T_s = 0: the stator passes on the angular momentum it receives from the pump,
+        // ω_s R_t² + R_t tan α_ss q = ω_p R_s² + R_s tan α_pp q, with q = −p
+        (_, true) => Quad::affine(wp * k.r[2] * k.r[2] / k.r2[1], k.reverse_free),
+    }
+}
+
+/// The forward steady state of `mode` from its balance `b`: the largest root q > 0.
+#[inline]
+fn forward_state<T: Scalar>(
+    k: &HtConstants<T>,
+    wp: T,
+    wt: T,
+    mode: StatorMode,
+    b: Balance<T>,
+) -> Option<HtSteadyState<T>> {
     let q = largest_real_root(b.residual)?;
     if q.re() <= 0.0 {
         return None;
     }
     let ws = b.stator_speed.eval(q);
-    let (pump, turbine, stator) = torques(g, wp, wt, ws, q);
+    let (pump, turbine, stator) = torques(k, wp, wt, ws, q);
     Some(HtSteadyState {
-        flow_m3_s: q * g.get(FlowArea),
+        flow_m3_s: q * k.area,
         stator_speed_rad_s: ws,
         pump_torque_nm: pump,
         turbine_torque_nm: turbine,
@@ -476,90 +520,133 @@ fn solve_mode<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, mode: StatorMode) -> O
     })
 }
 
+fn solve_mode<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, mode: StatorMode) -> Option<HtSteadyState<T>> {
+    forward_state(k, wp, wt, mode, balance(k, wp, wt, stator_speed(k, wp, wt, mode, false)))
+}
+
 /// Steady state with the stator held (ω_s = 0), whatever the sign of the holding torque.
 pub fn locked_steady_state<T: Scalar>(
     g: &HtGeometry<T>,
     pump_speed_rad_s: T,
     turbine_speed_rad_s: T,
 ) -> Option<HtSteadyState<T>> {
-    solve_mode(g, pump_speed_rad_s, turbine_speed_rad_s, StatorMode::Locked)
+    solve_mode(&HtConstants::new(g), pump_speed_rad_s, turbine_speed_rad_s, StatorMode::Locked)
 }
 
-/// The operating point's errors are about the speeds asked for ([`InputSource::Drive`]): any
-/// finite pair of speeds has a steady state.
-fn check_operating_point(wp: f64, wt: f64) -> CoreResult<()> {
-    if !wp.is_finite() {
-        return Err(CoreError::of(InputSource::Drive, "pump_speed_rad_s", wp, "a finite pump speed"));
+/// Why an operating point has no steady state, before any message is formatted (the batch's loop
+/// meets it per point). [`SteadyFailure::error`] gives the error.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SteadyFailure {
+    /// A pump speed that is not finite.
+    PumpSpeed,
+    /// A turbine speed that is not finite.
+    TurbineSpeed,
+    /// A steady state that overflows (pump speeds above about 1e150 rad/s, where ω² does).
+    Overflow,
+}
+
+impl SteadyFailure {
+    /// The error at speeds `wp`, `wt` (rad/s). The operating point's errors are about the speeds
+    /// asked for ([`InputSource::Drive`]): any finite pair of speeds has a steady state. An
+    /// overflow is never reported as a mode (it was `no-flow`).
+    pub fn error(self, wp: f64, wt: f64) -> CoreError {
+        match self {
+            Self::PumpSpeed => CoreError::of(InputSource::Drive, "pump_speed_rad_s", wp, "a finite pump speed"),
+            Self::TurbineSpeed => CoreError::of(InputSource::Drive, "turbine_speed_rad_s", wt, "a finite turbine speed"),
+            Self::Overflow => CoreError::of(
+                InputSource::Drive,
+                "pump_speed_rad_s",
+                wp.abs().max(wt.abs()),
+                "a pump speed at which the steady state of these parameters is finite (it overflows: its torques grow as the speed squared)",
+            ),
+        }
     }
-    if !wt.is_finite() {
-        return Err(CoreError::of(InputSource::Drive, "turbine_speed_rad_s", wt, "a finite turbine speed"));
-    }
-    Ok(())
 }
 
 /// The reverse-flow residual `F_Q/ρ·ρ` (docs/models.md, "Reverse flow") as a polynomial in
 /// `p = −q ≥ 0`, for a stator speed affine in p.
-fn reverse_balance<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
-    use HtParam::*;
-    let rho = g.get(FluidDensity);
-    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
-    let [tp, tt, ts, tpp, ttt, tss] = tangents(g);
-    let w = [Quad::cst(wp), Quad::cst(wt), stator_speed];
-    let q = Quad::q().times(T::cst(-1.0));
-    let (r_leave, tan_leave, src) = ([rs, rp, rt], [tpp, ttt, tss], [1usize, 2, 0]);
-    let h: [Quad<T>; 3] =
-        std::array::from_fn(|x| w[x].times(r_leave[x] * r_leave[x]).add(q.times(r_leave[x] * tan_leave[x])));
-    let head = (0..3).fold(Quad::cst(T::cst(0.0)), |acc, x| acc.add(w[x].mul_affine(h[src[x]].sub(h[x]))));
-    let (r_entry, b) = ([rp, rt, rs], [ttt - tp, tss - tt, tpp - ts]);
-    let c = [g.get(PumpShockLoss), g.get(TurbineShockLoss), g.get(StatorShockLoss)];
-    let shock = (0..3).fold(Quad::cst(T::cst(0.0)), |acc, x| {
-        let v = w[src[x]].sub(w[x]).times(r_entry[x]).add(q.times(b[x]));
-        acc.add(v.mul_affine(v).times(c[x]))
-    });
-    let one = T::cst(1.0);
-    let friction = q.mul_affine(q).times(g.get(FrictionLoss) * (one + tpp * tpp + one + ttt * ttt + one + tss * tss));
-    let residual = head.add(shock.add(friction).times(T::cst(0.5))).times(rho);
+#[inline]
+fn reverse_balance<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
+    let [rp, rt, rs] = k.r;
+    let [rp2, rt2, rs2] = k.r2;
+    let [ip, it, is] = k.inlet_swirl;
+    // ω_s = a + b p
+    let [a, b, _] = stator_speed.c;
+    // angular momentum per unit mass leaving across the inlet edges, h_x = h0 + h1 p (q = −p)
+    let (hp0, hp1) = (wp * rs2, -ip);
+    let (ht0, ht1) = (wt * rp2, -it);
+    let (hs0, hs1) = (a * rt2, b * rt2 - is);
+    // head = ω_p (h_t − h_p) + ω_t (h_s − h_t) + ω_s (h_p − h_s)
+    // (in the order of the polynomial arithmetic they replace, so that they are the same to the bit)
+    let head = [
+        wp * (ht0 - hp0) + wt * (hs0 - ht0) + a * (hp0 - hs0),
+        wp * (ht1 - hp1) + wt * (hs1 - ht1) + (a * (hp1 - hs1) + b * (hp0 - hs0)),
+        b * (hp1 - hs1),
+    ];
+    // shock at the entry of each element, from its source (pump ← turbine ← stator ← pump), u + v p
+    let [bp, bt, bs] = k.reverse_shock_slope;
+    let shocks = [((wt - wp) * rp, -bp), ((a - wt) * rt, b * rt - bt), ((wp - a) * rs, -b * rs - bs)];
+    let squares = |x: usize| {
+        let (u, v) = shocks[x];
+        [u * u * k.shock[x], (u * v + v * u) * k.shock[x], v * v * k.shock[x]]
+    };
+    let (sp, st, ss) = (squares(0), squares(1), squares(2));
+    let shock: [T; 3] = std::array::from_fn(|i| sp[i] + st[i] + ss[i]);
+    let half = T::cst(0.5);
+    let loss = [shock[0] * half, shock[1] * half, (shock[2] + k.reverse_friction) * half];
+    let residual = Quad { c: std::array::from_fn(|i| (head[i] + loss[i]) * k.rho) };
     Balance { residual, stator_speed }
 }
 
-/// A reverse-flow steady state in `mode` (locked or free-wheeling): the root in `p = −q > 0` of
-/// largest magnitude (the locked residual has one), with the torques of the reverse form.
-pub(crate) fn solve_reverse<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, mode: StatorMode) -> Option<HtSteadyState<T>> {
-    use HtParam::*;
-    let (rp, rt, rs) = (g.get(PumpExitRadius), g.get(TurbineExitRadius), g.get(StatorExitRadius));
-    let [_, _, _, tpp, ttt, tss] = tangents(g);
-    let stator_speed = match mode {
-        StatorMode::Locked => Quad::cst(T::cst(0.0)),
-        // T_s = 0: the stator passes on the angular momentum it receives from the pump,
-        // ω_s R_t² + R_t tan α_ss q = ω_p R_s² + R_s tan α_pp q, with q = −p
-        _ => Quad::affine(wp * rs * rs / (rt * rt), (rt * tss - rs * tpp) / (rt * rt)),
-    };
-    let b = reverse_balance(g, wp, wt, stator_speed);
+/// The reverse steady state of `mode` from its balance `b`: the root in `p = −q > 0` of largest
+/// magnitude (the locked residual has one), with the torques of the reverse form.
+#[inline]
+fn reverse_state<T: Scalar>(
+    k: &HtConstants<T>,
+    wp: T,
+    wt: T,
+    mode: StatorMode,
+    b: Balance<T>,
+) -> Option<HtSteadyState<T>> {
     let p = largest_real_root(b.residual)?;
     if p.re() <= 0.0 {
         return None;
     }
     let (ws, q) = (b.stator_speed.eval(p), -p);
-    let flow = q * g.get(FlowArea);
-    let rho = g.get(FluidDensity);
-    let hp = wp * rs * rs + rs * tpp * q;
-    let ht = wt * rp * rp + rp * ttt * q;
-    let hs = ws * rt * rt + rt * tss * q;
+    let flow = q * k.area;
+    let [rp, rt, rs] = k.r;
+    let [mp, mt, ms] = k.inlet_swirl;
+    let hp = wp * rs * rs + mp * q;
+    let ht = wt * rp * rp + mt * q;
+    let hs = ws * rt * rt + ms * q;
     Some(HtSteadyState {
         flow_m3_s: flow,
         stator_speed_rad_s: ws,
         // external torque −F_x = −ρQ(h_x − h_src(x)); the turbine's delivered torque is F_t
-        pump_torque_nm: -(rho * (hp - ht) * flow),
-        turbine_torque_nm: rho * (ht - hs) * flow,
-        stator_torque_nm: if mode == StatorMode::Locked { -(rho * (hs - hp) * flow) } else { T::cst(0.0) },
+        pump_torque_nm: -(k.rho * (hp - ht) * flow),
+        turbine_torque_nm: k.rho * (ht - hs) * flow,
+        stator_torque_nm: if mode == StatorMode::Locked { -(k.rho * (hs - hp) * flow) } else { T::cst(0.0) },
         mode,
     })
+}
+
+/// A reverse-flow steady state in `mode` (locked or free-wheeling): the root in `p = −q > 0` of
+/// largest magnitude (the locked residual has one), with the torques of the reverse form.
+#[cfg(test)]
+pub(crate) fn solve_reverse<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T, mode: StatorMode) -> Option<HtSteadyState<T>> {
+    let k = HtConstants::new(g);
+    reverse_state(&k, wp, wt, mode, reverse_balance(&k, wp, wt, stator_speed(&k, wp, wt, mode, true)))
 }
 
 /// The direction in which the flow starts from rest with the stator at rest (σ of
 /// [`crate::engine::converter_events::flow_sign_from_balance`] on `F_Q(0±)`): +1, −1 or 0 (held).
 pub fn start_direction<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T) -> i8 {
     let (forward, reverse) = zero_flow_forces(g, wp, wt);
+    direction_from_forces(forward, reverse)
+}
+
+/// [`start_direction`] from `(F_Q(0⁺), F_Q(0⁻))`.
+fn direction_from_forces(forward: f64, reverse: f64) -> i8 {
     match (forward > 0.0, reverse < 0.0) {
         (true, true) => {
             if forward >= -reverse {
@@ -576,8 +663,9 @@ pub fn start_direction<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T) -> i8 {
 
 /// `(F_Q(0⁺), F_Q(0⁻))` with the stator at rest, Pa.
 pub fn zero_flow_forces<T: Scalar>(g: &HtGeometry<T>, wp: T, wt: T) -> (f64, f64) {
+    let k = HtConstants::new(g);
     let zero = Quad::cst(T::cst(0.0));
-    (balance(g, wp, wt, zero).residual.c[0].re(), reverse_balance(g, wp, wt, zero).residual.c[0].re())
+    (balance(&k, wp, wt, zero).residual.c[0].re(), reverse_balance(&k, wp, wt, zero).residual.c[0].re())
 }
 
 fn no_flow<T: Scalar>(stator_speed: T) -> HtSteadyState<T> {
@@ -601,16 +689,6 @@ impl<T: Scalar> HtSteadyState<T> {
     }
 }
 
-/// The error of a steady state that overflowed: never reported as a mode (it was `no-flow`).
-fn overflow(wp: f64) -> CoreError {
-    CoreError::of(
-        InputSource::Drive,
-        "pump_speed_rad_s",
-        wp,
-        "a pump speed at which the steady state of these parameters is finite (it overflows: its torques grow as the speed squared)",
-    )
-}
-
 /// Steady state with the one-way clutch at any finite speeds (docs/models.md, "Steady state in
 /// every quadrant"). The flow direction is the one in which the flow starts from rest with the
 /// stator at rest ([`start_direction`]); in that direction: locked while the clutch holds
@@ -623,32 +701,65 @@ pub fn steady_state<T: Scalar>(
     pump_speed_rad_s: T,
     turbine_speed_rad_s: T,
 ) -> CoreResult<HtSteadyState<T>> {
+    steady_state_with(&HtConstants::new(g), pump_speed_rad_s, turbine_speed_rad_s)
+}
+
+/// [`steady_state`] with the geometry's constants computed beforehand (once for many points).
+pub fn steady_state_with<T: Scalar>(
+    k: &HtConstants<T>,
+    pump_speed_rad_s: T,
+    turbine_speed_rad_s: T,
+) -> CoreResult<HtSteadyState<T>> {
+    try_steady_state(k, pump_speed_rad_s, turbine_speed_rad_s)
+        .map_err(|e| e.error(pump_speed_rad_s.re(), turbine_speed_rad_s.re()))
+}
+
+/// [`steady_state_with`] with the reason of a failure instead of its error.
+pub fn try_steady_state<T: Scalar>(
+    k: &HtConstants<T>,
+    pump_speed_rad_s: T,
+    turbine_speed_rad_s: T,
+) -> Result<HtSteadyState<T>, SteadyFailure> {
     let (wp, wt) = (pump_speed_rad_s, turbine_speed_rad_s);
-    check_operating_point(wp.re(), wt.re())?;
-    let scale = wp.re().abs().max(wt.re().abs());
-    let (forward, reverse) = zero_flow_forces(g, wp, wt);
-    if !(forward.is_finite() && reverse.is_finite()) {
-        return Err(overflow(scale));
+    if !wp.re().is_finite() {
+        return Err(SteadyFailure::PumpSpeed);
     }
-    let direction = start_direction(g, wp, wt);
+    if !wt.re().is_finite() {
+        return Err(SteadyFailure::TurbineSpeed);
+    }
+    // the locked balances: their constant terms are F_Q(0±) with the stator at rest, which decide
+    // the direction; the forward one is the drive state's own balance (the reverse one is built
+    // again where it is needed, so that only its constant term is computed here once inlined)
+    let zero = Quad::cst(T::cst(0.0));
+    let fw_locked = balance(k, wp, wt, zero);
+    let (forward, reverse) = (fw_locked.residual.c[0].re(), reverse_balance(k, wp, wt, zero).residual.c[0].re());
+    if !(forward.is_finite() && reverse.is_finite()) {
+        return Err(SteadyFailure::Overflow);
+    }
+    let direction = direction_from_forces(forward, reverse);
     if direction == 0 {
         return Ok(no_flow(T::cst(0.0)));
     }
-    let in_direction = |sign: i8| -> CoreResult<HtSteadyState<T>> {
-        let solve = |mode| if sign > 0 { solve_mode(g, wp, wt, mode) } else { solve_reverse(g, wp, wt, mode) };
-        let locked = solve(StatorMode::Locked).ok_or_else(|| overflow(scale))?;
-        with_clutch(locked, || solve(StatorMode::FreeWheeling), wt, scale)
+    let solve = |sign: i8, mode: StatorMode| match (sign > 0, mode) {
+        (true, StatorMode::Locked) => forward_state(k, wp, wt, mode, fw_locked),
+        (true, _) => solve_mode(k, wp, wt, mode),
+        (false, _) => reverse_state(k, wp, wt, mode, reverse_balance(k, wp, wt, stator_speed(k, wp, wt, mode, true))),
     };
-    let first = in_direction(direction)?;
+    let locked = if direction > 0 {
+        forward_state(k, wp, wt, StatorMode::Locked, fw_locked)
+    } else {
+        reverse_state(k, wp, wt, StatorMode::Locked, reverse_balance(k, wp, wt, zero))
+    };
+    let locked = locked.ok_or(SteadyFailure::Overflow)?;
+    let first = with_clutch(locked, || solve(direction, StatorMode::FreeWheeling), wt)?;
     // where the direction the flow starts in has no flowing steady state, the other direction's is
     // taken if it has one: the free-wheeling stator spins up while the flow dies away and the flow
     // then settles in the other direction (coast just above SR 1: Appendix D at SR 1.0084–1.0303
     // starts forwards with the stator at rest and settles on reverse flow, as the transient does)
     if first.mode == StatorMode::NoFlow {
-        let solve = |mode| if direction < 0 { solve_mode(g, wp, wt, mode) } else { solve_reverse(g, wp, wt, mode) };
-        let other = match solve(StatorMode::Locked) {
-            Some(locked) => with_clutch(locked, || solve(StatorMode::FreeWheeling), wt, scale)?,
-            None => match solve(StatorMode::FreeWheeling) {
+        let other = match solve(-direction, StatorMode::Locked) {
+            Some(locked) => with_clutch(locked, || solve(-direction, StatorMode::FreeWheeling), wt)?,
+            None => match solve(-direction, StatorMode::FreeWheeling) {
                 Some(free) if free.is_finite() && free.stator_speed_rad_s.re() >= 0.0 => free,
                 _ => first,
             },
@@ -666,16 +777,15 @@ fn with_clutch<T: Scalar>(
     locked: HtSteadyState<T>,
     free: impl FnOnce() -> Option<HtSteadyState<T>>,
     wt: T,
-    scale: f64,
-) -> CoreResult<HtSteadyState<T>> {
+) -> Result<HtSteadyState<T>, SteadyFailure> {
     if !locked.is_finite() {
-        return Err(overflow(scale));
+        return Err(SteadyFailure::Overflow);
     }
     if locked.stator_torque_nm.re() >= 0.0 {
         return Ok(locked);
     }
     match free() {
-        Some(free) if !free.is_finite() => Err(overflow(scale)),
+        Some(free) if !free.is_finite() => Err(SteadyFailure::Overflow),
         Some(free) if free.stator_speed_rad_s.re() >= 0.0 => Ok(free),
         _ => Ok(no_flow(wt)),
     }
@@ -699,14 +809,15 @@ pub fn drive_steady_state<T: Scalar>(
     if !(0.0..=1.0).contains(&sr) {
         return Err(CoreError::of(InputSource::Drive, "speed_ratio", sr, "a speed ratio from 0 to 1 (drive)"));
     }
-    let locked = locked_steady_state(g, wp, wt).ok_or_else(|| {
+    let k = HtConstants::new(g);
+    let locked = solve_mode(&k, wp, wt, StatorMode::Locked).ok_or_else(|| {
         CoreError::new(
             "speed_ratio",
             sr,
             "an operating point where the locked-stator head exceeds the shock losses (no steady state with positive flow for these parameters)",
         )
     })?;
-    with_clutch(locked, || solve_mode(g, wp, wt, StatorMode::FreeWheeling), wt, wp.re())
+    with_clutch(locked, || solve_mode(&k, wp, wt, StatorMode::FreeWheeling), wt).map_err(|e| e.error(wp.re(), wt.re()))
 }
 
 /// The coupling point: the speed ratio in (0, 1) where the locked-stator holding torque changes
@@ -715,9 +826,9 @@ pub fn drive_steady_state<T: Scalar>(
 ///
 /// Safeguarded Newton iteration on T_s(SR) with the exact derivative from [`Dual`].
 pub fn coupling_point(g: &HtGeometry<f64>) -> Option<f64> {
-    let gd = g.to_dual();
+    let k = HtConstants::new(&g.to_dual());
     let ts = |sr: f64| -> Option<(f64, f64)> {
-        let s = locked_steady_state(&gd, Dual::cst(1.0), Dual::var(sr))?;
+        let s = solve_mode(&k, Dual::cst(1.0), Dual::var(sr), StatorMode::Locked)?;
         Some((s.stator_torque_nm.v, s.stator_torque_nm.d))
     };
     let (mut lo, mut hi) = (0.0, 1.0);
@@ -1000,6 +1111,101 @@ mod tests {
         let p = Quad { c: [-1.0, 0.0, 1.0] };
         assert_eq!(largest_real_root(p).unwrap(), 1.0);
         assert!(largest_real_root(Quad { c: [1.0, 0.0, 1.0] }).is_none());
+    }
+
+    /// A scalar that counts the tangents taken (issue 16: the steady state took the six blade-angle
+    /// tangents 2–4 times per point, 54 % of its time).
+    #[derive(Debug, Clone, Copy)]
+    struct Counted(f64);
+
+    thread_local! {
+        static TANGENTS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+    }
+
+    impl std::ops::Add for Counted {
+        type Output = Self;
+        fn add(self, o: Self) -> Self {
+            Self(self.0 + o.0)
+        }
+    }
+    impl std::ops::Sub for Counted {
+        type Output = Self;
+        fn sub(self, o: Self) -> Self {
+            Self(self.0 - o.0)
+        }
+    }
+    impl std::ops::Mul for Counted {
+        type Output = Self;
+        fn mul(self, o: Self) -> Self {
+            Self(self.0 * o.0)
+        }
+    }
+    impl std::ops::Div for Counted {
+        type Output = Self;
+        fn div(self, o: Self) -> Self {
+            Self(self.0 / o.0)
+        }
+    }
+    impl std::ops::Neg for Counted {
+        type Output = Self;
+        fn neg(self) -> Self {
+            Self(-self.0)
+        }
+    }
+    impl Scalar for Counted {
+        fn cst(v: f64) -> Self {
+            Self(v)
+        }
+        fn re(self) -> f64 {
+            self.0
+        }
+        fn sqrt(self) -> Self {
+            Self(self.0.sqrt())
+        }
+        fn tan(self) -> Self {
+            TANGENTS.with(|c| c.set(c.get() + 1));
+            Self(self.0.tan())
+        }
+    }
+
+    /// One steady state takes the six tangents once, and a geometry's constants serve any number
+    /// of points without another: the same numbers, bit for bit, as the plain `f64` path.
+    #[test]
+    fn a_steady_state_takes_the_six_tangents_once_per_geometry() {
+        let g = HtGeometry::appendix_d();
+        let counted = HtGeometry { values: g.values.map(Counted) };
+        let taken = || TANGENTS.with(|c| c.get());
+        let before = taken();
+        steady_state(&counted, Counted(WP), Counted(0.5 * WP)).unwrap();
+        assert_eq!(taken() - before, 6, "tangents of one steady state");
+        let k = HtConstants::new(&counted);
+        let before = taken();
+        for wp in [-WP, 0.0, WP] {
+            for sr in [-3.0, -0.5, 0.0, 0.5, 0.95, 0.995, 1.0, 1.02, 1.2, 3.0] {
+                let s = steady_state_with(&k, Counted(wp), Counted(sr * WP)).unwrap();
+                let f = steady_state(&g, wp, sr * WP).unwrap();
+                let bits = |v: [f64; 5]| v.map(f64::to_bits);
+                assert_eq!(
+                    bits([
+                        s.flow_m3_s.0,
+                        s.stator_speed_rad_s.0,
+                        s.pump_torque_nm.0,
+                        s.turbine_torque_nm.0,
+                        s.stator_torque_nm.0
+                    ]),
+                    bits([
+                        f.flow_m3_s,
+                        f.stator_speed_rad_s,
+                        f.pump_torque_nm,
+                        f.turbine_torque_nm,
+                        f.stator_torque_nm
+                    ]),
+                    "{wp} {sr}"
+                );
+                assert_eq!(s.mode, f.mode);
+            }
+        }
+        assert_eq!(taken(), before, "tangents of 30 steady states from the constants");
     }
 
     #[test]
