@@ -35,17 +35,22 @@ class PeerUnavailable(RuntimeError):
     """The peer cannot be built here (no gcc or no SUNDIALS headers and libraries)."""
 
 
-def build() -> Path:
-    """The peer's binary, compiled first if missing or older than its source."""
+def available() -> bool:
+    """Whether the peer can be built here: gcc and the CVODE headers."""
+    return shutil.which("gcc") is not None and Path("/usr/include/cvode/cvode.h").exists()
+
+
+def build(binary: Path = BINARY) -> Path:
+    """The peer's binary at ``binary``, compiled first if missing or older than its source."""
     source = HERE / "takeoff.c"
-    if BINARY.exists() and BINARY.stat().st_mtime >= source.stat().st_mtime:
-        return BINARY
-    if shutil.which("gcc") is None or not Path("/usr/include/cvode/cvode.h").exists():
+    if binary.exists() and binary.stat().st_mtime >= source.stat().st_mtime:
+        return binary
+    if not available():
         raise PeerUnavailable("needs gcc and libsundials-dev (apt-get install -y libsundials-dev)")
-    done = subprocess.run(["sh", str(HERE / "build.sh")], capture_output=True, text=True)
+    done = subprocess.run(["sh", str(HERE / "build.sh"), str(binary)], capture_output=True, text=True)
     if done.returncode != 0:
         raise PeerUnavailable(f"build failed: {done.stderr.strip()}")
-    return BINARY
+    return binary
 
 
 def parameter_text(params: dict, scenario: dict) -> str:
@@ -65,12 +70,12 @@ def parameter_text(params: dict, scenario: dict) -> str:
     return "\n".join(lines) + "\n"
 
 
-def run(params: dict, scenario: dict, repeats: int, samples: int) -> dict:
+def run(params: dict, scenario: dict, repeats: int, samples: int, binary: Path = BINARY) -> dict:
     """Run the peer: ``median_s``, ``fastest_s`` per run, ``stats`` (steps, rhs, jac, lu, roots: CVODE's
     counters summed over the run's segments), ``events`` [(time_s, kind)] and the sample columns
     (:data:`SAMPLE_COLUMNS`, equally spaced over the scenario's span) as arrays."""
     done = subprocess.run(
-        [str(build()), str(repeats), str(samples)],
+        [str(build(binary)), str(repeats), str(samples)],
         input=parameter_text(params, scenario),
         capture_output=True,
         text=True,

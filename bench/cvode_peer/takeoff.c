@@ -384,7 +384,8 @@ int main(int argc, char **argv) {
   SUNContext ctx;
   if (SUNContext_Create(NULL, &ctx)) return 1;
   double *times = malloc(sizeof(double) * ns), *wall = malloc(sizeof(double) * reps);
-  for (int i = 0; i < ns; i++) times[i] = p.t_end * i / (ns - 1);
+  for (int i = 0; i < ns; i++) times[i] = i * (p.t_end / (ns - 1)); /* as numpy.linspace */
+  times[ns - 1] = p.t_end;
   Samples s;
   double **cols[] = {&s.t, &s.wp, &s.wt, &s.ws, &s.Q, &s.Tp, &s.Tt, &s.Ts, &s.Ploss};
   Stats st;

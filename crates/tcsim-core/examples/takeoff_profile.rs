@@ -7,8 +7,14 @@
 //! the steps per run and the median wall time of the two phases: `simulate` (integration with its
 //! sampling) and `columns` (the 27 output columns). For counts and the split by function, run it
 //! under `valgrind --tool=callgrind` with two run counts and take the difference (bench/README.md).
+//!
+//! `... --example takeoff_profile -- batch RUNS SAMPLES THREADS...` runs RUNS take-offs as one batch
+//! ([`run_transient_jobs`], the core of `simulate_batch` without Python) with each thread count and
+//! prints the wall time and the process's CPU time (user + system, from `/proc/self/stat`) per run,
+//! and the speed-up over the first thread count.
 use std::time::Instant;
 
+use tcsim_core::batch::{run_transient_jobs, TransientJob};
 use tcsim_core::converter::dynamics::{HtDynamics, Inertias};
 use tcsim_core::converter::hrovat_tobler::HtGeometry;
 use tcsim_core::engine::isolated::{simulate, Drive, InitialState, TurbineLoad};
@@ -21,11 +27,8 @@ fn median(v: &mut [f64]) -> f64 {
     v[v.len() / 2]
 }
 
-fn main() {
-    let args: Vec<usize> = std::env::args().skip(1).map(|a| a.parse().expect("RUNS SAMPLES: integers")).collect();
-    let runs = args.first().copied().unwrap_or(200).max(1);
-    let samples = args.get(1).copied().unwrap_or(1001).max(2);
-    // python/tcsim/data/converters/li-sunden-2016.toml
+/// The bundled converter (python/tcsim/data/converters/li-sunden-2016.toml) and drive c of `bench/`.
+fn takeoff() -> (HtDynamics, Drive) {
     let model = HtDynamics::new(
         HtGeometry::appendix_d(),
         Inertias::new(0.109, 0.056, 0.01).unwrap(),
@@ -39,6 +42,62 @@ fn main() {
         load: TurbineLoad { torque_nm: Signal::constant(10.0), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 },
         lockup: None,
     };
+    (model, drive)
+}
+
+/// CPU time of this process so far (user + system), s; clock ticks of 1/100 s (Linux).
+fn cpu_time_s() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").expect("Linux /proc");
+    let fields: Vec<&str> = stat.rsplit(')').next().unwrap_or("").split_whitespace().collect();
+    // after the command name: state is field 3, utime 14 and stime 15 (1-based, proc(5))
+    let tick = |i: usize| fields[i - 3].parse::<f64>().unwrap_or(0.0) / 100.0;
+    tick(14) + tick(15)
+}
+
+fn batch(runs: usize, samples: usize, threads: &[usize]) {
+    let (model, drive) = takeoff();
+    let t: Vec<f64> = (0..samples).map(|i| 10.0 * i as f64 / (samples - 1) as f64).collect();
+    let jobs: Vec<TransientJob> = (0..runs)
+        .map(|_| TransientJob {
+            model: Box::new(model.clone()),
+            drive: drive.clone(),
+            times_s: t.clone(),
+            init: InitialState::default(),
+            options: SolverOptions::default(),
+        })
+        .collect();
+    let mut first = None;
+    for &n in threads {
+        let (cpu0, start) = (cpu_time_s(), Instant::now());
+        let out = run_transient_jobs(&jobs, n);
+        let (wall, cpu) = (start.elapsed().as_secs_f64(), cpu_time_s() - cpu0);
+        assert!(out.iter().all(Result::is_ok));
+        drop(out);
+        let base = *first.get_or_insert(wall);
+        println!(
+            "{runs} runs, {samples} samples, {n} threads: {:.1} µs/run wall, {:.1} µs/run CPU, speed-up {:.2}",
+            wall / runs as f64 * 1e6,
+            cpu / runs as f64 * 1e6,
+            base / wall
+        );
+    }
+}
+
+fn main() {
+    let words: Vec<String> = std::env::args().skip(1).collect();
+    let is_batch = words.first().is_some_and(|w| w == "batch");
+    let args: Vec<usize> = words
+        .iter()
+        .skip(usize::from(is_batch))
+        .map(|a| a.parse().expect("RUNS SAMPLES [THREADS...]: integers"))
+        .collect();
+    let runs = args.first().copied().unwrap_or(200).max(1);
+    let samples = args.get(1).copied().unwrap_or(1001).max(2);
+    if is_batch {
+        let threads = if args.len() > 2 { args[2..].to_vec() } else { vec![1, 2] };
+        return batch(runs, samples, &threads);
+    }
+    let (model, drive) = takeoff();
     let t: Vec<f64> = (0..samples).map(|i| 10.0 * i as f64 / (samples - 1) as f64).collect();
     let (mut sim, mut col) = (Vec::new(), Vec::new());
     let mut steps = 0;
