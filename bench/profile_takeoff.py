@@ -12,6 +12,11 @@ call counts per function come from ``callgrind_annotate``. Programs:
   SAMPLES samples, default options; ``simulate`` then the 27 ``columns``).
 * peer: ``bench/cvode_peer/takeoff`` (same take-off; 9 output columns).
 
+Then, in wall time (medians of ``WALL_REPEATS`` in this process, so the machine's load enters): one
+``tcsim.transient.simulate`` through the Python API, and inside it the core call
+(``_core.transient_runs``: the run, its 27 columns and their conversion to NumPy arrays); the rest
+is Python (checking inputs, building the result).
+
 The split printed for tcsim: *integration* is ``run_segment`` less the sampling inside it; of it,
 *our callbacks* are the right-hand side, the Jacobian-vector products, the mass products and the
 root functions, and *diffsol* is the rest (BDF bookkeeping, Newton, LU, root finding, allocation);
@@ -23,18 +28,26 @@ from __future__ import annotations
 
 import os
 import re
+import statistics
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(__file__))
+import numpy as np  # noqa: E402
+
 import cvode_peer  # noqa: E402
 import scipy_reference as ref  # noqa: E402
+import tcsim.simulation.transient as transient  # noqa: E402
+from tcsim.models.drives import isolated_takeoff  # noqa: E402
+from tcsim.models.dynamic import dynamic_model  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "target/release/examples/takeoff_profile"
 RUNS = (2, 12)
+WALL_REPEATS = 300
 LINE = re.compile(r"\s*([\d,]+) \(\s*[\d.]+%\)\s+([*<>]\s+)?(\S.*?) \[")
 CALLS = re.compile(r"\(([\d,]+)x\)")
 
@@ -161,7 +174,42 @@ def peer_profile(samples: int) -> None:
     print(f"  rest (initial state...) {pct(total - exact(cost, 'CVode') - exact(cost, 'sample'))}")
 
 
+def python_split(samples: int) -> None:
+    """Median wall time of ``simulate`` through the Python API and of the core call inside it."""
+    core, core_times = transient._core.transient_runs, []
+
+    def timed(*args):
+        t0 = time.perf_counter()
+        out = core(*args)
+        core_times.append(time.perf_counter() - t0)
+        return out
+
+    model, drive, times = (
+        dynamic_model("li-sunden-2016", "hrovat-tobler"),
+        isolated_takeoff(),
+        np.linspace(0, 10, samples),
+    )
+    transient._core.transient_runs = timed
+    try:
+        transient.simulate(model, drive, times_s=times)
+        core_times.clear()
+        totals = []
+        for _ in range(WALL_REPEATS):
+            t0 = time.perf_counter()
+            transient.simulate(model, drive, times_s=times)
+            totals.append(time.perf_counter() - t0)
+    finally:
+        transient._core.transient_runs = core
+    total, inside = statistics.median(totals), statistics.median(core_times)
+    print(
+        f"Python API, {samples} samples (wall, median of {WALL_REPEATS}, load {os.getloadavg()[0]:.1f}): simulate "
+        f"{total * 1e6:.0f} µs, of which the core call {inside * 1e6:.0f} µs and Python "
+        f"{(total - inside) * 1e6:.0f} µs ({100 * (total - inside) / total:.0f} %)"
+    )
+
+
 if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 1001
     tcsim_profile(n)
     peer_profile(n)
+    python_split(n)
