@@ -16,7 +16,7 @@
  * defaults, crates/tcsim-core/src/engine/options.rs). Root finding as tcsim does it: LOCKED, the
  * holding torque T_s = rho*Ss*Q' - F_s (+1e-6 N m hysteresis), falling, releases the stator; FREE,
  * ws (+1e-4 rad/s), falling, locks it; Q (+1e-7 m^3/s), falling, is flow reversal, which this peer
- * does not model: it stops with exit status 3 (the take-off never reverses the flow). At an event
+ * does not model: it stops with exit status 1 (the take-off never reverses the flow). At an event
  * the run continues in the new mode from the state at the root (CVodeReInit). Initial state: wt = 0,
  * stator locked, wp and Q steady under the first pump torque (homogeneity: the steady state at
  * wp = 1 rad/s scaled by sqrt(Tp / Tp(1))), as tcsim's default.
@@ -24,6 +24,8 @@
  * Input (stdin): "name value..." lines, names as in scipy_reference.load_parameters() plus IL, T0,
  * cd (load), table_t and table_T (pump torque table: count then values), t_end (s).
  * Usage: takeoff REPEATS SAMPLES < params.txt
+ * Exit status: 0; 2 and one line "error: <where>: <name> = <value>: expected <what>" for bad arguments or
+ * parameters; 1 and one "error: ..." line when CVODE fails or the flow reaches zero (not the input's fault).
  * Output (stdout): "timing median_s min_s repeats", "stats steps rhs jac lu roots", one "event t
  * kind" line per event, then one "sample t wp wt ws Q Tp Tt Ts Ploss" line per sample (last run).
  * Each run (timed with clock_gettime, CLOCK_MONOTONIC) does everything from the parameters to the
@@ -291,14 +293,17 @@ static int initial_state(const Params *p, double u[4]) {
   return 0;
 }
 
-/* One take-off: 0 on success, 3 on flow reversal (not modelled), 2 on a solver failure. */
+static double last_t; /* time reached by the last run, s (for the failure message) */
+
+/* One take-off: 0 on success, 2 on a solver failure, 3 on flow reversal (not modelled), 4 without a
+ * steady initial state. */
 static int run(const Params *p, SUNContext ctx, const double *times, int ns, Samples *s, Stats *st) {
   Mode modes[2];
   mode_init(&modes[LOCKED], p, LOCKED);
   mode_init(&modes[FREE], p, FREE);
   memset(st, 0, sizeof *st);
   double u[4];
-  if (initial_state(p, u)) return 2;
+  if (initial_state(p, u)) return 4;
   int mode = LOCKED, k = 0;
   Cv cv;
   if (cv_start(&cv, ctx, &modes[mode], 0.0, u, p->t_end)) return 2;
@@ -306,6 +311,7 @@ static int run(const Params *p, SUNContext ctx, const double *times, int ns, Sam
   while (k < ns && times[k] <= t) sample(&modes[mode], u, times[k], s, k), k++;
   while (k < ns) {
     int flag = CVode(cv.mem, times[k], cv.y, &t, CV_NORMAL);
+    last_t = t;
     if (flag < 0) return cv_stop(&cv, st), 2;
     full(&modes[mode], N_VGetArrayPointer(cv.y), u);
     if (flag == CV_ROOT_RETURN) {
@@ -327,8 +333,18 @@ static int run(const Params *p, SUNContext ctx, const double *times, int ns, Sam
   return 0;
 }
 
+/* A number from the token `text` of parameter `name`; else one error line (project format) and 0. */
+static int number(const char *name, const char *text, double *out) {
+  char *end;
+  *out = strtod(text, &end);
+  if (end != text && *end == '\0' && isfinite(*out)) return 1;
+  fprintf(stderr, "error: stdin: %s = %s: expected a finite number\n", name, text);
+  return 0;
+}
+
+/* Parameters from stdin; 0 on success, else one error line on stderr and 1. */
 static int read_params(Params *p) {
-  char name[64];
+  char name[64], text[64];
   memset(p, 0, sizeof *p);
   p->t_end = 10.0;
   struct { const char *n; double *v; } keys[] = {
@@ -337,25 +353,40 @@ static int read_params(Params *p) {
       {"ttt", &p->ttt}, {"tss", &p->tss}, {"Cp", &p->Cp}, {"Ct", &p->Ct}, {"Cs", &p->Cs}, {"f", &p->f},
       {"Lf", &p->Lf}, {"Sp", &p->Sp}, {"St", &p->St}, {"Ss", &p->Ss}, {"IL", &p->IL}, {"T0", &p->T0},
       {"cd", &p->cd}, {"t_end", &p->t_end}};
-  int nkeys = sizeof keys / sizeof keys[0];
+  int nkeys = sizeof keys / sizeof keys[0], ntab[2] = {0, 0};
   while (scanf("%63s", name) == 1) {
+    if (scanf("%63s", text) != 1) strcpy(text, "(missing)");
     if (!strcmp(name, "table_t") || !strcmp(name, "table_T")) {
-      double *dst = name[6] == 't' ? p->tab_t : p->tab_T;
-      int n;
-      if (scanf("%d", &n) != 1 || n < 1 || n > MAXTAB) return 1;
-      for (int i = 0; i < n; i++)
-        if (scanf("%lf", &dst[i]) != 1) return 1;
-      p->ntab = n;
+      int table = name[6] == 'T', n = atoi(text);
+      double *dst = table ? p->tab_T : p->tab_t;
+      if (n < 1 || n > MAXTAB) {
+        fprintf(stderr, "error: stdin: %s = %s: expected a count of 1 to %d values, then the values\n", name, text,
+                MAXTAB);
+        return 1;
+      }
+      for (int i = 0; i < n; i++) {
+        if (scanf("%63s", text) != 1) strcpy(text, "(missing)");
+        if (!number(name, text, &dst[i])) return 1;
+      }
+      ntab[table] = n;
       continue;
     }
     int i = 0;
     while (i < nkeys && strcmp(keys[i].n, name)) i++;
-    if (i == nkeys || scanf("%lf", keys[i].v) != 1) {
-      fprintf(stderr, "error: stdin: %s: expected a known name and a number\n", name);
+    if (i == nkeys) {
+      fprintf(stderr, "error: stdin: %s = %s: expected a parameter name of scipy_reference.load_parameters(), IL, "
+                      "T0, cd, t_end, table_t or table_T\n", name, text);
       return 1;
     }
+    if (!number(name, text, keys[i].v)) return 1;
   }
-  return p->ntab < 1;
+  if (ntab[0] < 1 || ntab[0] != ntab[1]) {
+    fprintf(stderr, "error: stdin: table_t = %d values: expected a pump torque table, table_T of as many values\n",
+            ntab[0]);
+    return 1;
+  }
+  p->ntab = ntab[0];
+  return 0;
 }
 
 static double now(void) {
@@ -371,15 +402,18 @@ static int cmp(const void *a, const void *b) {
 
 int main(int argc, char **argv) {
   if (argc != 3) {
-    fprintf(stderr, "usage: takeoff REPEATS SAMPLES < params.txt\n");
-    return 1;
+    fprintf(stderr, "error: argv: %d arguments: expected REPEATS SAMPLES (usage: takeoff REPEATS SAMPLES < params)\n",
+            argc - 1);
+    return 2;
   }
   int reps = atoi(argv[1]), ns = atoi(argv[2]);
-  Params p;
-  if (reps < 1 || ns < 2 || read_params(&p)) {
-    fprintf(stderr, "error: bad arguments or parameters\n");
-    return 1;
+  if (reps < 1 || ns < 2) {
+    fprintf(stderr, "error: argv: %s = %s: expected REPEATS >= 1 and SAMPLES >= 2\n", reps < 1 ? "REPEATS" : "SAMPLES",
+            reps < 1 ? argv[1] : argv[2]);
+    return 2;
   }
+  Params p;
+  if (read_params(&p)) return 2;
   derive(&p);
   SUNContext ctx;
   if (SUNContext_Create(NULL, &ctx)) return 1;
@@ -400,10 +434,15 @@ int main(int argc, char **argv) {
     if (r < reps - 1)
       for (int c = 0; c < 9; c++) free(*cols[c]);
   }
-  if (status) {
-    fprintf(stderr, status == 3 ? "error: the flow reached zero (flow reversal is not modelled)\n"
-                                : "error: CVODE failed\n");
-    return status;
+  if (status == 4) {
+    fprintf(stderr, "error: stdin: table_T = %g: expected a first pump torque that the converter absorbs at a "
+                    "steady state (positive)\n", p.tab_T[0]);
+    return 2;
+  }
+  if (status) { /* not the user's input: exit 1 */
+    fprintf(stderr, status == 3 ? "error: the flow reached zero at t = %g s: flow reversal is not modelled by this peer\n"
+                                : "error: CVODE failed at t = %g s\n", last_t);
+    return 1;
   }
   qsort(wall, reps, sizeof(double), cmp);
   printf("timing %.9e %.9e %d\n", wall[reps / 2], wall[0], reps);
