@@ -57,10 +57,15 @@ LOCAL = "local"
 class ChunkedStudy(Protocol):
     """What :func:`chunk_rows` needs of a study: plain, picklable data."""
 
-    #: The kind of study, recorded in its manifest (``appendix-d``).
-    kind: str
-    #: The columns of its rows, in order.
-    columns: tuple[str, ...]
+    @property
+    def kind(self) -> str:
+        """The kind of study, recorded in its manifest (``appendix-d``)."""
+        ...
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        """The columns of its rows, in order."""
+        ...
 
     @property
     def n_cases(self) -> int: ...

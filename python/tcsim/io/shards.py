@@ -11,8 +11,8 @@ Layout of ``DIR``
   everything its rows depend on, the speed unit and the tcsim version), ``chunk_size`` (cases per
   chunk), ``n_cases``, ``n_chunks``, ``columns`` (name and Arrow type of each) and ``chunks``: for
   each finished chunk its ``file``, ``rows``, ``size`` (bytes) and ``sha256``. It is rewritten
-  (temporary file and rename) after each shard, SIGINT and SIGTERM held back in between, so a
-  shard is listed only once it is in place.
+  (temporary file and rename) as each shard is renamed into place, SIGINT and SIGTERM held back
+  from the shard's rename to the manifest's, so that the shards in place are the listed ones.
 
 Rules
 -----
@@ -205,22 +205,6 @@ def _columns(table: pa.Table) -> list[dict[str, str]]:
     return [{"name": f.name, "type": str(f.type)} for f in table.schema]
 
 
-def _write_shard(out: Path, index: int, table: pa.Table) -> dict[str, Any]:
-    """``table`` as the shard of chunk ``index`` (temporary file, then rename); its manifest entry."""
-    rel = f"{SHARDS}/{shard_name(index)}"
-    with _blocked():
-        fd, name = tempfile.mkstemp(prefix=f".{shard_name(index)}.", suffix=".partial", dir=out / SHARDS)
-        os.close(fd)
-    try:
-        pq.write_table(table, name)
-        entry = {"file": rel, "rows": table.num_rows, "size": os.path.getsize(name), "sha256": _sha256(Path(name))}
-        os.replace(name, out / rel)
-    finally:
-        with _blocked(), contextlib.suppress(FileNotFoundError):
-            os.unlink(name)
-    return entry
-
-
 def _prepare(
     out: Path, record: dict[str, Any], chunk_size: int, n_cases: int, inputs: Sequence[str | Path]
 ) -> dict[str, Any]:
@@ -300,16 +284,27 @@ def run_to_shards(
 
 
 def _store(out: Path, manifest: dict[str, Any], index: int, table: pa.Table) -> None:
-    """Write chunk ``index``'s shard and list it in the manifest (signals held back in between)."""
+    """Write chunk ``index``'s shard to a temporary file, then rename it into place and list it in
+    the manifest with SIGINT and SIGTERM held back, so that a shard in place is a listed one."""
     columns = _columns(table)
     if manifest["columns"] is None:
         manifest["columns"] = columns
     elif manifest["columns"] != columns:
         raise RuntimeError(f"chunk {index} has the columns {columns}, not the study's {manifest['columns']}")
-    entry = _write_shard(out, index, table)
+    rel = f"{SHARDS}/{shard_name(index)}"
     with _blocked():
-        manifest["chunks"][str(index)] = entry
-        _write_manifest(out, manifest)
+        fd, name = tempfile.mkstemp(prefix=f".{shard_name(index)}.", suffix=".partial", dir=out / SHARDS)
+        os.close(fd)
+    try:
+        pq.write_table(table, name)
+        entry = {"file": rel, "rows": table.num_rows, "size": os.path.getsize(name), "sha256": _sha256(Path(name))}
+        with _blocked():
+            os.replace(name, out / rel)
+            manifest["chunks"][str(index)] = entry
+            _write_manifest(out, manifest)
+    finally:
+        with _blocked(), contextlib.suppress(FileNotFoundError):
+            os.unlink(name)
 
 
 def read_shards(out: str | Path, columns: Sequence[str] | None = None) -> pd.DataFrame:
