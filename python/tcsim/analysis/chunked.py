@@ -23,6 +23,7 @@ A worker that dies loses only its chunks in flight, which the scheduler gives to
 
 from __future__ import annotations
 
+import functools
 import importlib
 import math
 import os
@@ -91,7 +92,7 @@ class AppendixDStudy:
     kind: str = "appendix-d"
     columns: tuple[str, ...] = tuple(COLUMNS)
 
-    @property
+    @functools.cached_property
     def n_cases(self) -> int:
         return case_count(self.study, self.references)
 

@@ -167,8 +167,7 @@ def _write_manifest(out: Path, manifest: dict[str, Any]) -> None:
     fd, name = tempfile.mkstemp(prefix=f".{MANIFEST}.", suffix=".partial", dir=out)
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
-            json.dump(manifest, f, indent=1, allow_nan=True)
-            f.write("\n")
+            f.write(json.dumps(manifest, allow_nan=True) + "\n")  # compact, by the C encoder
         os.replace(name, out / MANIFEST)
     finally:
         with contextlib.suppress(FileNotFoundError):
