@@ -233,3 +233,71 @@ def test_an_interrupted_study_keeps_its_finished_shards_and_resumes(tmp_path, si
     run_to_shards(appendix_d_study(conv, definition), out, 10, on_chunk=seen.append)
     assert sorted(seen) == [i for i in range(n_chunks) if str(i) not in done]
     pd.testing.assert_frame_equal(read_shards(out), run_study(conv, definition), check_exact=True)
+
+
+# --------------------------------------------------------------------------------------------
+# on a dask cluster (the optional extra tcsim[dask])
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=50
+    ) as c:
+        yield c
+
+
+class ClientStopped(Exception):
+    """Raised from the hook: the client stops mid-study as if killed."""
+
+
+@pytest.mark.subprocess
+def test_dask_chunks_are_the_unchunked_study_bit_for_bit(tmp_path, cluster, study, unchunked):
+    run = run_to_shards(study, tmp_path / "s", 13, scheduler=cluster.scheduler_address)
+    assert sorted(run.computed) == list(range(run.n_chunks))
+    pd.testing.assert_frame_equal(read_shards(tmp_path / "s"), unchunked, check_exact=True)
+
+
+@pytest.mark.subprocess
+def test_a_study_whose_worker_and_then_client_die_resumes_to_the_uninterrupted_result(
+    tmp_path, cluster, study, unchunked
+):
+    """Acceptance (issue 16): kill one of the two workers mid-study (SIGKILL of its process), then
+    stop the client; the rerun computes only the chunks not yet written and gives the same rows."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
+        pids = client.run(os.getpid)
+    victim = sorted(pids.values())[0]
+    out = tmp_path / "s"
+    written: list[int] = []
+
+    def hook(index: int) -> None:
+        written.append(index)
+        if len(written) == 3:  # chunks are still in flight (two per worker are submitted at a time)
+            os.kill(victim, signal.SIGKILL)
+        if len(written) == 12:
+            raise ClientStopped
+
+    with pytest.raises(ClientStopped):
+        run_to_shards(study, out, 10, scheduler=cluster.scheduler_address, on_chunk=hook)
+    done = sorted(int(i) for i in listed(out))
+    assert done == sorted(written) and len(done) == 12
+    assert not list((out / SHARDS).glob("*.partial"))
+    run = run_to_shards(study, out, 10, scheduler=cluster.scheduler_address)
+    assert run.kept == done  # never recomputed
+    assert sorted(run.computed) == [i for i in range(run.n_chunks) if i not in done]
+    pd.testing.assert_frame_equal(read_shards(out), unchunked, check_exact=True)
+    with distributed.Client(cluster.scheduler_address, set_as_default=False) as client:
+        assert victim not in client.run(os.getpid).values()  # the worker was killed (the nanny started another)
+
+
+@pytest.mark.subprocess
+def test_the_command_line_on_a_local_cluster(cli, tmp_path, conv):
+    pytest.importorskip("distributed")
+    args = ["--chunk-size", "10", "--values-per-parameter", "3", "--scheduler", "local", "--workers", "2"]
+    r = cli("study", "li-sunden-2016", "--out", tmp_path / "s", *args)
+    assert r.code == 0, r.stderr
+    assert "51 cases, 969 points in 6 chunks of 10 cases (6 computed, 0 kept" in r.stdout
+    expected = run_study(conv, default_definition().replace(values_per_parameter=3))
+    pd.testing.assert_frame_equal(read_shards(tmp_path / "s"), expected, check_exact=True)

@@ -1,5 +1,5 @@
-"""Studies computed in chunks: the compute side of sharded, resumable studies (docs/models.md,
-"Large studies: chunks, shards and resuming"; the shard files are :mod:`tcsim.io.shards`).
+"""Studies computed in chunks: the compute side of sharded, resumable studies (docs/study.md,
+"Large studies"; the shard files are :mod:`tcsim.io.shards`).
 
 A study is an ordered list of ``n_cases`` cases. With a chunk size N, chunk ``i`` is the cases
 ``i·N`` to ``min((i+1)·N, n_cases)``, and its rows are a pure function of the study (plain data:
