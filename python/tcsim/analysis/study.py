@@ -147,20 +147,47 @@ def _valid_row(row: np.ndarray) -> bool:
     return True
 
 
-def _cases(converter: Converter, definition: StudyDefinition) -> tuple[pd.DataFrame, np.ndarray]:
-    """One (parameter, value) per case with its geometry row in core order and units."""
+def _parameter_values(definition: StudyDefinition, references: tuple[float, ...]) -> list[np.ndarray]:
+    """The values of each parameter of ``definition`` (file units), given the converter's own values."""
+    return [p.values(r, definition.values_per_parameter) for p, r in zip(definition.parameters, references)]
+
+
+def _references(converter: Converter, definition: StudyDefinition) -> tuple[float, ...]:
     geometry = converter.geometry
     assert geometry is not None  # run_study's converter.require checked it
-    base = geometry.core_row()
-    names, values, rows = [], [], []
-    for p in definition.parameters:
+    return tuple(float(getattr(geometry, p.key)) for p in definition.parameters)
+
+
+def case_count(definition: StudyDefinition, references: tuple[float, ...]) -> int:
+    """How many (parameter, value) cases the study has: its number of geometries."""
+    return sum(len(v) for v in _parameter_values(definition, references))
+
+
+def _cases(
+    base: np.ndarray,
+    definition: StudyDefinition,
+    references: tuple[float, ...],
+    start: int = 0,
+    stop: int | None = None,
+) -> tuple[pd.DataFrame, np.ndarray]:
+    """The cases ``start`` to ``stop`` (exclusive; all by default) in the study's order: one
+    (parameter, value) per case with its geometry row (``base``, the converter's row, with that
+    parameter changed) in core order and units. Only the rows of the slice are built."""
+    names: list[str] = []
+    values: list[float] = []
+    rows: list[np.ndarray] = []
+    first = 0
+    for p, parameter_values in zip(definition.parameters, _parameter_values(definition, references)):
+        last = first + len(parameter_values)
+        lo, hi = max(start, first), last if stop is None else min(stop, last)
         j = STEADY_KEYS.index(p.key)
-        for v in p.values(getattr(geometry, p.key), definition.values_per_parameter):
+        for v in parameter_values[lo - first : hi - first] if lo < hi else ():
             row = base.copy()
             row[j] = v * STEADY_SCALE[j]
             names.append(p.key)
             values.append(float(v))
             rows.append(row)
+        first = last
     cases = pd.DataFrame({"parameter": names, "parameter_value": values})
     return cases, np.array(rows, dtype=float).reshape(-1, len(STEADY_KEYS))
 
@@ -194,9 +221,25 @@ def run_study(converter: Converter, definition: StudyDefinition | None = None) -
     """
     converter.require("hrovat-tobler")
     definition = definition or default_definition()
+    _check_definition(definition)
+    assert converter.geometry is not None
+    return study_rows(converter.geometry.core_row(), definition, _references(converter, definition))
+
+
+def study_rows(
+    base: np.ndarray,
+    definition: StudyDefinition,
+    references: tuple[float, ...],
+    start: int = 0,
+    stop: int | None = None,
+) -> pd.DataFrame:
+    """The rows of the cases ``start`` to ``stop`` of the study (:func:`run_study`'s table for all of
+    them): a pure function of the converter's geometry row ``base`` (core order and units), the
+    definition and the converter's own values of its parameters (``references``, file units). Every
+    point is computed on its own, so the rows of a slice are those of the whole study, bit for bit."""
     sr = _check_definition(definition)
     wp = definition.pump_speed_rpm * RAD_S_PER_RPM
-    cases, rows = _cases(converter, definition)
+    cases, rows = _cases(np.asarray(base, dtype=float), definition, references, start, stop)
     valid = np.array([_valid_row(r) for r in rows], dtype=bool)
     n_sr = len(sr)
     n = len(rows) * n_sr
@@ -210,8 +253,8 @@ def run_study(converter: Converter, definition: StudyDefinition | None = None) -
         mode[ok] = [STATOR_MODES[int(m)] for m in out["stator_mode"]]
     df = pd.DataFrame(
         {
-            "parameter": np.repeat(cases["parameter"].to_numpy(), n_sr),
-            "parameter_value": np.repeat(cases["parameter_value"].to_numpy(), n_sr),
+            "parameter": np.repeat(cases["parameter"].to_numpy(dtype=object), n_sr),
+            "parameter_value": np.repeat(cases["parameter_value"].to_numpy(dtype=float), n_sr),
             "speed_ratio": np.tile(sr, len(rows)),
             **cols,
             "stator_mode": mode,

@@ -172,6 +172,10 @@ def interrupt_line(e: KeyboardInterrupt) -> tuple[str, int]:
 
     signum = e.signum if isinstance(e, Interrupted) else signal.SIGINT
     name = signal.Signals(signum).name
+    shards = sys.modules.get("tcsim.io.shards")  # a sharded study keeps its finished chunks
+    if shards is not None and shards.resumable:
+        where = ", ".join(shards.resumable)
+        return f"interrupted ({name}): the finished chunks in {where} are kept; run it again to resume", 128 + signum
     if outputs.committed:
         done = ", ".join(str(p) for p in outputs.committed)
         return f"interrupted ({name}) after {done} was written completely", 128 + signum
@@ -185,6 +189,8 @@ def main(argv: list[str] | None = None) -> int:
     warnings.showwarning = _show_warning
     outputs.command_line = ["tcsim", *(sys.argv[1:] if argv is None else argv)]
     outputs.committed.clear()
+    if (shards := sys.modules.get("tcsim.io.shards")) is not None:
+        shards.resumable.clear()
     _received.clear()
     try:
         with _signals_raise():

@@ -1,4 +1,9 @@
-"""``tcsim study``: the parameter study of Li & Sundén (2016), Appendix D."""
+"""``tcsim study``: the parameter study of Li & Sundén (2016), Appendix D.
+
+Without ``--chunk-size``: DIR/study.csv and one figure per parameter, written atomically. With
+``--chunk-size N``: the study in chunks of N cases, each written as a Parquet shard as it finishes
+(``tcsim.io.shards``), resumable, optionally on a dask cluster (``--scheduler``).
+"""
 
 from __future__ import annotations
 
@@ -7,11 +12,23 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from ..errors import InputError
 from .app import FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 if TYPE_CHECKING:
     from ..analysis.study import StudyDefinition
     from ..io.tables import TableFormat
+
+#: ``--values-per-parameter``: the most with ``--chunk-size``, and without it (one curve per value
+#: in each figure).
+MAX_VALUES_PER_PARAMETER = 1_000_000
+MAX_VALUES_PER_PARAMETER_UNCHUNKED = 1000
+
+HELP = (
+    "Appendix D parameter study: one figure per parameter and DIR/study.csv; with --chunk-size, "
+    "DIR/shards/part-NNNNN.parquet and DIR/manifest.json instead, written as the chunks finish and "
+    "resumed by running the same command again."
+)
 
 
 def study_command(
@@ -46,12 +63,85 @@ def study_command(
     return study_line(df, definition, Path(out), tf.format)
 
 
+def sharded_study_command(
+    converter: str,
+    out: str | Path,
+    chunk_size: int,
+    definition: StudyDefinition | None = None,
+    speed_unit: str = "rad/s",
+    scheduler: str | None = None,
+    workers: int | None = None,
+    progress: bool = True,
+) -> str:
+    """The study in chunks of ``chunk_size`` cases as DIR/shards/part-NNNNN.parquet and
+    DIR/manifest.json (``tcsim.io.shards``), resuming what DIR holds; the line to print."""
+    from ..analysis.chunked import appendix_d_study, check_chunk_size, check_scheduler
+    from ..io.shards import SHARDS, run_to_shards
+    from ..models.converter import load_converter
+    from ..reports.console import progress_display
+
+    check_chunk_size(chunk_size)
+    check_scheduler(scheduler, workers)
+    conv = load_converter(converter)
+    study = appendix_d_study(conv, definition)
+    inputs = [p for p in (converter, conv.path) if p]
+    with progress_display(progress) as display:
+        task = display.add_task("study chunks", total=None)
+
+        def advance(done: int, total: int) -> None:
+            display.update(task, completed=done, total=total)
+
+        run = run_to_shards(study, out, chunk_size, speed_unit, scheduler, workers, inputs, advance)
+    return (
+        f"study: {run.n_cases} cases, {run.rows} points in {run.n_chunks} chunks of {run.chunk_size} cases "
+        f"({len(run.computed)} computed, {len(run.kept)} kept from an earlier run) in {Path(out) / SHARDS} "
+        f"and {Path(out) / 'manifest.json'}"
+    )
+
+
+def _values_per_parameter(n: int | None, chunked: bool) -> int | None:
+    if n is None:
+        return None
+    most = MAX_VALUES_PER_PARAMETER if chunked else MAX_VALUES_PER_PARAMETER_UNCHUNKED
+    if not 1 <= n <= most:
+        why = "" if chunked else " without --chunk-size (one curve per value in each figure)"
+        raise InputError("command line", "--values-per-parameter", n, f"an integer from 1 to {most}{why}")
+    return n
+
+
 def study(
     converter: Annotated[str, typer.Argument(help="converter with a [geometry] section")],
     out: OutOpt = Path("study"),
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    values_per_parameter: Annotated[
+        int | None,
+        typer.Option(help="values of each parameter over its range (default 5), plus the converter's own"),
+    ] = None,
+    chunk_size: Annotated[
+        int | None,
+        typer.Option(help="write Parquet shards of this many cases each (a case: one parameter value), resumable"),
+    ] = None,
+    scheduler: Annotated[
+        str | None,
+        typer.Option(help="with --chunk-size: 'local' (a dask LocalCluster) or a dask scheduler's address"),
+    ] = None,
+    workers: Annotated[int | None, typer.Option(help="worker processes of --scheduler local (default: cores)")] = None,
+    no_progress: Annotated[bool, typer.Option("--no-progress", help="no progress bar (--chunk-size)")] = False,
 ) -> None:
-    """Appendix D parameter study: one figure per parameter and DIR/study.csv."""
+    """The command; its help is :data:`HELP`."""
+    from ..analysis.study import default_definition
+
     tf = table_format(file_format, speed_unit)
-    say(study_command(converter, out, tf=tf))
+    n = _values_per_parameter(values_per_parameter, chunk_size is not None)
+    definition = default_definition() if n is None else default_definition().replace(values_per_parameter=n)
+    if chunk_size is None:
+        for option, value in (("--scheduler", scheduler), ("--workers", workers)):
+            if value is not None:
+                raise InputError("command line", option, value, "to be given with --chunk-size (a sharded study)")
+        say(study_command(converter, out, definition, tf=tf))
+        return
+    line = sharded_study_command(
+        converter, out, chunk_size, definition, tf.speed_unit, scheduler, workers, progress=not no_progress
+    )
+    say(line)
