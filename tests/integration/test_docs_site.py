@@ -53,15 +53,21 @@ def test_site_builds_strict(tmp_path):
     assert not (REPO / "site").exists()
 
 
-def test_launch_comparison_example(tmp_path):
+def _run_example(script: str, out: Path) -> subprocess.CompletedProcess[str]:
+    """``docs/examples/<script> --fast --out <out>``, run in ``out``; it must succeed."""
     run = subprocess.run(
-        [sys.executable, str(REPO / "docs" / "examples" / "launch_comparison.py"), "--fast", "--out", str(tmp_path)],
-        cwd=tmp_path,
+        [sys.executable, str(REPO / "docs" / "examples" / script), "--fast", "--out", str(out)],
+        cwd=out,
         capture_output=True,
         text=True,
         timeout=600,
     )
     assert run.returncode == 0, run.stderr[-4000:]
+    return run
+
+
+def test_launch_comparison_example(tmp_path):
+    run = _run_example("launch_comparison.py", tmp_path)
     figure = tmp_path / "launch_comparison.png"
     assert figure.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     rows = {line.split()[0]: line.split()[1:] for line in run.stdout.splitlines()[1:4]}
@@ -73,14 +79,7 @@ def test_launch_comparison_example(tmp_path):
 
 
 def test_design_study_example(tmp_path):
-    run = subprocess.run(
-        [sys.executable, str(REPO / "docs" / "examples" / "design_study.py"), "--fast", "--out", str(tmp_path)],
-        cwd=tmp_path,
-        capture_output=True,
-        text=True,
-        timeout=600,
-    )
-    assert run.returncode == 0, run.stderr[-4000:]
+    run = _run_example("design_study.py", tmp_path)
     assert (tmp_path / "pareto.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
     rows = [line.split() for line in run.stdout.splitlines()[1:5]]
     assert len(rows) == 4 and all(len(r) == 6 for r in rows), run.stdout  # the 2 x 2 corners, no error

@@ -434,6 +434,17 @@ struct Balance<T> {
     stator_speed: Quad<T>,
 }
 
+/// `Σ_x C_sh,x (u_x + v_x q)²` as the coefficients of `1, q, q²`: the shock term of the power loss,
+/// eq 2.19, with the three shock velocities given as `u + v q` (forward or reverse flow).
+fn shock_loss<T: Scalar>(k: &HtConstants<T>, shocks: [(T, T); 3]) -> [T; 3] {
+    let squares = |x: usize| {
+        let (u, v) = shocks[x];
+        [u * u * k.shock[x], (u * v + v * u) * k.shock[x], v * v * k.shock[x]]
+    };
+    let (sp, st, ss) = (squares(0), squares(1), squares(2));
+    std::array::from_fn(|i| sp[i] + st[i] + ss[i])
+}
+
 #[inline]
 fn balance<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, stator_speed: Quad<T>) -> Balance<T> {
     let [rp, rt, rs] = k.r;
@@ -454,12 +465,7 @@ fn balance<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, stator_speed: Quad<T>) -
     // shock velocities, eqs 2.20–2.22, as u + v q: Σ C_sh (u + v q)²
     let [bp, bt, bs] = k.shock_slope;
     let shocks = [((a - wp) * rs, b * rs + bp), ((wp - wt) * rp, bt), ((wt - a) * rt, bs - b * rt)];
-    let squares = |x: usize| {
-        let (u, v) = shocks[x];
-        [u * u * k.shock[x], (u * v + v * u) * k.shock[x], v * v * k.shock[x]]
-    };
-    let (sp, st, ss) = (squares(0), squares(1), squares(2));
-    let shock: [T; 3] = std::array::from_fn(|i| sp[i] + st[i] + ss[i]);
+    let shock = shock_loss(k, shocks);
     // friction, eqs 2.19 and 2.23–2.25: Σ|V_re,x|² = q² Σ(1 + tan²α_x); the loss is halved
     let half = T::cst(0.5);
     let loss = [shock[0] * half, shock[1] * half, (shock[2] + k.friction) * half];
@@ -586,12 +592,7 @@ fn reverse_balance<T: Scalar>(k: &HtConstants<T>, wp: T, wt: T, stator_speed: Qu
     // shock at the entry of each element, from its source (pump ← turbine ← stator ← pump), u + v p
     let [bp, bt, bs] = k.reverse_shock_slope;
     let shocks = [((wt - wp) * rp, -bp), ((a - wt) * rt, b * rt - bt), ((wp - a) * rs, -b * rs - bs)];
-    let squares = |x: usize| {
-        let (u, v) = shocks[x];
-        [u * u * k.shock[x], (u * v + v * u) * k.shock[x], v * v * k.shock[x]]
-    };
-    let (sp, st, ss) = (squares(0), squares(1), squares(2));
-    let shock: [T; 3] = std::array::from_fn(|i| sp[i] + st[i] + ss[i]);
+    let shock = shock_loss(k, shocks);
     let half = T::cst(0.5);
     let loss = [shock[0] * half, shock[1] * half, (shock[2] + k.reverse_friction) * half];
     let residual = Quad { c: std::array::from_fn(|i| (head[i] + loss[i]) * k.rho) };
