@@ -34,7 +34,7 @@ import pandas as pd
 from ..models.converter import Converter, load_converter
 from ..models.design_file import DerivedConverter, DesignFile, derive_converter
 from ..models.drives import isolated_takeoff
-from ..models.dynamic import dynamic_model
+from ..models.dynamic import DynamicModel, dynamic_model
 from ..models.steady import characterise, coupling_point
 from ..models.vehicle import Vehicle, load_vehicle
 from ..simulation.launch import LAUNCH_COLUMNS as RUN_LAUNCH_COLUMNS
@@ -128,19 +128,19 @@ def launch_scenario() -> Scenario:
     return replace(base, stop_speed_m_s=SPEED_50_KM_H_M_S)
 
 
+def _launch_models(converters: Sequence[Converter], vehicle: Vehicle | None) -> tuple[Vehicle, list[DynamicModel]]:
+    """The launch's vehicle (default: the bundled one) and the ``hrovat-tobler`` model of each converter."""
+    return (load_vehicle(None) if vehicle is None else vehicle), [dynamic_model(c, "hrovat-tobler") for c in converters]
+
+
 def launch_runs(
-    converters: Sequence[Converter],
-    labels: Sequence[str],
-    vehicle: Vehicle | None = None,
-    threads: int = 0,
-    on_error: str = "raise",
+    converters: Sequence[Converter], labels: Sequence[str], vehicle: Vehicle | None = None
 ) -> dict[str, LaunchRun]:
     """The launch (:func:`launch_scenario`) of each converter with the ``hrovat-tobler`` model on
-    ``vehicle`` (default: the bundled vehicle), in one core call (``threads`` workers); by label
-    (:func:`tcsim.simulation.launch.run_launch`, ``on_error`` as there)."""
-    models = [dynamic_model(c, "hrovat-tobler") for c in converters]
-    veh = load_vehicle(None) if vehicle is None else vehicle
-    return run_launch(veh, launch_scenario(), models, {"output_step_s": LAUNCH_STEP_S}, threads, labels, on_error)
+    ``vehicle`` (default: the bundled vehicle), in one core call; by label
+    (:func:`tcsim.simulation.launch.run_launch`: the first failure raises)."""
+    veh, models = _launch_models(converters, vehicle)
+    return run_launch(veh, launch_scenario(), models, {"output_step_s": LAUNCH_STEP_S}, labels=labels)
 
 
 def launch_column_runs(
@@ -148,8 +148,7 @@ def launch_column_runs(
 ) -> list[dict[str, np.ndarray] | Exception]:
     """:func:`launch_runs` as :data:`LAUNCH_COLUMNS` arrays only, each run or its error in its place
     (:func:`tcsim.simulation.launch.launch_columns`; for studies of thousands of designs)."""
-    models = [dynamic_model(c, "hrovat-tobler") for c in converters]
-    veh = load_vehicle(None) if vehicle is None else vehicle
+    veh, models = _launch_models(converters, vehicle)
     options = {"output_step_s": LAUNCH_STEP_S}
     return launch_columns(veh, launch_scenario(), models, LAUNCH_COLUMNS, options, threads)
 

@@ -52,6 +52,7 @@ def design(
     from ..analysis.design_report import design_report
     from ..io.design_outputs import write_design_files
     from ..io.outputs import check_output_dir, output_dir
+    from ..io.results import write_text_files
     from ..models.design_file import LOSS_DEFAULTS_FROM, load_design_file
     from ..models.vehicle import load_vehicle
     from ..plots.characteristic import plot_characteristic
@@ -74,7 +75,7 @@ def design(
             plot_design_takeoff(report.takeoffs, stage, f"{title}: isolated take-off")
             plot_design_launch(report.launches, stage, f"{title}: launch, Hrovat & Tobler")
         names = {p.name for p in Path(stage).iterdir()}
-        (Path(stage) / "report.md").write_text(report_markdown(report, file, names), encoding="utf-8")
+        write_text_files({"report.md": report_markdown(report, file, names)}, stage)
     g = report.derived.geometry
     say(
         f"{file.name}: converter.toml with S_p, S_t, S_s = {g.pump.shape_effect_m2:.6g}, "
