@@ -143,7 +143,7 @@ def main() -> None:
     ours = simulate(model, drive, times_s=TIMES)
     t_ours = median_time(lambda: simulate(model, drive, times_s=TIMES), REPEATS)
     print(
-        f"tcsim (diffsol BDF), Python API: {t_ours * 1e3:.3f} ms per run (median of {REPEATS}); "
+        f"tcsim (BDF), Python API: {t_ours * 1e3:.3f} ms per run (median of {REPEATS}); "
         f"events {[(round(e.time_s, 5), e.kind) for e in ours.events]}"
     )
 

@@ -18,10 +18,12 @@ Then, in wall time (medians of ``WALL_REPEATS`` in this process, so the machine'
 is Python (checking inputs, building the result).
 
 The split printed for tcsim: *integration* is ``run_segment`` less the sampling inside it; of it,
-*our callbacks* are the right-hand side, the Jacobian-vector products, the mass products and the
-root functions, and *diffsol* is the rest (BDF bookkeeping, Newton, LU, root finding, allocation);
-*sampling* is diffsol's interpolation at the sample times plus ``Segment::sample`` (a sample's
-state, rates and torques); *columns* is ``outputs::columns`` (27 columns from the samples).
+*our callbacks* are the right-hand side (``Segment::reduced_rhs``; the trait methods are inlined),
+the model's Jacobian (``force_jacobian``) and the root functions, and *solver* is the rest (the
+NDF/BDF integrator of ``engine/bdf``: step bookkeeping, Newton, LU, error control, root finding);
+*sampling* is the integrator's interpolation (``Bdf::interpolate``, at the sample times and in the
+root finding) plus ``Segment::sample`` (a sample's state, rates and torques); *columns* is
+``outputs::columns`` (27 columns from the samples).
 """
 
 from __future__ import annotations
@@ -73,19 +75,25 @@ def callgrind(cmd: list[str], stdin: str | None = None) -> tuple[dict[str, int],
     cost: dict[str, int] = {}
     calls: dict[str, int] = {}
     for block in tree.split("\n\n"):
-        pending = 0
+        pending, callers = 0, []
         for line in block.splitlines():
             m = LINE.match(line)
             if not m:
                 continue
-            name = m.group(3).split(":", 1)[-1]
+            name = CALLS.sub("", m.group(3).split(":", 1)[-1]).strip()
             if m.group(2) and m.group(2).startswith("<"):
                 c = CALLS.search(line)
-                pending += int(c.group(1).replace(",", "")) if c else 0
+                n = int(c.group(1).replace(",", "")) if c else 0
+                pending += n
+                callers.append((name, n, int(m.group(1).replace(",", ""))))
             elif m.group(2) and m.group(2).startswith("*"):
                 cost[name] = cost.get(name, 0) + int(m.group(1).replace(",", ""))
                 calls[name] = calls.get(name, 0) + pending
-                pending = 0
+                # calls and inclusive cost by caller too, as "callee <- caller"
+                for caller, n, c in callers:
+                    calls[f"{name} <- {caller}"] = calls.get(f"{name} <- {caller}", 0) + n
+                    cost[f"{name} <- {caller}"] = cost.get(f"{name} <- {caller}", 0) + c
+                pending, callers = 0, []
     return cost, calls, done.stdout
 
 
@@ -99,8 +107,10 @@ def per_run(cmds: list[list[str]], stdin: str | None = None) -> tuple[dict[str, 
 
 
 def find(table: dict[str, float], *parts: str) -> float:
-    """Sum over the functions whose name contains all of ``parts``."""
-    return sum(v for f, v in table.items() if all(p in f for p in parts))
+    """Sum over the functions whose name contains all of ``parts`` (the "callee <- caller" entries of
+    the calls only when a part has " <- ")."""
+    by_caller = any(" <- " in p for p in parts)
+    return sum(v for f, v in table.items() if all(p in f for p in parts) and (by_caller or " <- " not in f))
 
 
 def exact(table: dict[str, float], name: str) -> float:
@@ -112,40 +122,43 @@ def tcsim_profile(samples: int) -> None:
     subprocess.run(["cargo", "build", "--release", "--example", "takeoff_profile"], cwd=ROOT, check=True)
     cost, calls, out = per_run([[str(EXAMPLE), str(r), str(samples)] for r in RUNS])
     total = find(cost, "takeoff_profile::main")
-    rhs = find(cost, "SmoothSegment>::rhs")
-    jac = find(cost, "SmoothSegment>::jacobian_times")
-    mass = find(cost, "SmoothSegment>::mass_times")
-    roots = find(cost, "Segment::root_values")
-    interp = find(cost, "OdeSolverMethod<Eqn>>::interpolate_inplace")
+    # the integrator's right-hand sides (the samples call reduced_rhs too, through kinematics)
+    rhs = find(cost, "Segment::reduced_rhs <- ", "engine::bdf::Bdf<S>::step") + find(
+        cost, "Segment::reduced_rhs <- ", "SmoothSegment>::rhs"
+    )
+    jac = find(cost, "SmoothSegment>::jacobian_times <- ", "engine::bdf::Bdf<S>::refactor")
+    roots = find(cost, "converter_segment::Segment::root_values")
+    interp = find(cost, "engine::bdf::Bdf<S>::interpolate")
     sample = find(cost, "converter_segment::Segment::sample")
     segment = find(cost, "engine::segment::run_segment")
     columns = find(cost, "engine::outputs::columns")
     integration = segment - interp - sample
-    ours = rhs + jac + mass + roots
+    ours = rhs + jac + roots
     pct = lambda x: f"{x / 1e3:8.0f} k instructions ({100 * x / total:4.1f} %)"  # noqa: E731
     print(f"tcsim, {samples} samples: {out.strip().splitlines()[-1]}")
     print(f"  per take-off            {pct(total)}")
     print(f"  integration             {pct(integration)}")
-    parts = f"RHS {rhs / 1e3:.0f} k, Jacobian {jac / 1e3:.0f} k, mass {mass / 1e3:.0f} k, roots {roots / 1e3:.0f} k"
+    parts = f"RHS {rhs / 1e3:.0f} k, Jacobian {jac / 1e3:.0f} k, roots {roots / 1e3:.0f} k"
     print(f"    our callbacks         {pct(ours)} ({parts})")
-    print(f"    diffsol               {pct(integration - ours)}")
+    print(f"    solver                {pct(integration - ours)}")
     print(f"  sampling                {pct(interp + sample)} (interpolation {interp / 1e3:.0f} k)")
     print(f"  columns                 {pct(columns)}")
     print(f"  rest (initial state...) {pct(total - segment - columns)}")
     print(
         "  calls per take-off: RHS {:.0f}, Jacobian-vector products {:.0f}, LU factorisations {:.0f}, "
-        "Newton solves {:.0f}, linear solves {:.0f}, root-function evaluations {:.0f}, samples {:.0f}".format(
-            find(calls, "SmoothSegment>::rhs"),
-            find(calls, "SmoothSegment>::jacobian_times"),
-            find(calls, "lu::BatchLu<T>::factor"),
-            find(calls, "NonLinearSolver<M>>::solve_in_place"),
-            find(calls, "lu::ReusableLU<T> as diffsol_la::linear_solver::LinearSolver"),
-            find(calls, "Segment::root_values"),
+        "linear solves {:.0f}, root-function evaluations {:.0f}, samples {:.0f}".format(
+            # the integrator's RHS calls (the samples and root functions call reduced_rhs too)
+            find(calls, "Segment::reduced_rhs <- ", "engine::bdf::Bdf<S>::step")
+            + find(calls, "Segment::reduced_rhs <- ", "SmoothSegment>::rhs"),
+            find(calls, "SmoothSegment>::jacobian_times <- ", "engine::bdf::Bdf<S>::refactor"),
+            find(calls, "engine::bdf::lu::Lu::factor"),
+            find(calls, "engine::bdf::lu::Lu::solve"),
+            find(calls, "converter_segment::Segment::root_values"),
             find(calls, "converter_segment::Segment::sample"),
         )
     )
     steps = int(re.search(r"(\d+) steps", out).group(1))
-    per_step = f"integration {integration / steps:.0f} instructions, diffsol {(integration - ours) / steps:.0f}"
+    per_step = f"integration {integration / steps:.0f} instructions, solver {(integration - ours) / steps:.0f}"
     print(f"  per step ({steps} steps): {per_step}")
 
 

@@ -125,3 +125,14 @@ def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
             item.add_marker(folder)
         if "fmu_library" in getattr(item, "fixturenames", ()):
             item.add_marker("fmu")
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A dask ``LocalCluster`` of two worker processes with one thread each (skipped without the
+    ``dask`` extra): the cluster of the sharded studies' tests."""
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=50
+    ) as c:
+        yield c

@@ -13,7 +13,8 @@ Tiers:
   :func:`simulate` (a converter, a drive and a model → :class:`~tcsim.transient.TransientResult`);
 * objects: :func:`load_converter` → :class:`Converter`, then :mod:`tcsim.steady` per model;
   :func:`dynamic_model` → :class:`~tcsim.transient.DynamicModel` and the drives of
-  :mod:`tcsim.transient`; :func:`simulate_batch` for many runs on all cores;
+  :mod:`tcsim.transient`; :func:`simulate_batch` for many runs on all cores, :func:`simulate_columns`
+  for their results as one array per column;
 * raw: :mod:`tcsim._core` (NumPy arrays in, arrays out, GIL released).
 """
 
@@ -30,7 +31,7 @@ if TYPE_CHECKING:
     from .models.converter import Converter, bundled_names, load_converter
     from .models.dynamic import dynamic_model
     from .models.steady import coupling_point, hrovat_tobler_steady_state
-    from .simulation.transient import simulate, simulate_batch
+    from .simulation.transient import simulate, simulate_batch, simulate_columns
 
 #: Where each public name lives: imported on first use, so that ``import tcsim`` and ``tcsim --help``
 #: do not import pandas, SciPy or matplotlib (issue 16).
@@ -44,6 +45,7 @@ _LAZY: dict[str, str] = {
     "hrovat_tobler_steady_state": ".models.steady",
     "simulate": ".simulation.transient",
     "simulate_batch": ".simulation.transient",
+    "simulate_columns": ".simulation.transient",
     "characterise": ".api",
     "steady_state": ".api",
     "operating_point": ".api",
@@ -63,6 +65,7 @@ __all__ = [
     "operating_point",
     "simulate",
     "simulate_batch",
+    "simulate_columns",
     "steady_state",
 ]
 

@@ -14,10 +14,30 @@ from .models.dynamic import (
     dynamic_model,
     resolve_model,
 )
-from .simulation.transient import COLUMNS, Event, SolverError, TransientResult, simulate, simulate_batch
+from .simulation.transient import (
+    COLUMNS,
+    EVENT_KINDS,
+    RUN_INPUT_ERROR,
+    RUN_OK,
+    RUN_OVERFLOW,
+    RUN_SOLVER_ERROR,
+    BatchColumns,
+    Event,
+    SolverError,
+    TransientResult,
+    simulate,
+    simulate_batch,
+    simulate_columns,
+)
 
 __all__ = [
     "COLUMNS",
+    "EVENT_KINDS",
+    "RUN_INPUT_ERROR",
+    "RUN_OK",
+    "RUN_OVERFLOW",
+    "RUN_SOLVER_ERROR",
+    "BatchColumns",
     "DERIVATIVE_WINDOW_S",
     "FLOW_TIME_CONSTANT_PUMP_SPEED_RAD_S",
     "Drive",
@@ -34,4 +54,5 @@ __all__ = [
     "resolve_model",
     "simulate",
     "simulate_batch",
+    "simulate_columns",
 ]

@@ -3,6 +3,7 @@ whose command line the parser accepts (the quick ones are run)."""
 
 from __future__ import annotations
 
+import re
 import shlex
 from importlib import metadata
 
@@ -53,3 +54,17 @@ def test_help_shows_an_example_the_parser_accepts(cli, tmp_path, name):
     if name in RUN:
         r = cli(*args[1:], cwd=tmp_path)
         assert r.code == 0, r.stderr
+
+
+@pytest.mark.parametrize("name", COMMANDS)
+def test_help_shows_every_bracketed_word_of_its_options(cli, name):
+    """rich reads ``[word]`` in a help text as markup and drops it (``tcsim study --help`` said
+    "converter with a  section"): every option's and argument's help shows its bracketed words."""
+    command = typer.main.get_command(app).commands[name]  # type: ignore[attr-defined]
+    r = cli(name, "--help")
+    assert r.code == 0, r.stderr
+    shown = " ".join(r.stdout.split())
+    for param in command.params:
+        text = getattr(param, "help", None) or ""
+        for word in re.findall(r"\\?\[([A-Za-z_][\w.]*)\]", text):
+            assert f"[{word}]" in shown, (name, param.name, word)

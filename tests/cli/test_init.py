@@ -29,6 +29,7 @@ ACCEPTED_BY = {
     "vehicle": ("v.toml", ["launch", "{file}", "--model", "table"]),
     "scenario": ("s.csv", ["launch", "--scenario", "{file}", "--model", "table"]),
     "study": ("st.toml", ["study", "{file}"]),
+    "monte-carlo": ("mc.toml", ["monte-carlo", "{file}", "--no-plots"]),
     "design": ("d.toml", ["design", "{file}"]),
 }
 
@@ -54,7 +55,7 @@ def test_default_file_names(cli, tmp_path):
     for kind in KINDS:
         assert cli("init", kind, cwd=tmp_path).code == 0
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        ["converter.toml", "vehicle.toml", "scenario.csv", "study.toml", "design.toml"]
+        ["converter.toml", "vehicle.toml", "scenario.csv", "study.toml", "monte-carlo.toml", "design.toml"]
     )
 
 
@@ -174,7 +175,9 @@ def test_bad_invocations_are_one_line_and_write_nothing(cli, tmp_path):
     table = tmp_path / "t.csv"
     table.write_bytes(HMMWV.read_bytes())
     cases = {
-        ("init", "vehicel"): "KIND = 'vehicel': expected one of converter, vehicle, scenario, study, design",
+        ("init", "vehicel"): (
+            "KIND = 'vehicel': expected one of converter, vehicle, scenario, study, monte-carlo, design"
+        ),
         ("init", "vehicle", "--from", "t.csv"): "--from = 't.csv'",
         ("init", "converter", "--from", "t.csv", "--out", "t.csv", "--force"): "--out = 't.csv'",
         ("init", "converter", "--from", "nope.csv"): "nope.csv",
@@ -184,3 +187,15 @@ def test_bad_invocations_are_one_line_and_write_nothing(cli, tmp_path):
         assert expected in one_error_line(cli(*args, cwd=tmp_path)), args
     assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv"]
     assert table.read_bytes() == HMMWV.read_bytes()
+
+
+@pytest.mark.parametrize("kind", ["converter", "vehicle", "design"])
+def test_the_suggested_command_names_the_file_as_given(cli, tmp_path, kind):
+    """``tcsim init KIND --out 'sub dir/f.toml'`` suggests a command that names that path (quoted for the
+    shell), not the bare file name, which is wrong outside the folder; the file's ``name`` is its stem."""
+    target = "sub dir/f.toml"
+    r = cli("init", kind, "--out", target, cwd=tmp_path)
+    assert r.code == 0, r.stderr
+    said = " ".join(r.stdout.split())
+    assert "run it with: tcsim " in said and "'sub dir/f.toml'" in said, said
+    assert tomllib.loads((tmp_path / target).read_text(encoding="utf-8"))["name"] == "f"

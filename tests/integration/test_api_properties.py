@@ -159,6 +159,47 @@ def test_transient_runs_return_results_or_refuse_the_input(models, drives, init,
     check_runs(runs, max(len(models), len(drives)))
 
 
+@given(
+    models=st.lists(model_specs(), min_size=1, max_size=2),
+    drives=st.lists(drive_specs(), min_size=1, max_size=2),
+    init=initials,
+    opts=options,
+    workers=threads,
+    chosen=st.one_of(st.none(), st.lists(st.sampled_from(transient.COLUMNS), unique=True, max_size=6)),
+)
+def test_a_columnar_batch_is_the_per_run_batch_or_refuses_the_input(models, drives, init, opts, workers, chosen):
+    """Issue 16: ``transient_batch`` refuses what ``transient_runs`` refuses, and otherwise gives each
+    run's chosen columns bit for bit, its events, and a status that says whether it failed and how."""
+    assume(len(models) == len(drives) or 1 in (len(models), len(drives)))
+    signals = [v for d in drives for k, v in d.items() if k not in ("kind", "time_s", "output_time_s")]
+    assume(not any(np.any(np.abs(np.asarray(v, dtype=float)) > 1e6) for v in [*signals, *(init or {}).values()]))
+    try:
+        runs = _core.transient_runs(models, drives, init, opts, workers)
+    except _core.CoreInputError as e:
+        with pytest.raises(_core.CoreInputError) as again:
+            _core.transient_batch(models, drives, init, opts, workers, chosen)
+        assert again.value.args == e.args
+        return
+    batch = _core.transient_batch(models, drives, init, opts, workers, chosen)
+    names = list(transient.COLUMNS) if chosen is None else chosen
+    assert batch["names"] == names and len(batch["status"]) == len(runs)
+    failures = {f["run"]: f for f in batch["failures"]}
+    kinds = _core.transient_event_kinds()
+    for i, run in enumerate(runs):
+        rows = slice(batch["offsets"][i], batch["offsets"][i + 1])
+        if not run.ok:
+            assert failures[i]["kind"] == run.error.kind and failures[i]["message"] == run.error.message
+            assert batch["status"][i] == (1 if run.error.kind == "input" else 2)
+            continue
+        assert batch["status"][i] in (0, 3) and (batch["status"][i] == 3) == (i in failures)
+        for name in names:
+            got, want = batch["columns"][name][rows], np.asarray(run.columns[name])
+            assert np.array_equal(got.view(np.uint64), want.view(np.uint64)), name
+        mine = batch["event_run"] == i
+        assert [kinds[k] for k in batch["event_kind"][mine]] == [e.kind for e in run.events]
+        assert batch["event_time_s"][mine].tolist() == [e.time_s for e in run.events]
+
+
 VEHICLE = load_vehicle()
 
 

@@ -1,7 +1,8 @@
 """The documentation site (issue 17): ``mkdocs build --strict`` (warnings are errors: a broken link or
 anchor, a page missing from the nav, a docstring mkdocstrings cannot read) and the worked examples
-of ``docs/examples/`` (a K-factor table to an FMU in FMPy, the launch comparison, a design study),
-each run in its fast mode, producing its figure.
+of ``docs/examples/`` (a K-factor table to an FMU in FMPy, replaying a measurement and fitting shape
+effects, the launch comparison, a drive cycle, a design study), each run in its fast mode, producing
+its figure; and the generated input-file reference (vehicle, scenario, measurement parts).
 
 The build needs the ``docs`` extra (``pip install ".[docs]"``); without it the build test is skipped,
 except in CI (``CI`` set), where the extra is installed and a skip would hide the check."""
@@ -18,6 +19,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from tcsim import _core
+from tcsim.io import measurement as measurement_io
 from tcsim.models.converter import load_converter
 from tcsim.transient import PumpTorqueTurbineSpeed, dynamic_model, simulate
 
@@ -49,6 +52,7 @@ def test_site_builds_strict(tmp_path):
     # the generated reference, the API reference and the example's included script are on the site
     reference = (site / "reference" / "input-files" / "index.html").read_text(encoding="utf-8")
     assert "pump_exit_angle_deg" in reference and "capacity_factor_nm_s2" in reference
+    assert "a finite number at least 50 and at most 200000" in reference  # [body].mass_kg, from the core
     api = (site / "api" / "transient" / "index.html").read_text(encoding="utf-8")
     assert "simulate_batch" in api
     assert not re.search(r":(func|class|mod):<code>", api), "a docstring's Sphinx role rendered as text"
@@ -107,6 +111,50 @@ def test_sphinx_roles_become_plain_code():
     assert docs_hooks.plain_roles(html) == "a <code>TransientResult</code>, <code>simulate</code>; x:<code>y</code>"
 
 
+def _docs_reference():
+    sys.path.insert(0, str(REPO / "tools"))
+    try:
+        import docs_reference  # noqa: PLC0415  (tools/ is not a package)
+    finally:
+        sys.path.remove(str(REPO / "tools"))
+    return docs_reference
+
+
+def test_vehicle_reference_is_the_core_schema():
+    """The vehicle part of the input-file reference lists every key of the core's schema with its
+    unit, whether it is required, and the range the core's check uses (the core's tests check each
+    row against the check); docs/vehicle.md keeps no hand-written copy of the ranges."""
+    part = "\n".join(_docs_reference().vehicle_part())
+    schema = _core.vehicle_schema()
+    assert len(schema) > 50
+    for row in schema:
+        required = "required" if row["required"] else f"optional, default {row['default']}"
+        allowed = row["range"].replace("|", "\\|")
+        assert f"| `{row['key']}` | {row['unit']} | {required} | {allowed} |" in part, row
+    assert "| `mass_kg` | kg | required | a finite number at least 50 and at most 200000 | `" in part
+    assert "| `min_gear` |  | required | an integer from 1 to the number of gears | `3` |" in part
+    vehicle_md = (REPO / "docs" / "vehicle.md").read_text(encoding="utf-8")
+    assert (
+        "200 000" not in vehicle_md.split("## Coordinates")[0] and "reference/input-files.md#vehicle-file" in vehicle_md
+    )
+
+
+def test_scenario_and_measurement_reference():
+    """The scenario part lists the columns tcsim.io.scenario reads, with units and ranges; the
+    measurement part lists every channel tcsim.io.measurement knows, with its check and the
+    commands that read it."""
+    ref = _docs_reference()
+    scenario = "\n".join(ref.scenario_part())
+    assert "| `time_s` or `time_ms` | s, ms | required |" in scenario
+    assert "| `accelerator_pedal` or `accelerator_pedal_percent` | 1, % | required | 0 to 1, 0 to 100 |" in scenario
+    assert "| `engine_torque_nm` | N·m | optional |" in scenario
+    rows = {line.split(" | ")[0].strip("| `"): line for line in ref.measurement_part() if line.startswith("| `")}
+    assert set(rows) == set(measurement_io.INPUT_CHANNELS)
+    assert "replay `--drive pump-torque`: input" in rows["pump_torque_nm"]
+    assert "at least 0" in rows["lockup_capacity_nm"] and "torque-estimate: required" in rows["engine_torque_nm"]
+    assert "fit-shapes: required" in rows["turbine_torque_nm"] and "-1100 to 1100 rad/s" in rows["turbine_speed_rad_s"]
+
+
 def _example_module(name: str):
     """A docs example script as a module (its functions, not its ``main``)."""
     spec = importlib.util.spec_from_file_location(name, REPO / "docs" / "examples" / f"{name}.py")
@@ -135,3 +183,44 @@ def test_fmu_from_table_example(tmp_path):
         expected = np.asarray(ref[column])
         span = np.ptp(simulate(model, drive, times_s=t[::10].tolist())[column])
         assert np.max(np.abs(printed[:, k] - expected)) <= 0.005 * span + 0.01, (column, printed[:, k], expected)
+
+
+def test_replay_fit_shapes_example(tmp_path):
+    """Example (b): the synthetic rig record of a converter with known shape effects is replayed and
+    fitted. The Hrovat & Tobler replay beats the table model on both compared channels, and the
+    fitted (S_p, S_t) are within the printed bound of the true ones: |bias| + 3 standard deviations
+    of the parametric bootstrap (the fit's uncertainty from the record's noise); the bound is
+    informative (below half of each true value)."""
+    run = _run_example("replay_fit_shapes.py", tmp_path)
+    assert (tmp_path / "replay_fit_shapes.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert (tmp_path / "fit-shapes" / "shape_fit.json").is_file()
+    lines = [line.split() for line in run.stdout.splitlines()]
+    rmse = {(r[0], r[1]): float(r[2]) for r in lines if len(r) == 4 and r[1].endswith(("_rad_s", "_nm"))}
+    assert len(rmse) == 6, run.stdout
+    for channel in ("pump_speed_rad_s", "turbine_torque_nm"):
+        assert rmse[("hrovat-tobler", channel)] < rmse[("table", channel)], (channel, rmse)
+    shapes = {r[0]: [float(x) for x in r[1:]] for r in lines if r and r[0] in ("S_p", "S_t") and len(r) == 6}
+    assert set(shapes) == {"S_p", "S_t"}, run.stdout
+    for name, (true, fitted, bias, std, bound) in shapes.items():
+        assert bound == pytest.approx(abs(bias) + 3 * std, abs=2e-5), (name, shapes[name])
+        assert abs(fitted - true) <= bound, (name, true, fitted, bound)
+        assert 0.0 < bound < 0.5 * true, (name, bound, true)
+
+
+def test_drive_cycle_example(tmp_path):
+    """Example (d): the bundled vehicle on the first 128 s of US06 with the three models. Each model
+    follows the trace within docs/drive.md's bound (RMS speed error at most 2 km/h, above which
+    ``tcsim drive`` warns), the energy balance closes to docs/drive.md's 1e-4 of the engine's work,
+    and the lock-up is locked most of the time the trace is above 80 km/h."""
+    run = _run_example("drive_cycle.py", tmp_path)
+    assert (tmp_path / "drive_cycle.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    models = ("table", "hrovat-tobler", "quasi-dynamic")
+    lines = [line.split() for line in run.stdout.splitlines()]
+    summary = {r[0]: [float(x) for x in r[1:]] for r in lines if len(r) == 9 and r[0] in models}
+    highway = {r[0]: float(r[1]) for r in lines if len(r) == 2 and r[0] in models}
+    assert set(summary) == set(highway) == set(models), run.stdout
+    for model, (rms, max_error, work, converter, lockup, brakes, residual, locked) in summary.items():
+        assert 0.0 < rms <= 2.0 and rms <= max_error, (model, rms, max_error)
+        assert abs(residual) <= 1e-4, (model, residual)
+        assert work > converter + lockup > 0.0 and brakes > 0.0, (model, work, converter, lockup, brakes)
+        assert 0.0 < locked < 1.0 and highway[model] > 0.5, (model, locked, highway[model])

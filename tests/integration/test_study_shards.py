@@ -239,15 +239,6 @@ def test_an_interrupted_study_keeps_its_finished_shards_and_resumes(tmp_path, si
 # on a dask cluster (the optional extra tcsim[dask])
 
 
-@pytest.fixture(scope="module")
-def cluster():
-    distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(
-        n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None, silence_logs=50
-    ) as c:
-        yield c
-
-
 class ClientStopped(Exception):
     """Raised from the hook: the client stops mid-study as if killed."""
 

@@ -17,6 +17,7 @@ from pydantic import BaseModel
 from tcsim.io.measurement import INPUT_CHANNELS
 from tcsim.models.converter import ConverterFile
 from tcsim.models.design_file import DesignFileModel
+from tcsim.models.study_file import MonteCarloFile
 from tcsim.models.vehicle import bundled_vehicle_names, load_vehicle
 
 REPO = Path(__file__).resolve().parents[2]
@@ -55,6 +56,15 @@ def test_every_schema_field_is_listed_in_its_section(page, model, title):
         assert re.search(rf"^\| `{key}` \|", where, flags=re.M), f"[{section}] {key}: not in the generated table"
 
 
+def test_every_monte_carlo_file_field_and_distribution_kind_is_listed(page):
+    part = _part(page, "Study files").split("### Monte Carlo study", 1)[1]
+    for key in MonteCarloFile.model_fields:
+        assert re.search(rf"^\| `{key}` \|", part, flags=re.M), key
+    for kind in ("normal", "uniform", "lognormal", "truncated-normal"):
+        assert re.search(rf"^\| `{kind}` \| `", part, flags=re.M), kind
+    assert re.search(r"^\| `runs` \|  \| required \| ≥ 1 and ≤ 1e\+07 \|", part, flags=re.M)
+
+
 def test_the_bounds_and_defaults_are_the_schemas(page):
     converter = _part(page, "Converter file")
     assert re.search(r"^\| `pump_exit_angle_deg` \| ° \| required \| > -90 and < 90", converter, flags=re.M)
@@ -66,11 +76,12 @@ def test_the_bounds_and_defaults_are_the_schemas(page):
 
 def test_every_key_of_every_bundled_vehicle_is_listed(page):
     part = _part(page, "Vehicle file")
+    tables = {chunk.split("`", 1)[0]: chunk for chunk in part.split("\n### `[")[1:]}  # one table per section
     for name in bundled_vehicle_names():
         vehicle = load_vehicle(name)
         for section, values in vehicle.sections.items():
             for key in values:
-                assert f"| `[{section}]` | `{key}` |" in part, f"{name}: [{section}] {key} not listed"
+                assert f"\n| `{key}` |" in tables[f"{section}]"], f"{name}: [{section}] {key} not listed"
 
 
 def test_every_measurement_channel_is_listed(page):

@@ -13,6 +13,7 @@ import csv
 import hashlib
 import importlib.util
 import io
+import os
 import zipfile
 from pathlib import Path
 
@@ -109,3 +110,42 @@ def test_files_added_to_a_wheel_are_in_its_record(tmp_path):
     assert ["demo/_fmu/libdemo.so", f"sha256={digest}", str(len(data))] in rows
     assert rows[-1] == ["demo-1.0.dist-info/RECORD", "", ""] and rows[0][0] == "demo/__init__.py"
     assert not list(tmp_path.glob("*.part"))
+
+
+def test_build_progress_counts_cargo_crates_and_copies_stderr_unchanged(tmp_path):
+    """The build backend's progress line (issue 16 item 8): every line cargo writes reaches the real
+    standard error unchanged (pip -v and a failed build's log lose nothing), and each ``Compiling``
+    line advances the count on the terminal."""
+    backend = _backend()
+    assert backend.compiled_crate("   Compiling nalgebra v0.33.2") == "nalgebra"
+    assert backend.compiled_crate("   Compiling tcsim-core v0.1.0 (/src/crates/tcsim-core)") == "tcsim-core"
+    assert backend.compiled_crate("    Finished `release` profile [optimized] target(s) in 3.2s") is None
+    assert backend.compiled_crate("warning: Compiling is a word") is None
+    lines = [
+        b"   Compiling libc v0.2.170\n",
+        b"warning: unused \xff byte\n",
+        b"   Compiling tcsim-core v0.1.0 (/src)\n",
+        b"    Finished release\n",
+    ]
+    read_fd, write_fd = os.pipe()
+    os.write(write_fd, b"".join(lines))
+    os.close(write_fd)
+    copy = tmp_path / "stderr"
+    tty = io.StringIO()
+    with open(copy, "wb") as out:
+        backend._relay(read_fd, out.fileno(), tty)
+    assert copy.read_bytes() == b"".join(lines)
+    shown = tty.getvalue().split("\r\x1b[K")[1:]
+    assert len(shown) == 2 and all(s.startswith("tcsim build: ") and len(s) <= 79 for s in shown), shown
+    assert shown[0].startswith("tcsim build: 1 crates, 0:00") and shown[0].endswith(": libc")
+    assert shown[1].startswith("tcsim build: 2 crates") and backend.FIRST_BUILD_NOTE in shown[1]
+
+
+def test_build_progress_changes_nothing_without_a_terminal(monkeypatch):
+    """Without a terminal (CI, a pipe) the backend leaves standard error as it is."""
+    backend = _backend()
+    monkeypatch.setattr(backend, "_terminal", lambda: None)
+    before = os.fstat(2)
+    with backend.build_progress():
+        during = os.fstat(2)
+    assert (during.st_ino, during.st_dev) == (before.st_ino, before.st_dev)

@@ -32,13 +32,16 @@ import importlib.util
 import io
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import zipfile
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -58,6 +61,80 @@ ROOT = Path(__file__).resolve().parents[2]
 FMU_PACKAGE, FMU_TARGET = "tcsim-fmu", "tcsim_fmu"
 #: Suffixes of a shared library (the cdylib among cargo's artifacts; not ``.dll.lib`` or ``.pdb``).
 LIBRARY_SUFFIXES = (".so", ".dylib", ".dll")
+
+
+#: What a first build takes, said while it runs (measured: ``pip wheel .`` from an empty target
+#: directory on the project's 2-core machine: 100 s, bench/README.md "Cold build").
+FIRST_BUILD_NOTE = "first build ≈ 2 min on 2 cores"
+#: A line of cargo's that says a crate is being compiled (``   Compiling nalgebra v0.33.2``).
+_COMPILING = re.compile(r"^\s*Compiling (\S+) v\S+")
+
+
+def compiled_crate(line: str) -> str | None:
+    """The crate a line of cargo's output starts compiling, or None."""
+    m = _COMPILING.match(line)
+    return m.group(1) if m else None
+
+
+def progress_text(crates: int, elapsed_s: float, crate: str = "") -> str:
+    """The one-line progress shown on the terminal while cargo compiles (the crate last: a narrow
+    terminal cuts it first)."""
+    minutes, seconds = divmod(int(elapsed_s), 60)
+    return f"tcsim build: {crates} crates, {minutes}:{seconds:02d} ({FIRST_BUILD_NOTE}): {crate}".rstrip(": ")
+
+
+def _terminal():
+    """The user's terminal for progress lines, or None: when ``pip`` shows the build's output
+    itself (``-v``: stderr is a terminal), or there is no terminal (CI, a pipe)."""
+    if os.isatty(2):
+        return None
+    try:
+        return open("/dev/tty", "w", encoding="utf-8")  # noqa: SIM115  (closed by build_progress)
+    except OSError:
+        return None
+
+
+def _relay(read_fd: int, stderr_fd: int, tty) -> None:
+    """Copy every line from ``read_fd`` to ``stderr_fd`` unchanged; count cargo's ``Compiling``
+    lines on ``tty``'s progress line."""
+    start, crates = time.monotonic(), 0
+    with os.fdopen(read_fd, "rb") as pipe:
+        for raw in pipe:
+            os.write(stderr_fd, raw)
+            crate = compiled_crate(raw.decode("utf-8", "replace"))
+            if crate is not None and tty is not None:
+                crates += 1
+                text = progress_text(crates, time.monotonic() - start, crate)
+                tty.write("\r\x1b[K" + text[: max(20, shutil.get_terminal_size().columns - 1)])
+                tty.flush()
+
+
+@contextmanager
+def build_progress() -> Iterator[None]:
+    """While the body runs, a progress line on the user's terminal: pip hides a build backend's
+    output unless ``-v``, and a first build compiles for minutes. Standard error (file descriptor
+    2, which cargo inherits) goes through a pipe whose lines are copied to the real standard error
+    unchanged, so ``pip -v`` and a failed build's log show everything as before. Without a terminal
+    nothing changes but the copy."""
+    tty = _terminal()
+    if tty is None:
+        yield
+        return
+    saved = os.dup(2)
+    read_fd, write_fd = os.pipe()
+    os.dup2(write_fd, 2)
+    os.close(write_fd)
+    relay = threading.Thread(target=_relay, args=(read_fd, saved, tty), daemon=True)
+    relay.start()
+    try:
+        yield
+    finally:
+        sys.stderr.flush()
+        os.dup2(saved, 2)  # closes the pipe's last write end: the relay reads to the end and stops
+        relay.join(timeout=10)
+        os.close(saved)
+        tty.write("\r\x1b[K")
+        tty.close()
 
 
 def _fmu_sources():
@@ -131,8 +208,9 @@ def build_wheel(
     wheel_directory: str, config_settings: Mapping[str, Any] | None = None, metadata_directory: str | None = None
 ) -> str:
     """maturin's wheel, with the FMU library and its sources in ``tcsim/_fmu/``."""
-    name = maturin.build_wheel(wheel_directory, config_settings, metadata_directory)
-    library = build_fmu_library()
+    with build_progress():
+        name = maturin.build_wheel(wheel_directory, config_settings, metadata_directory)
+        library = build_fmu_library()
     sources = _fmu_sources()
     package_dir = f"tcsim/{sources.PACKAGED_DIR}"
     with tempfile.TemporaryDirectory(prefix="tcsim-wheel-") as tmp:
@@ -149,6 +227,7 @@ def build_editable(
     wheel_directory: str, config_settings: Mapping[str, Any] | None = None, metadata_directory: str | None = None
 ) -> str:
     """maturin's editable wheel; the FMU library is built and stays in the target directory."""
-    name = maturin.build_editable(wheel_directory, config_settings, metadata_directory)
-    build_fmu_library()
+    with build_progress():
+        name = maturin.build_editable(wheel_directory, config_settings, metadata_directory)
+        build_fmu_library()
     return name

@@ -8,6 +8,9 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use crate::converter::hrovat_tobler::{
     drive_steady_state, steady_state, try_steady_state, HtConstants, HtGeometry, HtParam, StatorMode, NO_STEADY_STATE,
 };
+use crate::engine::isolated::{simulate, Event};
+use crate::engine::options::{try_reserve, TransientError, TransientResult};
+use crate::engine::outputs::{write_columns, Overflow, Selection};
 use crate::error::CoreError;
 use crate::scalar::{Dual, Scalar};
 
@@ -342,6 +345,210 @@ pub fn run_transient_jobs_cancellable(
     parallel_map_cancellable(jobs, threads, cancel, run_transient_job)
 }
 
+// ---------------------------------------------------------------------------------------------
+// Columnar transient batches
+
+/// Status of a run of a columnar batch ([`BatchColumns::status`]): finished.
+pub const RUN_OK: u8 = 0;
+/// Status: the run's input was refused ([`RunFailure::Error`] with [`TransientError::Input`]).
+pub const RUN_INPUT_ERROR: u8 = 1;
+/// Status: the solver failed ([`RunFailure::Error`] with [`TransientError::Solver`]).
+pub const RUN_SOLVER_ERROR: u8 = 2;
+/// Status: the run finished but a column overflowed ([`RunFailure::Overflow`]); its rows hold the
+/// values computed.
+pub const RUN_OVERFLOW: u8 = 3;
+
+/// Why a run of a columnar batch did not give a usable result.
+#[derive(Debug, Clone)]
+pub enum RunFailure {
+    Error(TransientError),
+    Overflow(Overflow),
+}
+
+/// The results of a columnar batch ([`run_transient_columns`]): one buffer per selected column for
+/// all runs, run `i` at rows `offsets[i]..offsets[i + 1]` (NaN for a run that failed with an
+/// error), its status, its events, and the failures of the runs that failed (only those).
+#[derive(Debug, Clone)]
+pub struct BatchColumns {
+    pub selection: Selection,
+    /// `runs + 1` row offsets.
+    pub offsets: Vec<usize>,
+    /// One per selected column, in the selection's order, `offsets[runs]` rows each.
+    pub columns: Vec<Vec<f64>>,
+    /// One per run: [`RUN_OK`], [`RUN_INPUT_ERROR`], [`RUN_SOLVER_ERROR`] or [`RUN_OVERFLOW`].
+    pub status: Vec<u8>,
+    /// Events of all runs in run order, each with its run's index.
+    pub events: Vec<(usize, Event)>,
+    /// The failed runs' indices and failures, in run order.
+    pub failures: Vec<(usize, RunFailure)>,
+}
+
+/// Consecutive runs `first..first + status.len()` of a columnar batch and their rows of every
+/// selected column, which one worker fills.
+struct RunRows<'a> {
+    first: usize,
+    columns: Vec<&'a mut [f64]>,
+    status: &'a mut [u8],
+}
+
+/// What a worker reports of its [`RunRows`]: events and failures in run order, and whether every
+/// run ran (false once the batch was cancelled).
+struct RowsDone {
+    events: Vec<(usize, Event)>,
+    failures: Vec<(usize, RunFailure)>,
+    complete: bool,
+}
+
+/// The most runs a worker of [`run_transient_columns`] takes at once.
+const MAX_RUNS_PER_PIECE: usize = 32;
+
+/// Run `jobs` on `threads` workers (0: one per core) and write the `selection`'s columns of each
+/// straight into its rows of preallocated buffers (one per column for all runs; the first
+/// `skips[i]` samples of job `i` are run, not stored; `skips` has one value per job or one for all).
+/// The workers take pieces of at most [`MAX_RUNS_PER_PIECE`] consecutive runs in turn; nothing is
+/// merged after but the events and the failures. The results do not depend on the number of
+/// threads. `Ok(None)` once `cancel` is set (no worker starts another run); an error, before any
+/// run, when the buffers cannot be had.
+pub fn run_transient_columns(
+    jobs: &[TransientJob],
+    skips: &[usize],
+    selection: &Selection,
+    threads: usize,
+    cancel: &AtomicBool,
+) -> TransientResult<Option<BatchColumns>> {
+    let n = jobs.len();
+    assert!(skips.len() == 1 || skips.len() == n, "one skip, or one per job");
+    let skip = |i: usize| skips[if skips.len() == 1 { 0 } else { i }];
+    let mut offsets = Vec::with_capacity(n + 1);
+    offsets.push(0);
+    for (i, j) in jobs.iter().enumerate() {
+        offsets.push(offsets[i] + j.times_s.len().saturating_sub(skip(i)));
+    }
+    let rows = offsets[n];
+    let mut columns = Vec::with_capacity(selection.len());
+    for _ in 0..selection.len() {
+        // zeroed memory is mapped lazily: the workers touch their own rows (the probe turns a
+        // lack of memory into an error instead of an abort)
+        let mut probe: Vec<f64> = Vec::new();
+        try_reserve(&mut probe, rows)?;
+        drop(probe);
+        columns.push(vec![0.0; rows]);
+    }
+    let mut status = vec![RUN_OK; n];
+    let cores = if threads == 0 { std::thread::available_parallelism().map_or(1, |c| c.get()) } else { threads };
+    let workers = cores.min(n).max(1);
+    let per_piece = (n / (16 * workers)).clamp(1, MAX_RUNS_PER_PIECE);
+    let pieces = run_rows(&mut columns, &mut status, &offsets, per_piece);
+    let work = |rows: RunRows<'_>| fill_run_rows(jobs, &skip, &offsets, selection, cancel, rows);
+    let done: Vec<RowsDone> = if workers == 1 {
+        pieces.into_iter().map(work).collect()
+    } else {
+        let queue: Vec<std::sync::Mutex<Option<RunRows<'_>>>> =
+            pieces.into_iter().map(|p| std::sync::Mutex::new(Some(p))).collect();
+        let next = std::sync::atomic::AtomicUsize::new(0);
+        let mut out: Vec<(usize, RowsDone)> = std::thread::scope(|scope| {
+            let handles: Vec<_> = (0..workers)
+                .map(|_| {
+                    scope.spawn(|| {
+                        let mut mine = Vec::new();
+                        loop {
+                            let k = next.fetch_add(1, Ordering::Relaxed);
+                            let Some(piece) = queue.get(k).and_then(|m| m.lock().ok()?.take()) else { break };
+                            mine.push((k, work(piece)));
+                        }
+                        mine
+                    })
+                })
+                .collect();
+            handles.into_iter().flat_map(|h| h.join().expect("a transient worker does not panic")).collect()
+        });
+        out.sort_by_key(|(k, _)| *k);
+        out.into_iter().map(|(_, d)| d).collect()
+    };
+    let mut result =
+        BatchColumns { selection: selection.clone(), offsets, columns, status, events: vec![], failures: vec![] };
+    for d in done {
+        if !d.complete {
+            return Ok(None);
+        }
+        result.events.extend(d.events);
+        result.failures.extend(d.failures);
+    }
+    Ok(Some(result))
+}
+
+/// The buffers cut into pieces of `per_piece` consecutive runs.
+fn run_rows<'a>(
+    columns: &'a mut [Vec<f64>],
+    status: &'a mut [u8],
+    offsets: &[usize],
+    per_piece: usize,
+) -> Vec<RunRows<'a>> {
+    let n = status.len();
+    let mut rest: Vec<&'a mut [f64]> = columns.iter_mut().map(|c| c.as_mut_slice()).collect();
+    let mut status_rest = status;
+    let mut out = Vec::with_capacity(n.div_ceil(per_piece));
+    let mut first = 0;
+    while first < n {
+        let end = (first + per_piece).min(n);
+        let len = offsets[end] - offsets[first];
+        let mut cols = Vec::with_capacity(rest.len());
+        for c in rest.iter_mut() {
+            let (head, tail) = std::mem::take(c).split_at_mut(len);
+            cols.push(head);
+            *c = tail;
+        }
+        let (st, st_tail) = std::mem::take(&mut status_rest).split_at_mut(end - first);
+        status_rest = st_tail;
+        out.push(RunRows { first, columns: cols, status: st });
+        first = end;
+    }
+    out
+}
+
+/// Run the jobs of `rows` one after the other, writing each run's columns into its rows.
+fn fill_run_rows(
+    jobs: &[TransientJob],
+    skip: &dyn Fn(usize) -> usize,
+    offsets: &[usize],
+    selection: &Selection,
+    cancel: &AtomicBool,
+    mut rows: RunRows<'_>,
+) -> RowsDone {
+    let mut done = RowsDone { events: vec![], failures: vec![], complete: true };
+    let base = offsets[rows.first];
+    for k in 0..rows.status.len() {
+        if cancel.load(Ordering::Relaxed) {
+            done.complete = false;
+            break;
+        }
+        let i = rows.first + k;
+        let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
+        let mut out: Vec<&mut [f64]> = rows.columns.iter_mut().map(|c| &mut c[a..b]).collect();
+        let job = &jobs[i];
+        let run = catch_panic(|| {
+            let traj = simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
+            let overflow = write_columns(job.model.as_ref(), &traj.samples, selection, skip(i), &mut out);
+            Ok((traj.events, overflow))
+        });
+        match run {
+            Ok((events, overflow)) => {
+                done.events.extend(events.into_iter().map(|e| (i, e)));
+                if let Some(o) = overflow {
+                    rows.status[k] = RUN_OVERFLOW;
+                    done.failures.push((i, RunFailure::Overflow(o)));
+                }
+            }
+            Err(e) => {
+                out.iter_mut().for_each(|c| c.fill(f64::NAN));
+                rows.status[k] = if matches!(e, TransientError::Input(_)) { RUN_INPUT_ERROR } else { RUN_SOLVER_ERROR };
+                done.failures.push((i, RunFailure::Error(e)));
+            }
+        }
+    }
+    done
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -467,6 +674,87 @@ mod tests {
         let go = AtomicBool::new(false);
         let all = parallel_map_cancellable(&jobs, 2, &go, |j| j * 2);
         assert_eq!(all, vec![Some(2), Some(4), Some(6), Some(8)]);
+    }
+
+    fn takeoff_job(times_s: Vec<f64>, pump_torque_nm: f64) -> TransientJob {
+        use crate::converter::dynamics::{HtDynamics, Inertias};
+        use crate::engine::isolated::{Drive, InitialState, TurbineLoad};
+        use crate::engine::signal::Signal;
+        let model =
+            HtDynamics::new(HtGeometry::appendix_d(), Inertias::new(0.109, 0.056, 0.01).unwrap(), 0.2914, [1.3e-3; 3])
+                .unwrap();
+        let torque =
+            Signal::new("pump_torque_nm", vec![0.0, 0.1, 0.3, 10.0], vec![40.0, 40.0, pump_torque_nm, 250.0], 0.0);
+        let drive = Drive::PumpTorqueLoad {
+            pump_torque_nm: torque.unwrap(),
+            load: TurbineLoad { torque_nm: Signal::constant(10.0), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 },
+            lockup: None,
+        };
+        let options = crate::engine::options::SolverOptions::default();
+        TransientJob { model: Box::new(model), drive, times_s, init: InitialState::default(), options }
+    }
+
+    /// Issue 16: a columnar batch writes each run into its rows; the rows are the run's own
+    /// columns ([`run_transient_job`]) bit for bit, whatever the number of threads and the piece
+    /// size, with ragged output times, skipped first samples, and a failing run among good ones
+    /// (its rows NaN, its status and error reported; the others intact).
+    #[test]
+    fn a_columnar_batch_is_the_runs_bit_for_bit() {
+        let grid = |n: usize, end: f64| (0..n).map(|i| end * i as f64 / (n - 1) as f64).collect::<Vec<f64>>();
+        let mut jobs: Vec<TransientJob> =
+            (0..70).map(|i| takeoff_job(grid(11 + i % 3, 2.0 + (i % 5) as f64), 150.0 + i as f64)).collect();
+        jobs[33].times_s = vec![0.0]; // one output time: refused by the engine
+        let skips: Vec<usize> = (0..70).map(|i| i % 2).collect();
+        let sel = Selection::from_names(&["turbine_torque_nm", "time_s", "stator_mode"]).unwrap();
+        let never = AtomicBool::new(false);
+        let one = run_transient_columns(&jobs, &skips, &sel, 1, &never).unwrap().unwrap();
+        assert_eq!(one.offsets.len(), 71);
+        assert_eq!(one.status.iter().filter(|&&s| s != RUN_OK).count(), 1);
+        assert_eq!(one.status[33], RUN_INPUT_ERROR);
+        assert!(
+            matches!(&one.failures[..], [(33, RunFailure::Error(TransientError::Input(e)))] if e.field == "time_s")
+        );
+        for (i, job) in jobs.iter().enumerate() {
+            let rows = one.offsets[i]..one.offsets[i + 1];
+            if i == 33 {
+                assert!(rows.is_empty());
+                continue;
+            }
+            assert_eq!(rows.len(), job.times_s.len() - skips[i], "run {i}");
+            let (cols, events) = run_transient_job(job).unwrap();
+            for (k, &c) in sel.indices().iter().enumerate() {
+                let want: Vec<u64> = cols[c][skips[i]..].iter().map(|x| x.to_bits()).collect();
+                let got: Vec<u64> = one.columns[k][rows.clone()].iter().map(|x| x.to_bits()).collect();
+                assert_eq!(got, want, "run {i}, column {c}");
+            }
+            let mine: Vec<Event> = one.events.iter().filter(|(r, _)| *r == i).map(|(_, e)| *e).collect();
+            assert_eq!(mine, events, "run {i}");
+        }
+        assert!(!one.events.is_empty());
+        for threads in [2, 3, 8] {
+            let other = run_transient_columns(&jobs, &skips, &sel, threads, &never).unwrap().unwrap();
+            assert_eq!((&other.offsets, &other.status), (&one.offsets, &one.status), "{threads} threads");
+            for (a, b) in other.columns.iter().zip(&one.columns) {
+                assert_eq!(
+                    a.iter().map(|x| x.to_bits()).collect::<Vec<_>>(),
+                    b.iter().map(|x| x.to_bits()).collect::<Vec<_>>()
+                );
+            }
+            assert_eq!(other.events, one.events, "{threads} threads");
+            assert_eq!(other.failures.len(), 1);
+        }
+        // a solver error's rows are NaN: a run made to fail by a step limit of one
+        jobs[5].options.max_steps = 1;
+        let failed = run_transient_columns(&jobs, &[0], &sel, 2, &never).unwrap().unwrap();
+        assert_eq!(failed.status[5], RUN_SOLVER_ERROR);
+        let rows = failed.offsets[5]..failed.offsets[6];
+        assert!(!rows.is_empty() && failed.columns.iter().all(|c| c[rows.clone()].iter().all(|x| x.is_nan())));
+        assert_eq!(failed.columns[1][failed.offsets[6]..failed.offsets[7]], jobs[6].times_s[..]);
+        let cancel = AtomicBool::new(true);
+        assert!(run_transient_columns(&jobs, &[0], &sel, 2, &cancel).unwrap().is_none());
+        let empty = run_transient_columns(&jobs[..3], &[0], &Selection::from_names::<&str>(&[]).unwrap(), 2, &never);
+        let empty = empty.unwrap().unwrap();
+        assert!(empty.columns.is_empty() && empty.status == [RUN_OK; 3] && !empty.events.is_empty());
     }
 
     #[test]

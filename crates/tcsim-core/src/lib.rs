@@ -9,7 +9,7 @@
 //! Folders depend one way: `converter` ← `engine` ← `vehicle`; the shared utilities below them.
 //!
 //! * [`converter`]: the converter models (tables, Hrovat & Tobler, quasi-dynamic, specifications).
-//! * [`engine`]: the transient engines on diffsol (BDF segments, converter events, isolated runs,
+//! * [`engine`]: the transient engines (own BDF integrator, segments, converter events, isolated runs,
 //!   Model Exchange view, co-simulation stepper, signals, output columns).
 //! * [`vehicle`]: whole-vehicle take-off (parameters, components, plant, modes, launch, columns).
 //! * [`batch`]: batched evaluation for characteristics, studies, fitting and parallel runs.

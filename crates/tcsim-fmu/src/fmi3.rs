@@ -1,6 +1,6 @@
 //! The FMI 3.0 C API of the tcsim converter models, beside FMI 2.0 in the same library and over the
 //! same [`Instance`]: Model Exchange (continuous states, their derivatives, the event indicators and
-//! the mode switches in `fmi3UpdateDiscreteStates`) and Co-Simulation (diffsol's BDF inside
+//! the mode switches in `fmi3UpdateDiscreteStates`) and Co-Simulation (tcsim's BDF inside
 //! `fmi3DoStep`). The variables are those of FMI 2.0 ([`crate::variables`]), all `Float64`, with
 //! two that FMI 3.0 adds: `time` (the independent variable, [`TIME`]) and the event indicators
 //! ([`FIRST_EVENT_INDICATOR`](crate::variables::FIRST_EVENT_INDICATOR)).

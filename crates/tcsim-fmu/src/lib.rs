@@ -1,4 +1,4 @@
-//! The FMI 2.0 C API of the tcsim converter models: Co-Simulation, with diffsol's BDF inside
+//! The FMI 2.0 C API of the tcsim converter models: Co-Simulation, with tcsim's BDF inside
 //! `fmi2DoStep` (through `tcsim_core::stepper`), and Model Exchange, with the continuous states,
 //! their derivatives, the event indicators of the stator clutch and of flow reversal, and the mode
 //! switches in `fmi2NewDiscreteStates` (through `tcsim_core::engine::mode_view::ModeView`). No Python at

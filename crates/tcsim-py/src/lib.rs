@@ -23,7 +23,7 @@ use pyo3::types::{PyDict, PyList};
 
 use tcsim_core::batch::{
     ht_ratio_gradients as core_ratio_gradients, ht_steady_states_cancellable as core_steady_states,
-    run_transient_jobs_cancellable, TransientJob,
+    run_transient_columns, run_transient_jobs_cancellable, BatchColumns, RunFailure, TransientJob,
 };
 use tcsim_core::converter::backward::{backward_points, Backward, Load, Reason};
 use tcsim_core::converter::capacity::CapacityConvention;
@@ -39,7 +39,7 @@ use tcsim_core::engine::converter_events::EventKind;
 use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
 use tcsim_core::engine::lockup::LockupCommand;
 use tcsim_core::engine::options::{SolverOptions, TransientError};
-use tcsim_core::engine::outputs::isolated_output_size;
+use tcsim_core::engine::outputs::{isolated_output_size, Selection, COLUMNS, INFINITE_ALLOWED, NAN_NOT_EXPECTED};
 use tcsim_core::engine::signal::Signal;
 use tcsim_core::vehicle::file::{read_vehicle as read_vehicle_core, VehicleDocument};
 use tcsim_core::vehicle::launch::{check_launch_output, simulate_launch, DEFAULT_OUTPUT_STEP_S};
@@ -959,37 +959,178 @@ fn transient_runs<'py>(
     threads: usize,
 ) -> PyResult<Vec<TransientRun>> {
     guard(|| {
-        let n = models.len().max(drives.len());
-        if models.is_empty()
-            || drives.is_empty()
-            || (models.len() != n && models.len() != 1)
-            || (drives.len() != n && drives.len() != 1)
-        {
-            return Err(PyValueError::new_err("models and drives must have equal lengths, or one of them length one"));
-        }
         let init = init_from(init.as_ref())?;
         let options = options_from(options.as_ref())?;
-        let parsed_drives = drives.iter().map(|d| drive_from(d)).collect::<PyResult<Vec<_>>>()?;
-        let jobs = (0..n)
-            .map(|i| {
-                let (drive, times) = &parsed_drives[if parsed_drives.len() == 1 { 0 } else { i }];
-                Ok(TransientJob {
-                    model: model_from(&models[if models.len() == 1 { 0 } else { i }])?,
-                    drive: drive.clone(),
-                    times_s: times.clone(),
-                    init,
-                    options,
-                })
-            })
-            .collect::<PyResult<Vec<_>>>()?;
+        let (jobs, _skips) = transient_jobs(&models, &drives, init, options)?;
         let samples = jobs.iter().map(|j| j.times_s.len()).sum();
-        isolated_output_size(1, samples, &options)
+        isolated_output_size(1, samples, COLUMNS.len(), &options)
             .check(InputSource::Drive, options.max_output_bytes)
             .map_err(input_error)?;
         let results = cancellable(py, |cancel| {
             run_transient_jobs_cancellable(&jobs, threads, cancel).into_iter().collect::<Option<Vec<_>>>()
         })?;
         results.into_iter().map(|r| transient_run(py, r)).collect()
+    })
+}
+
+/// Event kinds of a transient run in the order of their codes in `transient_batch`'s
+/// `event_kind` (`transient_event_kinds()`).
+const EVENT_KINDS: [EventKind; 7] = [
+    EventKind::StatorRelease,
+    EventKind::StatorLock,
+    EventKind::FlowZero,
+    EventKind::FlowStart,
+    EventKind::LockupLock,
+    EventKind::LockupSlip,
+    EventKind::LockupArm,
+];
+
+/// Names of the event kinds of `transient_batch`: `event_kind` code `k` is the `k`-th.
+#[pyfunction]
+fn transient_event_kinds() -> Vec<&'static str> {
+    EVENT_KINDS.iter().map(|k| k.name()).collect()
+}
+
+/// The rules of the overflow check of a run's columns: the columns that may be ±inf, and the unit
+/// suffixes of the physical quantities that may not be NaN at some samples only
+/// (`tcsim_core::engine::outputs::{INFINITE_ALLOWED, NAN_NOT_EXPECTED}`).
+#[pyfunction]
+fn output_value_rules() -> (Vec<&'static str>, Vec<&'static str>) {
+    (INFINITE_ALLOWED.to_vec(), NAN_NOT_EXPECTED.to_vec())
+}
+
+/// `{name: value}` of a failed run of `transient_batch`.
+fn failure_dict<'py>(py: Python<'py>, run: usize, f: RunFailure) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    d.set_item("run", run)?;
+    match f {
+        RunFailure::Overflow(o) => {
+            d.set_item("kind", "overflow")?;
+            d.set_item("column", COLUMNS[o.column])?;
+            d.set_item("value", o.value)?;
+            d.set_item("time_s", o.time_s)?;
+        }
+        RunFailure::Error(e) => {
+            let e = RunError::from_core(e);
+            for (k, v) in [("source", e.source), ("field", e.field), ("value", e.value), ("expected", e.expected)] {
+                d.set_item(k, v)?;
+            }
+            d.set_item("kind", e.kind)?;
+            d.set_item("message", e.message)?;
+        }
+    }
+    Ok(d)
+}
+
+/// The dict `transient_batch` returns (see there), moving the buffers into NumPy without a copy.
+fn batch_dict<'py>(py: Python<'py>, b: BatchColumns) -> PyResult<Bound<'py, PyDict>> {
+    let d = PyDict::new(py);
+    let names = b.selection.names();
+    d.set_item("names", &names)?;
+    let cols = PyDict::new(py);
+    for (name, col) in names.iter().zip(b.columns) {
+        cols.set_item(*name, col.into_pyarray(py))?;
+    }
+    d.set_item("columns", cols)?;
+    let offsets: Vec<i64> = b.offsets.iter().map(|&o| o as i64).collect();
+    d.set_item("offsets", offsets.into_pyarray(py))?;
+    d.set_item("status", b.status.into_pyarray(py))?;
+    let ev = &b.events;
+    let code = |k: EventKind| EVENT_KINDS.iter().position(|&c| c == k).unwrap_or(usize::MAX) as u8;
+    d.set_item("event_run", ev.iter().map(|(i, _)| *i as i64).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item("event_time_s", ev.iter().map(|(_, e)| e.time_s).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item("event_kind", ev.iter().map(|(_, e)| code(e.kind)).collect::<Vec<_>>().into_pyarray(py))?;
+    d.set_item(
+        "event_stator_locked",
+        ev.iter().map(|(_, e)| e.mode.stator_locked).collect::<Vec<_>>().into_pyarray(py),
+    )?;
+    d.set_item("event_flow_direction", ev.iter().map(|(_, e)| e.mode.flow_sign).collect::<Vec<_>>().into_pyarray(py))?;
+    let failures = b.failures.into_iter().map(|(i, f)| failure_dict(py, i, f)).collect::<PyResult<Vec<_>>>()?;
+    d.set_item("failures", PyList::new(py, failures)?)?;
+    Ok(d)
+}
+
+/// The transient jobs of `models[i]` under `drives[i]` (a list of length one is broadcast) and each
+/// drive's `output_skip` (leading output times run but not stored, default 0).
+fn transient_jobs(
+    models: &[Bound<'_, PyDict>],
+    drives: &[Bound<'_, PyDict>],
+    init: InitialState,
+    options: SolverOptions,
+) -> PyResult<(Vec<TransientJob>, Vec<usize>)> {
+    let n = models.len().max(drives.len());
+    if models.is_empty()
+        || drives.is_empty()
+        || (models.len() != n && models.len() != 1)
+        || (drives.len() != n && drives.len() != 1)
+    {
+        return Err(PyValueError::new_err("models and drives must have equal lengths, or one of them length one"));
+    }
+    let mut parsed = Vec::with_capacity(drives.len());
+    let mut skips = Vec::with_capacity(drives.len());
+    for d in drives {
+        let (drive, times) = drive_from(d)?;
+        let skip: usize = opt_item(d, "output_skip")?.unwrap_or(0);
+        if skip > 0 && skip >= times.len() {
+            return Err(PyValueError::new_err(format!("output_skip {skip} of {} output times", times.len())));
+        }
+        parsed.push((drive, times));
+        skips.push(skip);
+    }
+    let jobs = (0..n)
+        .map(|i| {
+            let (drive, times) = &parsed[if parsed.len() == 1 { 0 } else { i }];
+            let model = model_from(&models[if models.len() == 1 { 0 } else { i }])?;
+            Ok(TransientJob { model, drive: drive.clone(), times_s: times.clone(), init, options })
+        })
+        .collect::<PyResult<Vec<_>>>()?;
+    Ok((jobs, skips))
+}
+
+/// Run transient jobs as [`transient_runs`] does, returning columnar results: a dict with `names`
+/// (the selected columns, `columns` or all of `transient_columns()`), `columns` (name → one float64
+/// array of all runs' rows, run `i` at rows `offsets[i]:offsets[i + 1]`, NaN for a run that failed
+/// with an error), `offsets` (int64, runs + 1), `status` (uint8 per run: 0 ok, 1 input error, 2
+/// solver error, 3 overflow), the events as flat arrays `event_run`, `event_time_s`, `event_kind`
+/// (codes of `transient_event_kinds()`), `event_stator_locked`, `event_flow_direction`, and
+/// `failures`, a dict per failed run (`run`, `kind` and, for `input`/`solver`, `message`, `source`,
+/// `field`, `value`, `expected`; for `overflow`, `column`, `value`, `time_s`). The runs write their
+/// rows straight into the buffers with the GIL released; the buffers become the arrays without a
+/// copy. A drive dict's `output_skip` (int) leading output times are run but not stored.
+#[pyfunction]
+#[pyo3(signature = (models, drives, init=None, options=None, threads=0, columns=None))]
+fn transient_batch<'py>(
+    py: Python<'py>,
+    models: Vec<Bound<'py, PyDict>>,
+    drives: Vec<Bound<'py, PyDict>>,
+    init: Option<Bound<'py, PyDict>>,
+    options: Option<Bound<'py, PyDict>>,
+    threads: usize,
+    columns: Option<Vec<String>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    guard(|| {
+        let selection = match &columns {
+            Some(names) => Selection::from_names(names).map_err(input_error)?,
+            None => Selection::all(),
+        };
+        let init = init_from(init.as_ref())?;
+        let options = options_from(options.as_ref())?;
+        let (jobs, skips) = transient_jobs(&models, &drives, init, options)?;
+        let samples = jobs.iter().map(|j| j.times_s.len()).sum();
+        isolated_output_size(1, samples, selection.len(), &options)
+            .check(InputSource::Drive, options.max_output_bytes)
+            .map_err(input_error)?;
+        let batch =
+            cancellable(py, |cancel| match run_transient_columns(&jobs, &skips, &selection, threads, cancel) {
+                Ok(Some(b)) => Some(Ok(b)),
+                Ok(None) => None,
+                Err(e) => Some(Err(e)),
+            })?;
+        match batch {
+            Ok(b) => batch_dict(py, b),
+            Err(TransientError::Input(e)) => Err(input_error(e)),
+            Err(e) => Err(PyRuntimeError::new_err(e.to_string())),
+        }
     })
 }
 
@@ -1075,6 +1216,27 @@ fn py_value<'py>(py: Python<'py>, v: &toml::Value) -> PyResult<Bound<'py, PyAny>
 #[pyfunction]
 fn vehicle_sections() -> Vec<&'static str> {
     tcsim_core::vehicle::file::SECTIONS.to_vec()
+}
+
+/// The vehicle file's schema, one dict per key in file order (the core's `SCHEMA`, whose ranges are
+/// the validator's): `section` (`""` top level), `key`, `unit`, `required`, `default` (text or
+/// None), `range` (the allowed values in words) and `meaning`. The `[sources]` section is free-form.
+#[pyfunction]
+fn vehicle_schema(py: Python<'_>) -> PyResult<Vec<Bound<'_, PyDict>>> {
+    tcsim_core::vehicle::file::SCHEMA
+        .iter()
+        .map(|row| {
+            let d = PyDict::new(py);
+            d.set_item("section", row.section)?;
+            d.set_item("key", row.key)?;
+            d.set_item("unit", row.unit)?;
+            d.set_item("required", row.default.is_none())?;
+            d.set_item("default", row.default)?;
+            d.set_item("range", row.range_text())?;
+            d.set_item("meaning", row.meaning)?;
+            Ok(d)
+        })
+        .collect()
 }
 
 /// Read a vehicle file's `text` (`file` names it in messages): the one parse and validation of a
@@ -1434,8 +1596,12 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(drive_runs, m)?)?;
     m.add_function(wrap_pyfunction!(read_vehicle, m)?)?;
     m.add_function(wrap_pyfunction!(vehicle_sections, m)?)?;
+    m.add_function(wrap_pyfunction!(vehicle_schema, m)?)?;
     m.add_class::<PyVehicle>()?;
     m.add_function(wrap_pyfunction!(transient_runs, m)?)?;
+    m.add_function(wrap_pyfunction!(transient_batch, m)?)?;
+    m.add_function(wrap_pyfunction!(transient_event_kinds, m)?)?;
+    m.add_function(wrap_pyfunction!(output_value_rules, m)?)?;
     m.add_function(wrap_pyfunction!(time_resolution_s, m)?)?;
     fmu::register(m)?;
     design::register(m)?;

@@ -23,11 +23,13 @@ A worker that dies loses only its chunks in flight, which the scheduler gives to
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import importlib
+import itertools
 import math
 import os
-from collections.abc import Generator, Iterable, Iterator
+from collections.abc import Generator, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from types import ModuleType
 from typing import Any, Protocol
@@ -37,6 +39,8 @@ import pandas as pd
 
 from ..errors import InputError
 from ..models.converter import Converter
+from ..models.design_file import DesignFile
+from .design_study import check_sweep, design_rows, row_columns, study_base
 from .study import (
     COLUMNS,
     StudyDefinition,
@@ -126,6 +130,58 @@ def appendix_d_study(converter: Converter, definition: StudyDefinition | None = 
         references=_references(converter, definition),
         study=definition,
     )
+
+
+@dataclass(frozen=True)
+class DesignSweepStudy:
+    """A design study (:func:`tcsim.analysis.design_study.design_study`) as plain data: a case is one
+    design of the full grid of ``values`` (one tuple per swept parameter of ``names``, the first
+    varying slowest); its row is :func:`~tcsim.analysis.design_study.design_rows`'s, without
+    ``pareto_front`` (which compares all designs: compute it from the shards read back with
+    :func:`~tcsim.analysis.design_study.pareto_front`). ``threads``: core workers of each chunk (0:
+    all cores); it does not change the rows."""
+
+    design: DesignFile
+    names: tuple[str, ...]
+    values: tuple[tuple[float, ...], ...]
+    threads: int = 0
+    kind: str = "design-study"
+
+    @property
+    def n_cases(self) -> int:
+        return math.prod(len(v) for v in self.values)
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        return row_columns(self.names)
+
+    def definition(self) -> dict[str, Any]:
+        d = self.design
+        return {
+            "design": {
+                "file": d.path,
+                "name": d.name,
+                "design": dataclasses.asdict(d.design),
+                "metal_inertia": d.metal_inertia.model_dump(),
+                "losses": dict(d.losses),
+            },
+            "sweep": {n: list(v) for n, v in zip(self.names, self.values)},
+        }
+
+    def rows(self, start: int, stop: int) -> pd.DataFrame:
+        grid = list(itertools.islice(itertools.product(*self.values), start, stop))
+        return design_rows(self.design, self.names, grid, self.threads)
+
+
+def design_sweep_study(
+    design: DesignFile, sweep: Mapping[str, Sequence[float] | np.ndarray], threads: int = 0
+) -> DesignSweepStudy:
+    """The design study of ``sweep`` (one or two parameters → their values) around ``design`` for
+    chunked runs; the sweep checked as :func:`~tcsim.analysis.design_study.design_study` checks it."""
+    check_sweep(sweep)
+    names = tuple(sweep)
+    values = tuple(tuple(np.asarray(sweep[n], dtype=float).tolist()) for n in names)
+    return DesignSweepStudy(study_base(design, names), names, values, threads)
 
 
 def check_chunk_size(chunk_size: Any, source: str = "command line", field: str = "--chunk-size") -> int:

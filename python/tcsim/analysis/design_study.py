@@ -244,13 +244,32 @@ def design_study(
     file = design if isinstance(design, DesignFile) else load_design_file(design)
     check_sweep(sweep)
     names = list(sweep)
+    file = study_base(file, names)
+    grid = list(itertools.product(*(np.asarray(sweep[n], dtype=float).tolist() for n in names)))
+    df = design_rows(file, names, grid, threads)
+    front = pareto_front(df["stall_torque_ratio"].to_numpy(), df["takeoff_effective_tr_dip"].to_numpy())
+    df.insert(len(df.columns) - 1, "pareto_front", front)
+    return df
+
+
+def study_base(file: DesignFile, names: Sequence[str]) -> DesignFile:
+    """The base design of a study of ``names``: a circular design swept in its squash ratio or axial
+    width becomes the elliptic one of squash 0 (the circle); a polyline's width is refused."""
     if AXIAL_WIDTH in names and file.design.profile == "polyline":
         raise InputError(
             "--sweep", "NAME", AXIAL_WIDTH, "a circular or elliptic design (a polyline's paths set its width)"
         )
     if {"squash_ratio", AXIAL_WIDTH} & set(names) and file.design.profile == "circular":  # squash 0: the circle
         file = replace(file, design=replace(file.design, profile="elliptic", squash_ratio=0.0))
-    grid = list(itertools.product(*(np.asarray(sweep[n], dtype=float).tolist() for n in names)))
+    return file
+
+
+def design_rows(
+    file: DesignFile, names: Sequence[str], grid: Sequence[tuple[float, ...]], threads: int = 2
+) -> pd.DataFrame:
+    """The rows of :func:`design_study` of the designs ``grid`` (values of ``names`` each, around
+    :func:`study_base` ``file``) without ``pareto_front`` (which compares all designs): each row
+    depends on its design alone, so the rows of a part of the grid are those of the whole."""
     rows: list[dict[str, Any]] = []
     convs: list[Converter] = []
     files = [replace(file, design=_swept(file.design, dict(zip(names, combo)))) for combo in grid]
@@ -278,13 +297,16 @@ def design_study(
         assert isinstance(steady, _Steady) and isinstance(run, TransientResult) and not isinstance(launch, str)
         sr, tr = steady.speed_ratio, steady.torque_ratio
         row |= steady.figures | takeoff_figures(run.columns, sr, tr) | launch_figures(launch, sr, tr)
-    columns = [*names, "pump_shape_effect_m2", "turbine_shape_effect_m2", "stator_shape_effect_m2"]
-    columns += [*GEOMETRY_COLUMNS, *(c for c in FIGURE_COLUMNS if not c.endswith("_shape_effect_m2")), "error"]
-    df = pd.DataFrame(rows).reindex(columns=columns)
-    front = pareto_front(df["stall_torque_ratio"].to_numpy(), df["takeoff_effective_tr_dip"].to_numpy())
-    df.insert(len(columns) - 1, "pareto_front", front)
+    df = pd.DataFrame(rows).reindex(columns=list(row_columns(names)))
     df["error"] = df["error"].fillna("")
     return df
+
+
+def row_columns(names: Sequence[str]) -> tuple[str, ...]:
+    """The columns of :func:`design_rows` (:func:`design_study` adds ``pareto_front`` before ``error``)."""
+    columns = [*names, "pump_shape_effect_m2", "turbine_shape_effect_m2", "stator_shape_effect_m2"]
+    columns += [*GEOMETRY_COLUMNS, *(c for c in FIGURE_COLUMNS if not c.endswith("_shape_effect_m2")), "error"]
+    return tuple(columns)
 
 
 __all__ = [
@@ -293,6 +315,7 @@ __all__ = [
     "SWEEP_COUNT_RANGE",
     "SWEEP_PARAMETERS",
     "check_sweep",
+    "design_rows",
     "design_study",
     "pareto_front",
     "parse_sweep",

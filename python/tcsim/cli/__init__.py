@@ -22,6 +22,7 @@ from . import (
     fit_shapes,
     init,
     launch,
+    monte_carlo,
     operating_point,
     replay,
     study,
@@ -38,6 +39,7 @@ EXAMPLES: dict[str, str] = {
     "operating-point": "tcsim operating-point li-sunden-2016 points.csv --model table",
     "fit": "tcsim fit li-sunden-2016 --target k_factor_table.csv --out fit",
     "study": "tcsim study li-sunden-2016 --out study",
+    "monte-carlo": "tcsim monte-carlo monte-carlo.toml --chunk-size 100 --out monte-carlo",
     "replay": "tcsim replay li-sunden-2016 measurement.csv --model table --out replay",
     "fit-shapes": "tcsim fit-shapes li-sunden-2016 takeoff.csv --model quasi-dynamic --out fit-shapes",
     "launch": "tcsim launch midsize-awd-8at --scenario part-pedal --out launch",
@@ -64,6 +66,7 @@ _register("characterise", characterise.characterise)
 _register("operating-point", operating_point.operating_point, operating_point.HELP)
 _register("fit", fit.fit)
 _register("study", study.study, study.HELP)
+_register("monte-carlo", monte_carlo.monte_carlo, monte_carlo.HELP)
 _register("replay", replay.replay)
 _register("fit-shapes", fit_shapes.fit_shapes, fit_shapes.HELP)
 _register("launch", launch.launch, launch.HELP)

@@ -34,7 +34,7 @@ def design(
     design: Annotated[str, typer.Argument(help="design .toml or bundled design name (li-sunden-2016-design)")],
     out: OutOpt = Path("design"),
     reference: Annotated[
-        str, typer.Option("--reference", help="reference converter with [geometry]: bundled name or .toml")
+        str, typer.Option("--reference", help=r"reference converter with \[geometry]: bundled name or .toml")
     ] = "li-sunden-2016",
     vehicle: Annotated[
         str | None,

@@ -2,15 +2,15 @@
 
 ::
 
-    tcsim init converter|vehicle|scenario|study|design [--from TABLE] [--out FILE] [--force]
+    tcsim init converter|vehicle|scenario|study|monte-carlo|design [--from TABLE] [--out FILE] [--force]
 
-FILE defaults to ``converter.toml``, ``vehicle.toml``, ``scenario.csv``, ``study.toml`` or ``design.toml``
-in the current directory; an existing FILE is refused (exit 2, one line) unless ``--force``.
+FILE defaults to ``converter.toml``, ``vehicle.toml``, ``scenario.csv``, ``study.toml``,
+``monte-carlo.toml`` or ``design.toml`` in the current directory; an existing FILE is refused (exit 2,
+one line) unless ``--force``.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
@@ -19,14 +19,14 @@ from .app import say
 
 #: The command's ``--help`` text.
 HELP = (
-    "Write a commented, valid starting file: converter, vehicle, scenario, study or design (values from the "
-    "bundled data, with units, ranges and sources); 'init converter --from TABLE' makes a converter of a "
-    "characteristic table and marks what the other models still need."
+    "Write a commented, valid starting file: converter, vehicle, scenario, study, monte-carlo or design "
+    "(values from the bundled data, with units, ranges and sources); 'init converter --from TABLE' makes a "
+    "converter of a characteristic table and marks what the other models still need."
 )
 
 
 def init(
-    kind: Annotated[str, typer.Argument(help="converter | vehicle | scenario | study | design")],
+    kind: Annotated[str, typer.Argument(help="converter | vehicle | scenario | study | monte-carlo | design")],
     from_table: Annotated[
         str | None,
         typer.Option("--from", help="converter only: a characteristic table (.csv, .vtcc) or converter .toml"),
@@ -45,7 +45,7 @@ def init(
     target = DEFAULT_FILES[kind] if out is None else out
     if not target.strip():
         raise InputError("command line", "--out", target, "a file name (an empty name is not a file)")
-    template = make_template(kind, Path(target).name, from_table)
+    template = make_template(kind, target, from_table)  # the command names the file as the user gave it
     write_template(template, target, force, (from_table,) if from_table else ())
     say(f"wrote {target}: a {kind} file; run it with: {template.command}")
     if template.todo:

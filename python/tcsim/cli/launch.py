@@ -117,12 +117,13 @@ def write_launch(result: Launch, out_dir: Path, tf: TableFormat | None = None, p
     of a launch into ``out_dir`` (a staging directory)."""
     from ..io.results import write_launch_files
     from ..io.tables import CSV
-    from ..plots.launch import plot_launch, plot_sweep
 
     out_dir = Path(out_dir)
     paths = write_launch_files(result, out_dir, tf or CSV)
     if not plots:
         return paths
+    from ..plots.launch import plot_launch, plot_sweep  # only with plots: matplotlib's import
+
     first_events = next(iter(result.runs.values())).events if result.runs else []
     release = result.scenario.brake_release_time_s
     paths += plot_launch(result.frames, first_events, release, result.scenario.name, out_dir, result.summary)

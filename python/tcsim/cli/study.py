@@ -7,6 +7,7 @@ Without ``--chunk-size``: DIR/study.csv and one figure per parameter, written at
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
@@ -16,13 +17,44 @@ from ..errors import InputError
 from .app import FormatOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 if TYPE_CHECKING:
+    from ..analysis.chunked import ChunkedStudy
     from ..analysis.study import StudyDefinition
+    from ..io.shards import ShardRun
     from ..io.tables import TableFormat
 
 #: ``--values-per-parameter``: the most with ``--chunk-size``, and without it (one curve per value
 #: in each figure).
 MAX_VALUES_PER_PARAMETER = 1_000_000
 MAX_VALUES_PER_PARAMETER_UNCHUNKED = 1000
+
+#: The options of every sharded command (``tcsim study``, ``monte-carlo``, ``design-study``).
+ChunkSizeOpt = Annotated[
+    int | None,
+    typer.Option(help="write Parquet shards of this many cases each (DIR/shards, DIR/manifest.json), resumable"),
+]
+SchedulerOpt = Annotated[
+    str | None,
+    typer.Option(help="with --chunk-size: 'local' (a dask LocalCluster) or a dask scheduler's address"),
+]
+WorkersOpt = Annotated[int | None, typer.Option(help="worker processes of --scheduler local (default: cores)")]
+NoProgressOpt = Annotated[bool, typer.Option("--no-progress", help="no progress bar")]
+
+
+def refuse_cluster_options(scheduler: str | None, workers: int | None) -> None:
+    """``--scheduler`` and ``--workers`` without ``--chunk-size``: an :class:`InputError`."""
+    for option, value in (("--scheduler", scheduler), ("--workers", workers)):
+        if value is not None:
+            raise InputError("command line", option, value, "to be given with --chunk-size (a sharded study)")
+
+
+def refuse_format_with_shards(file_format: str) -> None:
+    """``--format`` other than the default with ``--chunk-size``: an :class:`InputError` (the shards
+    are Parquet whatever the format; a silently ignored option would surprise)."""
+    if file_format != "csv":
+        raise InputError(
+            "command line", "--format", file_format, "csv (the default) with --chunk-size: shards are always Parquet"
+        )
+
 
 HELP = (
     "Appendix D parameter study: one figure per parameter and DIR/study.csv; with --chunk-size, "
@@ -76,26 +108,49 @@ def sharded_study_command(
     """The study in chunks of ``chunk_size`` cases as DIR/shards/part-NNNNN.parquet and
     DIR/manifest.json (``tcsim.io.shards``), resuming what DIR holds; the line to print."""
     from ..analysis.chunked import appendix_d_study, check_chunk_size, check_scheduler
-    from ..io.shards import SHARDS, run_to_shards
     from ..models.converter import load_converter
-    from ..reports.console import progress_display
 
     check_chunk_size(chunk_size)
     check_scheduler(scheduler, workers)
     conv = load_converter(converter)
     study = appendix_d_study(conv, definition)
     inputs = [p for p in (converter, conv.path) if p]
+    run = run_sharded(study, out, chunk_size, speed_unit, scheduler, workers, inputs, progress)
+    return f"study: {run.n_cases} cases, {run.rows} points in {shards_line(run)}"
+
+
+def run_sharded(
+    study: ChunkedStudy,
+    out: str | Path,
+    chunk_size: int,
+    speed_unit: str,
+    scheduler: str | None,
+    workers: int | None,
+    inputs: Sequence[str | Path],
+    progress: bool,
+) -> ShardRun:
+    """``study`` in chunks of ``chunk_size`` cases as DIR/shards/part-NNNNN.parquet and
+    DIR/manifest.json (:func:`tcsim.io.shards.run_to_shards`), resuming what DIR holds, with a
+    progress bar of the chunks unless ``progress`` is False: what every sharded command runs."""
+    from ..io.shards import run_to_shards
+    from ..reports.console import progress_display
+
     with progress_display(progress) as display:
-        task = display.add_task("study chunks", total=None)
+        task = display.add_task(f"{study.kind} chunks", total=None)
 
         def advance(done: int, total: int) -> None:
             display.update(task, completed=done, total=total)
 
-        run = run_to_shards(study, out, chunk_size, speed_unit, scheduler, workers, inputs, advance)
+        return run_to_shards(study, out, chunk_size, speed_unit, scheduler, workers, inputs, advance)
+
+
+def shards_line(run: ShardRun) -> str:
+    """``N chunks of M cases (C computed, K kept from an earlier run) in DIR/shards and
+    DIR/manifest.json``: the end of every sharded command's output line."""
+    out = Path(run.out)
     return (
-        f"study: {run.n_cases} cases, {run.rows} points in {run.n_chunks} chunks of {run.chunk_size} cases "
-        f"({len(run.computed)} computed, {len(run.kept)} kept from an earlier run) in {Path(out) / SHARDS} "
-        f"and {Path(out) / 'manifest.json'}"
+        f"{run.n_chunks} chunks of {run.chunk_size} cases ({len(run.computed)} computed, {len(run.kept)} kept "
+        f"from an earlier run) in {out / 'shards'} and {out / 'manifest.json'}"
     )
 
 
@@ -110,7 +165,7 @@ def _values_per_parameter(n: int | None, chunked: bool) -> int | None:
 
 
 def study(
-    converter: Annotated[str, typer.Argument(help="converter with a [geometry] section")],
+    converter: Annotated[str, typer.Argument(help=r"converter with a \[geometry] section")],
     out: OutOpt = Path("study"),
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
@@ -122,11 +177,8 @@ def study(
         int | None,
         typer.Option(help="write Parquet shards of this many cases each (a case: one parameter value), resumable"),
     ] = None,
-    scheduler: Annotated[
-        str | None,
-        typer.Option(help="with --chunk-size: 'local' (a dask LocalCluster) or a dask scheduler's address"),
-    ] = None,
-    workers: Annotated[int | None, typer.Option(help="worker processes of --scheduler local (default: cores)")] = None,
+    scheduler: SchedulerOpt = None,
+    workers: WorkersOpt = None,
     no_progress: Annotated[bool, typer.Option("--no-progress", help="no progress bar (--chunk-size)")] = False,
 ) -> None:
     """The command; its help is :data:`HELP`."""
@@ -136,11 +188,10 @@ def study(
     n = _values_per_parameter(values_per_parameter, chunk_size is not None)
     definition = default_definition() if n is None else default_definition().replace(values_per_parameter=n)
     if chunk_size is None:
-        for option, value in (("--scheduler", scheduler), ("--workers", workers)):
-            if value is not None:
-                raise InputError("command line", option, value, "to be given with --chunk-size (a sharded study)")
+        refuse_cluster_options(scheduler, workers)
         say(study_command(converter, out, definition, tf=tf))
         return
+    refuse_format_with_shards(file_format)
     line = sharded_study_command(
         converter, out, chunk_size, definition, tf.speed_unit, scheduler, workers, progress=not no_progress
     )

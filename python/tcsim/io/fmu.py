@@ -15,7 +15,7 @@ The FMU is a zip archive:
 * ``resources/model.json``: the model specification (:attr:`tcsim.transient.DynamicModel.spec`),
   the causality and the parameter list, read by the library at ``fmi2Instantiate``;
 * ``binaries/linux64/tcsim_converter.so``: the Rust library ``crates/tcsim-fmu`` (a ``cdylib`` over
-  ``tcsim-core``: diffsol's BDF solver inside ``fmi2DoStep``), found by :func:`find_libraries`
+  ``tcsim-core``: tcsim's BDF solver inside ``fmi2DoStep``), found by :func:`find_libraries`
   (``binaries/win64/tcsim_converter.dll`` and ``binaries/darwin64/tcsim_converter.dylib`` as well
   when ``$TCSIM_FMU_LIBRARY`` lists them);
 * ``sources/``: a README on rebuilding the binary for Windows and macOS, with the Rust sources of

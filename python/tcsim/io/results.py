@@ -8,12 +8,12 @@ import json
 import warnings
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import pandas as pd
 import tomli_w
 
-from ..analysis.fitting import FitResult
 from ..analysis.launch import Launch
 from ..analysis.replay import Replay
 from ..errors import TcsimWarning
@@ -21,6 +21,9 @@ from ..models.characteristic import Characteristic
 from ..models.converter import Converter, parse_converter
 from ..simulation.transient import INFINITE_ALLOWED, NAN_NOT_EXPECTED
 from .tables import CSV, TableFormat, column_in_unit, write_table
+
+if TYPE_CHECKING:  # the fit's type only: importing the fitting module imports scipy.optimize
+    from ..analysis.fitting import FitResult
 
 
 def _partly_nan(df: pd.DataFrame, name: str) -> np.ndarray:

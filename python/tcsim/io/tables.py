@@ -34,9 +34,6 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
-import pyarrow as pa
-import pyarrow.parquet as pq
-import scipy.io
 
 from ..errors import InputError
 from ..units import RAD_S_PER_RPM
@@ -145,6 +142,9 @@ def write_csv(df: pd.DataFrame, path: Path) -> None:
 def write_parquet(df: pd.DataFrame, path: Path) -> None:
     """``df`` as Parquet at ``path`` (pyarrow; no index). A text column holding other values as
     well (numbers in an event's detail) is written as text."""
+    import pyarrow as pa  # noqa: PLC0415  lazy: start-up time (a CSV run never needs pyarrow)
+    import pyarrow.parquet as pq  # noqa: PLC0415  lazy: start-up time
+
     columns = {}
     for name in df.columns:
         col = df[name]
@@ -179,6 +179,8 @@ def mat_variables(df: pd.DataFrame) -> dict[str, np.ndarray]:
 
 def write_mat(df: pd.DataFrame, path: Path) -> None:
     """``df`` as a MATLAB v5 ``.mat`` file at ``path``: :func:`mat_variables`, N×1 each, compressed."""
+    import scipy.io  # noqa: PLC0415  lazy: start-up time (a CSV run never needs SciPy)
+
     scipy.io.savemat(path, mat_variables(df), oned_as="column", do_compression=True)
 
 

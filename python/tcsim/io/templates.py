@@ -1,4 +1,5 @@
-"""Starting files for ``tcsim init``: a commented, valid converter, vehicle, scenario, study or design file.
+"""Starting files for ``tcsim init``: a commented, valid converter, vehicle, scenario, study, Monte Carlo
+study or design file.
 
 Every value of a template is read from the bundled data (the converter ``li-sunden-2016``, the vehicle
 ``midsize-awd-8at``, the built-in flip-flop scenario, the design ``li-sunden-2016-design``) or, with
@@ -19,6 +20,7 @@ unless ``force``.
 
 from __future__ import annotations
 
+import shlex
 import textwrap
 import tomllib
 from collections.abc import Callable, Mapping
@@ -52,13 +54,14 @@ from ..simulation.scenarios import flip_flop
 from .outputs import check_output_file, output_file
 
 #: What ``tcsim init`` writes.
-KINDS = ("converter", "vehicle", "scenario", "study", "design")
+KINDS = ("converter", "vehicle", "scenario", "study", "monte-carlo", "design")
 #: The file ``tcsim init KIND`` writes without ``--out``.
 DEFAULT_FILES = {
     "converter": "converter.toml",
     "vehicle": "vehicle.toml",
     "scenario": "scenario.csv",
     "study": "study.toml",
+    "monte-carlo": "monte-carlo.toml",
     "design": "design.toml",
 }
 #: The bundled converter whose values fill the converter and study templates.
@@ -270,13 +273,18 @@ def _converter_sections(doc: _Toml, raw: dict[str, Any], sections: tuple[str, ..
     doc.table("sources", kept)
 
 
+def _arg(path: str) -> str:
+    """``path`` as one shell word in a suggested command line."""
+    return shlex.quote(path)
+
+
 def converter_template(out_name: str, study: bool = False) -> Template:
     """The bundled :data:`TEMPLATE_CONVERTER` as a commented file (``study``: its ``[geometry]`` alone,
     with the ranges ``tcsim study`` sweeps)."""
     conv = load_converter(TEMPLATE_CONVERTER)
     raw = _bundled_toml(conv.path)
     kind = "study" if study else "converter"
-    command = f"tcsim study {out_name}" if study else f"tcsim characterise {out_name}"
+    command = f"tcsim study {_arg(out_name)}" if study else f"tcsim characterise {_arg(out_name)}"
     extra: tuple[str, ...] = (
         "Sections and keys: docs/conventions.md and docs/models.md; each model needs only its own sections, "
         "unknown keys are errors. Replace every value (and its [sources] line) with your converter's.",
@@ -327,7 +335,7 @@ def table_template(table_spec: str, out_name: str) -> Template:
     if conv.characteristic is None:
         raise InputError(conv.path, "[characteristic]", "missing", "a characteristic table (.csv, .vtcc or .toml)")
     table_name = Path(conv.path).name
-    command = f"tcsim characterise {out_name} --model table"
+    command = f"tcsim characterise {_arg(out_name)} --model table"
     todo = tuple(TODO_SECTIONS)
     doc = _Toml()
     _header(doc, "converter", f"[characteristic] from {table_name}", command)
@@ -364,7 +372,7 @@ def vehicle_template(out_name: str) -> Template:
     """The bundled vehicle :data:`~tcsim.models.vehicle.DEFAULT_VEHICLE` as a commented file."""
     vehicle = load_vehicle(DEFAULT_VEHICLE)
     raw = _bundled_toml(vehicle.path)
-    command = f"tcsim launch {out_name}"
+    command = f"tcsim launch {_arg(out_name)}"
     extra = (
         "Every key, its unit, its range (checked when the file is read) and its meaning: docs/vehicle.md. "
         "The converter's inertias belong to the converter file, not here.",
@@ -389,7 +397,7 @@ def scenario_template(out_name: str) -> Template:
     """The built-in flip-flop launch (:func:`tcsim.simulation.scenarios.flip_flop`) as a CSV scenario."""
     scenario = flip_flop()
     t, pedal, brake = scenario.time_s, scenario.accelerator_pedal, scenario.brake_pedal
-    command = f"tcsim launch --scenario {out_name}"
+    command = f"tcsim launch --scenario {_arg(out_name)}"
     doc = _Toml()
     _header(doc, "scenario", f"the built-in scenario {scenario.name}", command)
     notes = (
@@ -415,7 +423,7 @@ def design_template(out_name: str) -> Template:
     """The bundled design :data:`TEMPLATE_DESIGN` as a commented file."""
     file = load_design_file(TEMPLATE_DESIGN)
     raw = _bundled_toml(file.path)
-    command = f"tcsim design {out_name}"
+    command = f"tcsim design {_arg(out_name)}"
     extra = ("Every key and what the command derives from it: docs/design.md, 'Design files'.",)
     doc = _Toml()
     _header(doc, "design", f"the values of the bundled design {TEMPLATE_DESIGN}", command, extra)
@@ -436,12 +444,74 @@ def design_template(out_name: str) -> Template:
     return Template("design", doc.text(), (), command)
 
 
+#: The Monte Carlo template's cases (a first look; a tolerance study's tails need 10⁴ or more).
+TEMPLATE_RUNS = 100
+#: The Monte Carlo template's distributions: (parameter, kind, spread relative to the bundled value).
+#: The means are the bundled vehicle's and its converter's values, read when the template is written.
+TEMPLATE_DISTRIBUTIONS: tuple[tuple[str, str, float], ...] = (
+    ("vehicle.body.mass_kg", "truncated-normal", 0.02),
+    ("vehicle.engine.inertia_kg_m2", "lognormal", 0.05),
+    ("converter.inertia.turbine_kg_m2", "uniform", 0.05),
+    ("converter.quasi_dynamic.pump_shape_effect_m2", "normal", 0.1),
+)
+
+
+def _template_distribution(kind: str, value: float, spread: float) -> dict[str, Any]:
+    """A distribution of ``kind`` around ``value``: std (or half-width) ``spread`` of it, truncated at 3 std."""
+    d = float(f"{abs(value) * spread:.6g}")
+    if kind == "uniform":
+        return {"kind": kind, "low": float(f"{value - d:.6g}"), "high": float(f"{value + d:.6g}")}
+    if kind == "truncated-normal":
+        low, high = float(f"{value - 3 * d:.6g}"), float(f"{value + 3 * d:.6g}")
+        return {"kind": kind, "mean": value, "std": d, "low": low, "high": high}
+    return {"kind": kind, "mean": value, "std": d}
+
+
+def monte_carlo_template(out_name: str) -> Template:
+    """A Monte Carlo study file (:mod:`tcsim.models.study_file`) of the bundled vehicle
+    :data:`~tcsim.models.vehicle.DEFAULT_VEHICLE` and its converter, the means their values."""
+    vehicle = load_vehicle(DEFAULT_VEHICLE)
+    files = {"vehicle": vehicle.to_toml_dict(), "converter": vehicle.converter.to_toml_dict()}
+    command = f"tcsim monte-carlo {_arg(out_name)}"
+    extra = (
+        "Every key: docs/study.md, 'Monte Carlo studies'. Each case draws every parameter below from its "
+        "distribution (seeded by seed and the case's number alone) and launches every model; a distribution "
+        "whose support leaves a parameter's valid range is refused before anything runs.",
+    )
+    doc = _Toml()
+    _header(doc, "monte-carlo", f"the bundled vehicle {DEFAULT_VEHICLE} and its converter", command, extra)
+    doc.blank()
+    doc.key("name", Path(out_name).stem, "the name outputs and messages use")
+    doc.key("vehicle", DEFAULT_VEHICLE, "a bundled vehicle (tcsim vehicles) or a vehicle .toml, relative to this file")
+    doc.comment("converter: a bundled converter or a converter .toml relative to this file (default: the vehicle's)")
+    doc.key("converter", vehicle.converter_spec, commented=True)
+    doc.key("scenario", "flip-flop", "flip-flop (full pedal, to 100 km/h) | part-pedal (pedal 0.3, to 50 km/h)")
+    doc.key("models", list(vehicle.converter.models), "launched in each case; the dip is against the table run")
+    doc.key("runs", TEMPLATE_RUNS, "cases; run with --chunk-size N for many (resumable Parquet shards)")
+    doc.key("seed", 1, "the same file and seed give the same cases bit for bit, however the study is chunked")
+    outputs = ["time_0_50_km_h_s", "time_0_100_km_h_s", "effective_torque_ratio_dip_first_0_5_s"]
+    doc.key("outputs", outputs, "launch summary columns kept per case and model (docs/launch_summary.md)")
+    doc.section(
+        "distributions",
+        "parameter as the file writes it (converter.<section>.<key>, vehicle.<section>.<key>) = normal "
+        "{mean, std} | uniform {low, high} | lognormal {mean, std of the value itself} | truncated-normal "
+        "{mean, std, low, high}; the means below are the bundled values",
+    )
+    for key, kind, spread in TEMPLATE_DISTRIBUTIONS:
+        target, section, name = key.split(".")
+        value = float(files[target][section][name])
+        items = ", ".join(f"{k} = {_value(v)}" for k, v in _template_distribution(kind, value, spread).items())
+        doc.lines.append(f'"{key}" = {{ {items} }}')
+    return Template("monte-carlo", doc.text(), (), command)
+
+
 #: The builder of each kind (``init converter --from`` is :func:`table_template`).
 _BUILDERS: dict[str, Callable[[str], Template]] = {
     "converter": converter_template,
     "vehicle": vehicle_template,
     "scenario": scenario_template,
     "study": lambda out_name: converter_template(out_name, study=True),
+    "monte-carlo": monte_carlo_template,
     "design": design_template,
 }
 

@@ -12,7 +12,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-__all__ = ["finish_figure", "mpl_text", "plt"]
+__all__ = ["finish_figure", "fixed_figure", "mpl_text", "plt"]
 
 #: Control characters, tab and newline included (shown as ``\x01``, ``\t``), and lone surrogates (a
 #: non-UTF-8 file name decoded with ``surrogateescape``; shown as U+FFFD): matplotlib cannot draw them.
@@ -29,6 +29,32 @@ def mpl_text(text: Any) -> str:
     is: ``$`` escaped so that nothing is read as mathtext, undrawable characters replaced. Every user
     string that reaches matplotlib goes through here."""
     return _UNDRAWABLE.sub(_undrawable, str(text)).replace("$", r"\$")
+
+
+#: Margins of a figure of one axes and of two stacked axes, fractions of the figure: room for the
+#: tick labels and the axis label on the left, the x label below and a one-line title above at the
+#: sizes :func:`fixed_figure` is used with (6.4–7.2 in wide, 4.2–5.6 in high).
+MARGINS_ONE = {"left": 0.11, "right": 0.97, "bottom": 0.12, "top": 0.91}
+MARGINS_TWO = {"left": 0.11, "right": 0.97, "bottom": 0.09, "top": 0.93}
+
+
+def fixed_figure(figsize: tuple[float, float], height_ratios: tuple[float, ...] | None = None, hspace: float = 0.08):
+    """A figure of one axes, or of ``len(height_ratios)`` stacked axes sharing x, with fixed margins.
+
+    Fixed margins instead of matplotlib's constrained layout: the layout engine draws every figure
+    twice (once to measure its text), which made the six figures of ``tcsim launch`` take 0.55 s
+    more CPU (1.40 s against 0.85 s, measured 2026-11-24). ``hspace``: the gap between stacked axes
+    (fraction of their mean height; 0.2 leaves room for a one-line title of the lower axes).
+    Returns ``(fig, ax)`` or ``(fig, axes)``."""
+    if height_ratios is None:
+        fig, ax = plt.subplots(figsize=figsize)
+        fig.subplots_adjust(**MARGINS_ONE)
+        return fig, ax
+    fig, axes = plt.subplots(
+        len(height_ratios), 1, figsize=figsize, sharex=True, gridspec_kw={"height_ratios": list(height_ratios)}
+    )
+    fig.subplots_adjust(**{**MARGINS_TWO, "hspace": hspace})
+    return fig, axes
 
 
 def finish_figure(fig, ax, path: Path, title: str, xlabel: str = "Time [s]") -> Path:

@@ -36,7 +36,7 @@ from matplotlib.ticker import MaxNLocator
 from ..analysis.launch import REFERENCE_MODEL
 from ..analysis.launch_metrics import RECOVERY_BAND, deficit_series, shift_windows
 from ..units import KM_H
-from .common import finish_figure, mpl_text, plt
+from .common import finish_figure, fixed_figure, mpl_text, plt
 from .styles import MODEL_STYLES, model_line
 
 LABELS = {name: style.label for name, style in MODEL_STYLES.items()}
@@ -79,7 +79,7 @@ def _summary_value(summary: pd.DataFrame | None, model: str, column: str) -> flo
 def plot_torque_speed_ratio(frames: Frames, release: float, out_dir: Path) -> Path:
     """Figure 3.5: effective TR (upper lines) and SR (lower lines) against time around the release."""
     a, b = release - RATIO_WINDOW_S[0], release + RATIO_WINDOW_S[1]
-    fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+    fig, ax = fixed_figure((6.4, 4.2))
     top = 2.5
     for i, (name, f) in enumerate(frames.items()):
         w = _window(f, a, b)
@@ -102,9 +102,7 @@ def plot_effective_torque_ratio(frames: Frames, release: float, out_dir: Path, s
     (below) with the recovery band, the dip and the recovery time of ``summary`` marked."""
     a, b = release - EFFECTIVE_WINDOW_S[0], release + EFFECTIVE_WINDOW_S[1]
     ref = frames.get(REFERENCE_MODEL)
-    fig, (ax, dax) = plt.subplots(
-        2, 1, figsize=(6.4, 5.6), sharex=True, layout="constrained", gridspec_kw={"height_ratios": [3, 2]}
-    )
+    fig, (ax, dax) = fixed_figure((6.4, 5.6), (3, 2), hspace=0.2)
     for i, (name, f) in enumerate(frames.items()):
         w = _window(f, a, b)
         ax.plot(w["time_s"], w["effective_torque_ratio"], **_style(name, i))
@@ -188,7 +186,7 @@ def plot_acceleration(
     ``events`` (``(time_s, kind, ...)``, those of the first model) are marked on the second, with
     the first model's shift transients shaded and each model's launch peak (``summary``) marked."""
     paths = []
-    fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+    fig, ax = fixed_figure((6.4, 4.2))
     for i, (name, f) in enumerate(frames.items()):
         w = _window(f, release - ACCEL_WINDOW_S[0], release + ACCEL_WINDOW_S[1])
         ax.plot(w["time_s"], w["vehicle_accel_m_s2"], **_style(name, i))
@@ -203,7 +201,7 @@ def plot_acceleration(
         )
     )
 
-    fig, ax = plt.subplots(figsize=(7.2, 4.2), layout="constrained")
+    fig, ax = fixed_figure((7.2, 4.2))
     start = release - ACCEL_WINDOW_S[0]
     for i, (name, f) in enumerate(frames.items()):
         w = f[f["time_s"] >= start]
@@ -221,16 +219,14 @@ def plot_acceleration(
             fig,
             ax,
             Path(out_dir) / "vehicle_accel.png",
-            "Vehicle acceleration over the run (▲ launch peaks; events of the first model), cf. thesis fig. 3.20",
+            "Vehicle acceleration (▲ launch peaks; events of the first model), cf. thesis fig. 3.20",
         )
     )
     return paths
 
 
 def _two_panels(title: str):
-    fig, (top, bottom) = plt.subplots(
-        2, 1, figsize=(6.4, 5.6), sharex=True, layout="constrained", gridspec_kw={"height_ratios": [3, 2]}
-    )
+    fig, (top, bottom) = fixed_figure((6.4, 5.6), (3, 2))
     top.set_title(mpl_text(title), fontsize="medium")
     for ax in (top, bottom):
         ax.grid(True, alpha=0.3)
@@ -311,7 +307,7 @@ def plot_sweep(sweep: pd.DataFrame | None, steady: pd.DataFrame | None, release:
     for key, g in sweep.groupby("model", sort=False):
         model = str(key)
         for column, ylabel, what, figure in _SWEEP_FIGURES:
-            fig, ax = plt.subplots(figsize=(6.4, 4.2), layout="constrained")
+            fig, ax = fixed_figure((6.4, 4.2))
             for label, run in g.groupby("label", sort=False):
                 w = _window(run, a, b)
                 ax.plot(w["time_s"], w[column], lw=1.1, label=mpl_text(label))

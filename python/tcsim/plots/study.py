@@ -22,8 +22,11 @@ def _figure_path(out_dir: Path, key: str) -> Path:
     return Path(out_dir) / f"study_{key}.png"
 
 
-def plot_parameter(df: pd.DataFrame, p: ParameterRange, reference: float, path: Path, title: str) -> Path:
-    """Three panels (TR, CF, volume flow against SR), one line per value; the reference in black."""
+def plot_parameter(
+    df: pd.DataFrame, p: ParameterRange, reference: float, path: Path, title: str, dpi: int = 100
+) -> Path:
+    """Three panels (TR, CF, volume flow against SR), one line per value; the reference in black;
+    saved at ``dpi`` dots per inch."""
     fig, axes = plt.subplots(1, 3, figsize=(13.5, 4.2), layout="constrained")
     rows = df[df["parameter"] == p.key]
     values = rows["parameter_value"].unique()
@@ -41,7 +44,7 @@ def plot_parameter(df: pd.DataFrame, p: ParameterRange, reference: float, path: 
         ax.grid(True, alpha=0.3)
     axes[0].legend(title=mpl_text(f"{p.label} [{p.unit}]"), fontsize="small")
     fig.suptitle(mpl_text(f"Effect of parameter '{p.label}': {title}"))
-    fig.savefig(path, dpi=100)
+    fig.savefig(path, dpi=dpi)
     plt.close(fig)
     return path
 

@@ -1,6 +1,6 @@
 """Transient simulation of an isolated converter: models, drives, one-line and batch runs.
 
-The engine is the Rust core's (:mod:`tcsim._core`): diffsol's BDF solver on the models in
+The engine is the Rust core's (:mod:`tcsim._core`): its own variable-order BDF (NDF) solver on the models in
 mass-matrix form, with root finding for the stator one-way clutch and for flow reversal.
 See ``docs/transient.md`` for the equations, events and conventions.
 
@@ -12,7 +12,12 @@ API tiers (after FMPy):
   :class:`Speeds`, :class:`PumpTorqueLoad`;
 * batch: :func:`simulate_batch`, N models × one drive, one model × N drives, or N pairs, with the
   GIL released and one worker per core;
-* raw: ``tcsim._core.transient_runs`` with the dicts of :meth:`DynamicModel.spec` and ``Drive.spec``.
+* columnar batch: :func:`simulate_columns` → :class:`BatchColumns`, one array per chosen column for
+  all runs, per-run status and errors, no Python object per run (what scales with cores);
+* raw: ``tcsim._core.transient_batch`` with the dicts of :meth:`DynamicModel.spec` and ``Drive.spec``.
+
+Every tier takes ``columns`` (names of :data:`COLUMNS`; default all): only those are computed and
+stored by the core.
 """
 
 from __future__ import annotations
@@ -73,56 +78,143 @@ def _options(rtol: float | None, **extra) -> dict[str, Any]:
     return o
 
 
+_INFINITE_ALLOWED, _NAN_NOT_EXPECTED = _core.output_value_rules()
 #: Columns that may hold ±inf or NaN by definition: the K-factor is infinite where the capacity is
-#: zero and undefined (NaN) where it is negative (overrun rows of a table, ``conventions.md``).
-INFINITE_ALLOWED: frozenset[str] = frozenset({"k_factor_rpm_per_sqrt_nm"})
+#: zero and undefined (NaN) where it is negative (overrun rows of a table, ``conventions.md``). The
+#: rule is the core's (``tcsim._core.output_value_rules``), which checks every run with it.
+INFINITE_ALLOWED: frozenset[str] = frozenset(_INFINITE_ALLOWED)
 #: Unit suffixes of physical quantities (speeds, torques, flows, powers, energies): a run that has
 #: such a quantity never leaves it NaN at some samples; ratios, times not reached and metrics may be
-#: NaN where undefined.
-NAN_NOT_EXPECTED: tuple[str, ...] = ("_rad_s", "_nm", "_m3_s", "_w", "_j")
+#: NaN where undefined. The core's rule, as :data:`INFINITE_ALLOWED`.
+NAN_NOT_EXPECTED: tuple[str, ...] = tuple(_NAN_NOT_EXPECTED)
+#: Event kinds in the order of the codes of :attr:`BatchColumns.events` ``["kind"]``.
+EVENT_KINDS: tuple[str, ...] = tuple(_core.transient_event_kinds())
+#: Run status codes of :attr:`BatchColumns.status`: finished; input refused; solver failed;
+#: finished, but a column overflowed (±inf, or NaN in a physical quantity).
+RUN_OK, RUN_INPUT_ERROR, RUN_SOLVER_ERROR, RUN_OVERFLOW = 0, 1, 2, 3
+#: Columns the table models' extension warning reads (:meth:`DynamicModel.warn_about_run`).
+_WARNING_COLUMNS = ("pump_speed_rad_s", "turbine_speed_rad_s")
 
 
-def _overflow(columns: Mapping[str, np.ndarray]) -> tuple[str, float, float] | None:
-    """The first column of a run that overflowed (±inf, or NaN in a physical quantity the run has at
-    other samples): its name, the value and the time, s."""
-    time = np.asarray(columns.get("time_s", []), dtype=float)
-    for name, values in columns.items():
-        v = np.asarray(values, dtype=float)
-        bad = np.isinf(v) if name not in INFINITE_ALLOWED else np.zeros(v.shape, dtype=bool)
-        if name.endswith(NAN_NOT_EXPECTED) and not np.isnan(v).all():
-            bad |= np.isnan(v)
-        if bad.any():
-            i = int(np.flatnonzero(bad)[0])
-            return name, float(v[i]), float(time[i]) if i < len(time) else float("nan")
-    return None
-
-
-def _unpack(
-    run: _core.TransientRun, model: DynamicModel, index: int | None, files: Mapping[str, str] | None = None
-) -> TransientResult:
-    """The one reading of the core's result of a transient run (raises its error, shown against
-    ``files[source]`` for the input the core blamed, the model's converter file by default)."""
-    where = "" if index is None else f" (run {index})"
-    err = run.error
-    if err is None:
-        events = [Event(e.time_s, e.kind, e.stator_locked, e.flow_direction) for e in run.events]
-        overflow = _overflow(run.columns)
-        if overflow is not None:  # never a non-finite result without saying so: the drive is beyond the model
-            name, value, t = overflow
-            raise InputError(
-                (files or {}).get("drive") or "drive",
-                f"output {name}{where}",
-                value,
-                f"a drive whose run stays finite (it overflows at t = {t:.6g} s: check the drive's values and units)",
-                core_source="drive",
-            )
-        model.warn_about_run(run.columns, "the run" + where)
-        return TransientResult(model.name, dict(run.columns), events)
-    if err.kind == "input":
-        assert err.source is not None and err.field is not None and err.expected is not None
+def _failure(
+    f: Mapping[str, Any], model: DynamicModel, where: str, files: Mapping[str, str] | None
+) -> InputError | SolverError:
+    """The exception of a failed run from the core's report ``f`` (``transient_batch``'s
+    ``failures``), shown against ``files[source]`` for the input the core blamed (the model's
+    converter file by default). ``where`` names the run in a batch (`` (run 3)``)."""
+    if f["kind"] == "overflow":  # never a non-finite result without saying so: the drive is beyond the model
+        return InputError(
+            (files or {}).get("drive") or "drive",
+            f"output {f['column']}{where}",
+            f["value"],
+            "a drive whose run stays finite "
+            f"(it overflows at t = {f['time_s']:.6g} s: check the drive's values and units)",
+            core_source="drive",
+        )
+    if f["kind"] == "input":
         sources = {"converter": model.source, **(files or {})}
-        raise core_input_error(err.source, err.field + where, err.value, err.expected, sources)
-    raise SolverError(f"{model.name}{where}: {err.message}")
+        return core_input_error(f["source"], f["field"] + where, f["value"], f["expected"], sources)
+    return SolverError(f"{model.name}{where}: {f['message']}")
+
+
+@dataclass
+class BatchColumns:
+    """Results of N transient runs as columns (:func:`simulate_columns`): one array per chosen column
+    for all runs, no Python object per run.
+
+    Attributes
+    ----------
+    models : sequence of DynamicModel
+        The models as given (one for all runs, or one per run).
+    columns : dict of str to ndarray
+        Name (:data:`COLUMNS`, SI units in the name) → float64 array of shape (N, S) when every run
+        has S samples, else of shape (offsets[-1],), run ``i`` at rows ``offsets[i]:offsets[i + 1]``.
+        A run that failed with an error has NaN rows; an overflowing run (status
+        :data:`RUN_OVERFLOW`) has its values.
+    offsets : ndarray of int64, shape (N + 1,)
+        Row offsets of the runs in the flat layout (also given for the (N, S) layout).
+    time_s : ndarray or None
+        The sample times, s, shape (S,), when every run has the same ones; else None.
+    status : ndarray of uint8, shape (N,)
+        :data:`RUN_OK`, :data:`RUN_INPUT_ERROR`, :data:`RUN_SOLVER_ERROR` or :data:`RUN_OVERFLOW`.
+    events : dict of str to ndarray
+        All runs' events as flat arrays in run order: ``run`` (int64), ``time_s`` (s), ``kind``
+        (uint8 codes of :data:`EVENT_KINDS`), ``stator_locked`` (bool) and ``flow_direction`` (+1,
+        −1, 0 held at zero, after the event).
+    errors : dict of int to Exception
+        The :class:`~tcsim.errors.InputError` or :class:`SolverError` of each failed run, by index.
+    """
+
+    models: Sequence[DynamicModel]
+    columns: dict[str, np.ndarray]
+    offsets: np.ndarray
+    time_s: np.ndarray | None
+    status: np.ndarray
+    events: dict[str, np.ndarray]
+    errors: dict[int, Exception] = field(default_factory=dict)
+
+    def __len__(self) -> int:
+        return len(self.status)
+
+    def _model(self, i: int) -> DynamicModel:
+        return self.models[i if len(self.models) > 1 else 0]
+
+    def rows(self, name: str, i: int) -> np.ndarray:
+        """Column ``name`` of run ``i`` (a view, no copy)."""
+        col = self.columns[name]
+        return col[i] if col.ndim == 2 else col[self.offsets[i] : self.offsets[i + 1]]
+
+    def run_events(self, i: int) -> list[Event]:
+        """The events of run ``i``."""
+        ev = self.events
+        a, b = np.searchsorted(ev["run"], [i, i + 1])
+        kinds = ev["kind"][a:b].tolist()
+        return [
+            Event(t, EVENT_KINDS[k], locked, flow)
+            for t, k, locked, flow in zip(
+                ev["time_s"][a:b].tolist(), kinds, ev["stator_locked"][a:b].tolist(), ev["flow_direction"][a:b].tolist()
+            )
+        ]
+
+    def check(self) -> None:
+        """Raise the error of the first run that failed with an error (input or solver), else of the
+        first run that overflowed; nothing when every run finished."""
+        if not self.errors:
+            return
+        failed = np.flatnonzero((self.status == RUN_INPUT_ERROR) | (self.status == RUN_SOLVER_ERROR))
+        if not failed.size:
+            failed = np.flatnonzero(self.status == RUN_OVERFLOW)
+        if failed.size:
+            raise self.errors[int(failed[0])]
+
+    def run(self, i: int) -> TransientResult:
+        """Run ``i`` as a :class:`TransientResult` (its columns are views of :attr:`columns`); raises
+        the run's error if it failed."""
+        if self.status[i] != RUN_OK:
+            raise self.errors[i]
+        cols = {name: self.rows(name, i) for name in self.columns}
+        return TransientResult(self._model(i).name, cols, self.run_events(i))
+
+    def frame(self, i: int) -> pd.DataFrame:
+        """Run ``i`` as a DataFrame (:meth:`TransientResult.frame`)."""
+        return self.run(i).frame()
+
+    def runs(self) -> list[TransientResult]:
+        """Every run as a :class:`TransientResult` (its columns views of :attr:`columns`), after
+        :meth:`check` (which raises the first failed run's error)."""
+        self.check()
+        n = len(self)
+        names = list(self.columns)
+        cols = [list(c) if c.ndim == 2 else np.split(c, self.offsets[1:-1]) for c in self.columns.values()]
+        rows = zip(*cols) if names else iter([()] * n)
+        ev = self.events
+        bounds = np.searchsorted(ev["run"], np.arange(n + 1)).tolist()
+        fields = [ev[k].tolist() for k in ("time_s", "kind", "stator_locked", "flow_direction")]
+        events = [Event(t, EVENT_KINDS[k], locked, flow) for t, k, locked, flow in zip(*fields)]
+        return [
+            TransientResult(self._model(i).name, dict(zip(names, values)), events[bounds[i] : bounds[i + 1]])
+            for i, values in enumerate(rows)
+        ]
 
 
 def _initial(initial: dict[str, float] | None) -> dict[str, float] | None:
@@ -144,6 +236,7 @@ def simulate(
     initial: dict[str, float] | None = None,
     rtol: float | None = None,
     files: Mapping[str, str] | None = None,
+    columns: Sequence[str] | None = None,
     **solver_options,
 ) -> TransientResult:
     """Run one model under one drive; samples at ``times_s`` (default: the drive's time stamps).
@@ -151,6 +244,8 @@ def simulate(
     The run always integrates from the drive's first time stamp; ``times_s`` (s, increasing, within
     the drive's span) only chooses the samples, so a later first sample gives the same values as a
     full run at the same times (:func:`output_times`). Events before the first sample are kept.
+    ``columns`` chooses the output columns (names of :data:`COLUMNS`, default all); the others are
+    neither computed nor stored.
 
     The initial state is the steady state consistent with the first input sample (drive c: with
     the turbine at rest) unless ``initial`` gives ``pump_speed_rad_s``, ``turbine_speed_rad_s``,
@@ -158,7 +253,9 @@ def simulate(
     blame in an :class:`InputError` (``{"drive": "log.csv"}``; see :func:`simulate_batch`).
     """
     m = converter if isinstance(converter, DynamicModel) else dynamic_model(converter, model)
-    return simulate_batch([m], [drive], times_s, initial, rtol, threads=1, files=files, **solver_options)[0]
+    return simulate_batch(
+        [m], [drive], times_s, initial, rtol, threads=1, files=files, columns=columns, **solver_options
+    )[0]
 
 
 def simulate_batch(
@@ -169,39 +266,171 @@ def simulate_batch(
     rtol: float | None = None,
     threads: int = 0,
     files: Mapping[str, str] | None = None,
+    columns: Sequence[str] | None = None,
     **solver_options,
 ) -> list[TransientResult]:
     """Run ``models[i]`` under ``drives[i]``; a sequence of length one is broadcast. The runs go to
     the core in one call, which releases the GIL and uses ``threads`` workers (0: all cores).
-    Raises :class:`InputError` or :class:`SolverError` for the first run that fails.
+    Raises :class:`InputError` or :class:`SolverError` for the first run that fails (an error
+    before an overflow). ``columns`` as in :func:`simulate`; each result's columns are views of the
+    batch's arrays (:func:`simulate_columns`, which this reads).
 
     An :class:`InputError` names the input the core blamed (``core_source``: ``converter``,
     ``drive``, ``initial``, ``options``), shown as ``files[source]`` when given, else as the models'
     converter file or the input's name. ``solver_options`` are the core's: ``rtol``,
     ``speed_atol_rad_s``, ``flow_atol_m3_s``, ``first_step_s``, ``max_events`` and
-    ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs is refused above it
-    before anything runs)."""
-    specs, skip = [], []
+    ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs, counting only the
+    chosen columns, is refused above it before anything runs)."""
+    batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options)
+    batch.check()
+    _warn_about_runs(batch)
+    if columns is not None and len(batch.columns) > len(columns):
+        batch.columns = {name: batch.columns[name] for name in columns}
+    return batch.runs()
+
+
+def _where(i: int, n: int) -> str:
+    """How an error or a warning names run ``i`` of ``n``: nothing for a single run."""
+    return "" if n == 1 else f" (run {i})"
+
+
+def _warning_rows(batch: BatchColumns, i: int) -> dict[str, np.ndarray]:
+    return {name: batch.rows(name, i) for name in _WARNING_COLUMNS}
+
+
+def _drive_specs(drives: Sequence[Drive], times_s: Sequence[float] | None) -> tuple[list[dict], np.ndarray | None]:
+    """The drives' dicts for the core (with ``output_time_s`` and ``output_skip`` for ``times_s``) and
+    the sample times every run shares, s (None when the drives' time stamps differ)."""
+    specs = []
     for d in drives:
         s = d.spec()
-        skip.append(0)
         if times_s is not None:
-            s["output_time_s"], skip[-1] = output_times(s["time_s"], times_s)
+            s["output_time_s"], s["output_skip"] = output_times(s["time_s"], times_s)
         specs.append(s)
+    if times_s is not None:
+        return specs, np.atleast_1d(np.asarray(times_s, dtype=float))
+    first = np.asarray(specs[0]["time_s"], dtype=float)
+    same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
+    return specs, first if same else None
+
+
+def simulate_columns(
+    models: Sequence[DynamicModel],
+    drives: Sequence[Drive],
+    times_s: Sequence[float] | None = None,
+    columns: Sequence[str] | None = None,
+    initial: dict[str, float] | None = None,
+    rtol: float | None = None,
+    threads: int = 0,
+    files: Mapping[str, str] | None = None,
+    **solver_options,
+) -> BatchColumns:
+    """Run ``models[i]`` under ``drives[i]`` (a sequence of length one is broadcast) and return the
+    results as columns: one float64 array per chosen column for all runs, built by the core with the
+    GIL released on ``threads`` workers (0: all cores) and handed to NumPy without a copy.
+
+    Parameters
+    ----------
+    models, drives : sequence of DynamicModel, sequence of Drive
+        As in :func:`simulate_batch`.
+    times_s : sequence of float, optional
+        Sample times, s, for every run (:func:`output_times`); default each drive's time stamps.
+    columns : sequence of str, optional
+        Names of :data:`COLUMNS` (SI units in the name), each once; default all. Only these are
+        computed and stored; an empty list gives the status and events only. An unknown or repeated
+        name is an :class:`InputError` about ``columns[i]`` listing the valid names.
+    initial, rtol, files, **solver_options
+        As in :func:`simulate_batch`; ``max_output_bytes`` counts only the chosen columns.
+
+    Returns
+    -------
+    BatchColumns
+        Columns of shape (N, S) (or flat with ``offsets`` when the runs' sample counts differ), the
+        per-run ``status``, the events as flat arrays, and ``errors`` for the failed runs only. A
+        failed run does not raise here: :meth:`BatchColumns.check` or :meth:`BatchColumns.run` do.
+    """
+    batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options)
+    _warn_about_runs(batch)
+    if columns is not None and len(batch.columns) > len(columns):
+        batch.columns = {name: batch.columns[name] for name in columns}
+    return batch
+
+
+def _run_batch(
+    models: Sequence[DynamicModel],
+    drives: Sequence[Drive],
+    times_s: Sequence[float] | None,
+    columns: Sequence[str] | None,
+    initial: dict[str, float] | None,
+    rtol: float | None,
+    threads: int,
+    files: Mapping[str, str] | None,
+    solver_options: dict[str, Any],
+) -> BatchColumns:
+    """The one call of the core's ``transient_batch`` (:func:`simulate_columns`), with the columns
+    the warnings read added for table models (:func:`_core_columns`)."""
+    specs, shared_time = _drive_specs(drives, times_s)
     try:
-        raw = _core.transient_runs(
-            [m.spec for m in models], specs, _initial(initial), _options(rtol, **solver_options), threads
+        raw = _core.transient_batch(
+            [m.spec for m in models],
+            specs,
+            _initial(initial),
+            _options(rtol, **solver_options),
+            threads,
+            _core_columns(models, columns),
         )
     except _core.CoreInputError as e:
+        if str(e.args[1]).startswith("columns["):
+            raise from_core(e, "simulate") from None
         converters = {m.source for m in models}
         sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
         raise from_core(e, sources) from None
-    n = len(raw)
-    failed = next((i for i, r in enumerate(raw) if r.error is not None), None)
-    if failed is not None:  # raised before any run's warning: a failure is one line
-        _unpack(raw[failed], models[failed if len(models) > 1 else 0], failed if n > 1 else None, files)
-    results = [_unpack(r, models[i if len(models) > 1 else 0], i if n > 1 else None, files) for i, r in enumerate(raw)]
-    return [_drop_first(r, skip[i if len(skip) > 1 else 0]) for i, r in enumerate(results)]
+    return _batch_columns(raw, models, shared_time, files)
+
+
+def _core_columns(models: Sequence[DynamicModel], columns: Sequence[str] | None) -> list[str] | None:
+    """The columns asked of the core: ``columns`` and, for table models, what their warning reads."""
+    if columns is None:
+        return None
+    if isinstance(columns, str):
+        raise InputError("simulate", "columns", columns, "a list of output column names (one name: [name])")
+    chosen = [str(c) for c in columns]
+    if any(m.name in ("table", "quasi-dynamic") for m in models):
+        chosen += [c for c in _WARNING_COLUMNS if c not in chosen]
+    return chosen
+
+
+def _batch_columns(
+    raw: dict[str, Any], models: Sequence[DynamicModel], shared_time: np.ndarray | None, files: Mapping[str, str] | None
+) -> BatchColumns:
+    """The :class:`BatchColumns` of the core's ``transient_batch`` result (reshaped views, no copy)."""
+    offsets, status = raw["offsets"], raw["status"]
+    n = len(status)
+    counts = np.diff(offsets)
+    regular = n > 0 and bool((counts == counts[0]).all())
+    cols = {k: v.reshape(n, int(counts[0])) if regular else v for k, v in raw["columns"].items()}
+    if shared_time is not None and not (regular and int(counts[0]) == len(shared_time)):
+        shared_time = None
+    events = {k: raw[f"event_{k}"] for k in ("run", "time_s", "kind", "stator_locked", "flow_direction")}
+    batch = BatchColumns(models, cols, offsets, shared_time, status, events)
+    for f in raw["failures"]:
+        i = int(f["run"])
+        batch.errors[i] = _failure(f, batch._model(i), _where(i, n), files)
+    return batch
+
+
+def _warn_about_runs(batch: BatchColumns) -> None:
+    """The warnings about the finished runs (:meth:`DynamicModel.warn_about_run`): only the table
+    models have any about a run's values, so only their runs are looked at."""
+    n = len(batch)
+    for m in {id(m): m for m in batch.models if m.name == "quasi-dynamic"}.values():
+        m.warn_if_fragile_near_coupling()
+    if not any(m.name in ("table", "quasi-dynamic") for m in batch.models):
+        return
+    for i in np.flatnonzero(batch.status == RUN_OK).tolist():
+        m = batch._model(i)
+        if m.name in ("table", "quasi-dynamic"):
+            m.warn_if_extended(_warning_rows(batch, i), "the run" + _where(i, n))
 
 
 def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]) -> tuple[list[float], int]:
@@ -237,10 +466,3 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
             f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
         )
     return [start, *t.tolist()], 1
-
-
-def _drop_first(result: TransientResult, n: int) -> TransientResult:
-    """``result`` without its first ``n`` samples (the drive's start, prepended by :func:`output_times`)."""
-    if n == 0:
-        return result
-    return TransientResult(result.model, {k: np.asarray(v)[n:] for k, v in result.columns.items()}, result.events)

@@ -1,4 +1,4 @@
-//! The transient engine: a converter model, a way of driving it, and diffsol's BDF solver with
+//! The transient engine: a converter model, a way of driving it, and the BDF solver ([`crate::engine::bdf`]) with
 //! root finding for the discrete events.
 //!
 //! # Coordinates, states and modes
@@ -11,14 +11,14 @@
 //!   ([`crate::engine::signal`]);
 //! * **held** at zero: the stator while the one-way clutch holds, the flow while it is stalled.
 //!
-//! The free coordinates `x` obey `M_xx ẋ = F_x(u) + T_x(t, u) − M_xz ż(t)`, handed to diffsol in
+//! The free coordinates `x` obey `M_xx ẋ = F_x(u) + T_x(t, u) − M_xz ż(t)`, handed to the solver in
 //! this mass-matrix form with its analytic Jacobian. The external torque on a given or held
 //! coordinate is whatever the constraint needs, `T_z = (M u̇ − F)_z`: the turbine torque in drive
 //! (a), both torques in drive (b), the stator's holding torque.
 //!
 //! # Events
 //!
-//! The system is smooth between events; at an event the engine stops at the root (diffsol's root
+//! The system is smooth between events; at an event the engine stops at the root (the solver's root
 //! finder), switches the mode and starts a new BDF segment from the state at the root, which is
 //! continuous. Root functions per mode:
 //!

@@ -1,9 +1,10 @@
-//! The transient engines on diffsol: one BDF segment loop, the converter's events, the isolated
+//! The transient engines: the BDF integrator, one segment loop, the converter's events, the isolated
 //! converter under a drive, its Model Exchange view and its co-simulation stepper. Uses
 //! [`crate::converter`]; never the vehicle.
 //!
 //! * [`options`]: solver tolerances, event hysteresis, the engines' error type.
-//! * [`segment`]: the generic BDF loop over one smooth segment, up to the first root.
+//! * [`bdf`]: the variable-order NDF/BDF integrator (fixed-size arrays, events, dense output).
+//! * [`segment`]: the generic loop over one smooth segment, up to the first root.
 //! * [`converter_events`]: the converter's modes, roots, switches and samples (shared with the vehicle).
 //! * [`lockup`]: the lock-up clutch (friction law, states, roots), shared with the vehicle.
 //! * [`converter_segment`]: one smooth piece of an isolated run (roles, reduced mass, roots, switches).
@@ -14,6 +15,7 @@
 //! * [`signal`]: sampled input signals with a smoothed derivative.
 //! * [`outputs`]: the named output columns of a run.
 
+pub mod bdf;
 pub mod converter_events;
 pub mod converter_segment;
 pub mod drive;

@@ -1,12 +1,10 @@
-//! The diffsol BDF loop shared by the transient engines: one smooth segment of a piecewise-smooth
-//! system, from a state to the first root of its event functions (or the end time).
+//! The segment loop shared by the transient engines: one smooth segment of a piecewise-smooth
+//! system, from a state to the first root of its event functions (or the end time), on the
+//! fixed-size NDF/BDF integrator of [`crate::engine::bdf`].
 
-use diffsol::{NalgebraLU, NalgebraMat, OdeBuilder, OdeSolverMethod, OdeSolverStopReason};
-
+use crate::engine::bdf::roots::RootFinder;
+use crate::engine::bdf::{Bdf, N_MAX};
 use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
-
-type Matrix = NalgebraMat<f64>;
-type Lu = NalgebraLU<f64>;
 
 /// A smooth system `M ẋ = f(x, t)` with event functions, as one mode of a piecewise-smooth model.
 pub trait SmoothSegment {
@@ -45,71 +43,60 @@ pub fn run_segment<S: SmoothSegment>(
     samples: &mut Vec<S::Sample>,
     steps: &mut usize,
 ) -> TransientResult<SegmentEnd<S::Root>> {
-    let n = seg.n_states();
-    let fail = |t: f64, x: &[f64], e: &dyn std::fmt::Display| TransientError::Solver {
-        time_s: t,
-        state: if x.is_empty() { vec![] } else { seg.coordinates(x, t) },
-        message: e.to_string(),
-    };
+    #[cfg(test)]
+    if crate::engine::bdf::crosscheck::diffsol_selected() {
+        return crate::engine::bdf::crosscheck::run_segment(seg, x0, t0, t_end, times_s, o, samples, steps);
+    }
     while samples.len() < times_s.len() && times_s[samples.len()] <= t0 {
         samples.push(seg.sample(&x0, times_s[samples.len()]));
     }
     if t0 >= t_end {
         return Ok(None);
     }
+    let mut bdf = Bdf::new(seg, &x0, t0, t_end, o)?;
+    let n = x0.len();
     let roots = seg.roots();
-    let x_init = x0.clone();
-    let problem = OdeBuilder::<Matrix>::new()
-        .t0(t0)
-        .h0(o.first_step_s.min(t_end - t0))
-        .rtol(o.rtol)
-        .atol(seg.atol(o))
-        .rhs_implicit(
-            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| seg.rhs(x, t, y),
-            |x: &[f64], _p: &[f64], t: f64, v: &[f64], y: &mut [f64]| seg.jacobian_times(x, t, v, y),
-        )
-        .mass(|v: &[f64], _p: &[f64], _t: f64, beta: f64, y: &mut [f64]| seg.mass_times(v, beta, y))
-        .init(move |_p: &[f64], _t: f64, y: &mut [f64]| y.copy_from_slice(&x_init), n)
-        .root(
-            |x: &[f64], _p: &[f64], t: f64, y: &mut [f64]| {
-                if roots.is_empty() {
-                    y[0] = 1.0;
-                } else {
-                    seg.root_values(x, t, &o.hysteresis, y)
-                }
-            },
-            roots.len().max(1),
-        )
-        .build()
-        .map_err(|e| fail(t0, &x0, &e))?;
-    let mut solver = problem.bdf::<Lu>().map_err(|e| fail(t0, &x0, &e))?;
-    solver.set_stop_time(t_end).map_err(|e| fail(t0, &x0, &e))?;
-    let mut buffer = solver.state().y.clone();
+    let mut finder = RootFinder::new(if roots.is_empty() {
+        vec![]
+    } else {
+        let mut g0 = vec![0.0; roots.len()];
+        seg.root_values(&x0, t0, &o.hysteresis, &mut g0);
+        g0
+    });
+    let mut x = [0.0; N_MAX];
     loop {
         if *steps >= o.max_steps {
-            let s = solver.state();
-            return Err(fail(s.t, s.y.batch_as_slice(0), &format!("more than {} steps", o.max_steps)));
+            let (t, x) = (bdf.t(), bdf.x());
+            let message = format!("more than {} steps", o.max_steps);
+            return Err(TransientError::Solver { time_s: t, state: seg.coordinates(x, t), message });
         }
         *steps += 1;
-        let reason = solver.step().map_err(|e| {
-            let s = solver.state();
-            fail(s.t, s.y.batch_as_slice(0), &e)
-        })?;
-        let t_now = solver.state().t;
-        let (upto, root) = match reason {
-            OdeSolverStopReason::RootFound(tr, idx) if !roots.is_empty() => (tr, Some(roots[idx.min(roots.len() - 1)])),
-            _ => (t_now, None),
+        let t_lo = bdf.t();
+        bdf.step(t_end)?;
+        let t_hi = bdf.t();
+        let root = if roots.is_empty() {
+            None
+        } else {
+            finder.check(t_lo, t_hi, |t, g| {
+                if t == t_hi {
+                    seg.root_values(bdf.x(), t, &o.hysteresis, g);
+                } else {
+                    bdf.interpolate(t, &mut x);
+                    seg.root_values(&x[..n], t, &o.hysteresis, g);
+                }
+            })
         };
+        let upto = root.map_or(t_hi, |(t, _)| t);
         while samples.len() < times_s.len() && times_s[samples.len()] <= upto {
             let t = times_s[samples.len()];
-            solver.interpolate_inplace(t, &mut buffer).map_err(|e| fail(t, &[], &e))?;
-            samples.push(seg.sample(buffer.batch_as_slice(0), t));
+            bdf.interpolate(t, &mut x);
+            samples.push(seg.sample(&x[..n], t));
         }
-        if let Some(root) = root {
-            let x = solver.interpolate(upto).map_err(|e| fail(upto, &[], &e))?;
-            return Ok(Some((upto, root, x.batch_as_slice(0).to_vec())));
+        if let Some((t, i)) = root {
+            bdf.interpolate(t, &mut x);
+            return Ok(Some((t, roots[i], x[..n].to_vec())));
         }
-        if matches!(reason, OdeSolverStopReason::TstopReached) || t_now >= t_end {
+        if t_hi >= t_end {
             return Ok(None);
         }
     }

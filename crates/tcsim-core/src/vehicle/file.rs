@@ -3,8 +3,10 @@
 //! A vehicle file is TOML; [`VehicleFile`] mirrors it exactly (top-level `name`, `source`,
 //! optional `description`, `converter`, sections `[engine] [gearbox] [lockup] [driveline]
 //! [tyres] [body] [brake]` and optional `[sources]`). Every quantity is SI with its unit in its
-//! name; docs/vehicle.md describes the format field by field, with the same units and ranges as
-//! the doc comments here.
+//! name. [`SCHEMA`] lists every key with its unit, default, range and meaning; the ranges are the
+//! validator's own constants ([`super::parameters`], [`super::shift`], [`super::shift_pedal`]), a
+//! test checks each row at its bounds against [`read_vehicle`], and the documentation's vehicle
+//! file reference is generated from it (through the binding's `vehicle_schema()`).
 //!
 //! [`read_vehicle`] parses the text, checks the shape (unknown keys, missing keys, wrong types)
 //! while deserialising, converts the sections into the plant's [`Vehicle`] and checks the values
@@ -18,13 +20,131 @@ use indexmap::IndexMap;
 use serde::de::{self, DeserializeSeed, Deserializer, MapAccess, SeqAccess, Unexpected, Visitor};
 use serde::{Deserialize, Serialize};
 
-use super::parameters::{field, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Tyres, Vehicle};
-use super::shift::ShiftControl;
-use super::shift_pedal::PedalFilter;
+use super::parameters::{
+    self as p, field, Body, Brake, Curve, Driveline, Engine, Gearbox, Lockup, Range, Tyres, Vehicle,
+};
+use super::shift::{self, ShiftControl};
+use super::shift_pedal::{self, PedalFilter};
 use crate::error::{CoreError, CoreResult};
 
 /// The sections of a vehicle file that hold the vehicle's values, in file order.
 pub const SECTIONS: [&str; 7] = ["engine", "gearbox", "lockup", "driveline", "tyres", "body", "brake"];
+
+/// One key of a vehicle file as the documentation lists it: a row of [`SCHEMA`].
+#[derive(Debug, Clone, Copy)]
+pub struct KeySpec {
+    /// The section (`engine`, …), `""` for the top level.
+    pub section: &'static str,
+    /// The key as the file writes it.
+    pub key: &'static str,
+    /// The unit (SI, as the key's name carries it), `""` for a number without unit or a text.
+    pub unit: &'static str,
+    /// `None`: required; `Some(text)`: optional, and what its absence means.
+    pub default: Option<&'static str>,
+    /// The range of the value (of each value of an array) that [`read_vehicle`] enforces; `None`
+    /// for a text or an integer.
+    pub range: Option<Range>,
+    /// What else is checked (lengths, order, cross-checks with other keys), `""` if nothing.
+    pub rule: &'static str,
+    /// What the key means.
+    pub meaning: &'static str,
+}
+
+impl KeySpec {
+    /// The allowed values in words: the range's text and the rule, `; `-separated.
+    pub fn range_text(&self) -> String {
+        let range = self.range.map(|r| r.expected());
+        [range.as_deref().unwrap_or(""), self.rule]
+            .iter()
+            .filter(|t| !t.is_empty())
+            .copied()
+            .collect::<Vec<_>>()
+            .join("; ")
+    }
+}
+
+const fn key(
+    section: &'static str,
+    key: &'static str,
+    unit: &'static str,
+    range: Option<Range>,
+    rule: &'static str,
+    meaning: &'static str,
+) -> KeySpec {
+    KeySpec { section, key, unit, default: None, range, rule, meaning }
+}
+
+const fn optional(
+    section: &'static str,
+    key: &'static str,
+    unit: &'static str,
+    default: &'static str,
+    range: Range,
+    meaning: &'static str,
+) -> KeySpec {
+    KeySpec { section, key, unit, default: Some(default), range: Some(range), rule: "", meaning }
+}
+
+const SPEEDS: &str = "gears − 1 values, strictly increasing";
+const DOWN_SPEEDS: &str = "gears − 1 values, strictly increasing, each below the upshift speed of the same index";
+
+/// Every key of a vehicle file (but the free-form `[sources]`), in file order: the one schema the
+/// documentation is generated from. The ranges are the constants [`Vehicle::validate`] checks with.
+pub const SCHEMA: &[KeySpec] = &[
+    key("", "name", "", None, "text", "The vehicle's name."),
+    key("", "source", "", None, "text", "Where the vehicle's values come from, in one sentence."),
+    KeySpec { section: "", key: "description", unit: "", default: Some("none"), range: None, rule: "text", meaning: "Free text." },
+    key("", "converter", "", None, "text", "A bundled converter's name, or a converter `.toml` path relative to the vehicle file."),
+    key("engine", "inertia_kg_m2", "kg·m²", Some(Range::POSITIVE), "", "Crank and flywheel inertia (the converter pump's inertia is the converter's)."),
+    key("engine", "idle_speed_rad_s", "rad/s", Some(Range::POSITIVE), "within [full_load_speed_rad_s[0], full_load_speed_rad_s[-1]), where the full-load torque exceeds the drag", "Idle speed, held by the idle governor."),
+    key("engine", "full_load_speed_rad_s", "rad/s", Some(Range::NON_NEGATIVE), "two or more values, strictly increasing", "Speeds of the full-load curve."),
+    key("engine", "full_load_torque_nm", "N·m", Some(p::ENGINE_TORQUE), "one per speed; more than the drag torque at idle", "Full-load torque at those speeds."),
+    key("engine", "drag_torque_nm", "N·m", Some(Range::NON_NEGATIVE), "", "Constant part of the engine's drag."),
+    key("engine", "drag_nm_s_per_rad", "N·m·s/rad", Some(Range::NON_NEGATIVE), "", "Viscous part of the engine's drag."),
+    key("engine", "fast_time_constant_s", "s", Some(p::ENGINE_TIME_CONSTANT), "", "Time constant of the aspirated torque part."),
+    key("engine", "boost_time_constant_s", "s", Some(p::ENGINE_TIME_CONSTANT), "", "Time constant of the boost torque part (\"time to torque\", thesis §3.3)."),
+    key("engine", "boost_fraction", "", Some(Range::FRACTION), "", "Share of the pedal torque built up by boost."),
+    key("engine", "idle_governor_gain_nm_s_per_rad", "N·m·s/rad", Some(p::IDLE_GOVERNOR_GAIN), "", "Idle governor gain. Without the governor no engine speed balances drag and the stalled converter (no braked standstill to start from); above 1000 it settles faster than a firing interval and the solver fails."),
+    key("gearbox", "ratios", "", Some(p::GEAR_RATIO), "at least one value, gear 1 first, strictly decreasing", "Ratio of each gear."),
+    key("gearbox", "efficiencies", "", Some(Range::EFFICIENCY), "one per gear", "Efficiency of each gear."),
+    key("gearbox", "input_inertia_kg_m2", "kg·m²", Some(p::GEARBOX_INPUT_INERTIA), "one per gear", "Inertia of each gear at the gearbox input; 0 lumps it into the converter's turbine inertia."),
+    key("gearbox", "output_inertia_kg_m2", "kg·m²", Some(p::GEARBOX_OUTPUT_INERTIA), "", "Inertia of the gearbox output side."),
+    key("gearbox", "shift_clutch_capacity_nm", "N·m", Some(p::CLUTCH_CAPACITY), "", "Capacity of each shift clutch, at the gearbox input."),
+    key("gearbox", "shift_handover_s", "s", Some(Range::POSITIVE), "", "Torque handover time of a shift."),
+    optional("gearbox", "upshift_torque_reduction", "", "0", shift::TORQUE_REDUCTION, "Fraction of the engine's torque withheld in the inertia phase of an upshift (typical 0.3–0.6)."),
+    optional("gearbox", "upshift_inertia_phase_s", "s", "none: the on-coming clutch keeps `shift_clutch_capacity_nm`", shift::INERTIA_PHASE, "Target duration of an upshift's inertia phase, for the on-coming clutch's feed-forward (typical 0.2–0.5 s)."),
+    optional("gearbox", "upshift_power_on_nm", "N·m", "0 (any positive input torque)", shift::POWER_ON_THRESHOLD, "The TCU's power-on/power-off decision, at the gearbox input: an upshift is power-on (controlled on-coming capacity and torque reduction) when the input torque at its command is above it, power-off (constant capacity, no torque reduction) otherwise."),
+    optional("gearbox", "shift_pedal_rise_s", "s", "0 (at once)", shift_pedal::PEDAL_TIME_CONSTANT, "Time constant with which the pedal the shift schedule reads follows a pressed pedal (the TCU's filter; a full pedal, the kickdown, passes at once)."),
+    optional("gearbox", "shift_pedal_fall_s", "s", "0 (no filter)", shift_pedal::PEDAL_TIME_CONSTANT, "The same for a released pedal (the TCU holds the gear when the driver lifts). Both 0: the schedule reads the accelerator pedal itself."),
+    key("gearbox", "upshift_speed_zero_pedal_m_s", "m/s", Some(Range::POSITIVE), SPEEDS, "Vehicle speed of the upshift from gear k at zero pedal."),
+    key("gearbox", "upshift_speed_full_pedal_m_s", "m/s", Some(Range::POSITIVE), SPEEDS, "As `upshift_speed_zero_pedal_m_s`, at full pedal."),
+    key("gearbox", "downshift_speed_zero_pedal_m_s", "m/s", Some(Range::POSITIVE), DOWN_SPEEDS, "Vehicle speed of the downshift from gear k + 1 into k at zero pedal."),
+    key("gearbox", "downshift_speed_full_pedal_m_s", "m/s", Some(Range::POSITIVE), DOWN_SPEEDS, "As `downshift_speed_zero_pedal_m_s`, at full pedal."),
+    key("lockup", "capacity_nm", "N·m", Some(p::CLUTCH_CAPACITY), "", "Kinetic friction capacity of the lock-up clutch."),
+    key("lockup", "static_to_kinetic", "", Some(Range::AT_LEAST_ONE), "", "Static over kinetic capacity."),
+    key("lockup", "engage_time_s", "s", Some(Range::POSITIVE), "", "Engagement ramp."),
+    key("lockup", "min_gear", "", None, "an integer from 1 to the number of gears", "Lowest gear with lock-up."),
+    key("lockup", "engage_speed_zero_pedal_m_s", "m/s", Some(Range::POSITIVE), "", "Vehicle speed above which the lock-up engages at zero pedal."),
+    key("lockup", "engage_speed_full_pedal_m_s", "m/s", Some(Range::POSITIVE), "", "As `engage_speed_zero_pedal_m_s`, at full pedal."),
+    key("driveline", "final_drive_ratio", "", Some(p::FINAL_DRIVE_RATIO), "", "Final drive ratio (both axles)."),
+    key("driveline", "front_shaft_stiffness_nm_per_rad", "N·m/rad", Some(p::SHAFT_STIFFNESS), "", "Front shaft torsional stiffness at the propshaft side (referred to the gearbox output, before the final drive: a wheel-side stiffness k_w is k_w / final_drive_ratio² here; thesis §4.3.1)."),
+    key("driveline", "rear_shaft_stiffness_nm_per_rad", "N·m/rad", Some(p::SHAFT_STIFFNESS), "", "Rear shaft torsional stiffness, at the propshaft side."),
+    key("driveline", "front_shaft_damping_nm_s_per_rad", "N·m·s/rad", Some(p::SHAFT_DAMPING), "", "Front shaft damping."),
+    key("driveline", "rear_shaft_damping_nm_s_per_rad", "N·m·s/rad", Some(p::SHAFT_DAMPING), "", "Rear shaft damping."),
+    key("driveline", "front_axle_inertia_kg_m2", "kg·m²", Some(p::AXLE_INERTIA), "", "Front axle inertia (both wheels, hubs, brakes, half shafts)."),
+    key("driveline", "rear_axle_inertia_kg_m2", "kg·m²", Some(p::AXLE_INERTIA), "", "Rear axle inertia."),
+    key("tyres", "rolling_radius_m", "m", Some(p::ROLLING_RADIUS), "", "Rolling radius."),
+    key("tyres", "friction_coefficient", "", Some(Range::POSITIVE), "", "Friction coefficient μ."),
+    key("tyres", "slip_stiffness", "", Some(p::SLIP_STIFFNESS), "", "Slip stiffness: dF_x/dκ over F_z at zero slip."),
+    key("tyres", "front_load_fraction", "", Some(p::FRONT_LOAD_FRACTION), "", "Front axle's share of the static load. Both axles are driven: an axle without load has no tyre force and its shaft would spin it up without bound."),
+    key("body", "mass_kg", "kg", Some(p::BODY_MASS), "", "Vehicle mass."),
+    key("body", "drag_area_m2", "m²", Some(p::DRAG_AREA), "", "Drag area C_d·A."),
+    key("body", "rolling_resistance", "", Some(Range::NON_NEGATIVE), "", "Rolling resistance coefficient."),
+    key("body", "air_density_kg_m3", "kg/m³", Some(p::AIR_DENSITY), "", "Air density; 0 only removes the aerodynamic drag (as `drag_area_m2 = 0` does)."),
+    key("body", "grade_percent", "%", Some(p::GRADE_PERCENT), "", "Road grade. The axle loads are static (no load transfer): at 50 % a sedan already moves about 10 % of its weight between the axles; the steepest public roads (about 35 %) are inside."),
+    key("brake", "capacity_nm", "N·m", Some(p::BRAKE_CAPACITY), "", "Total wheel brake torque at full pedal: every launch starts with the wheels held by the brake against the stalled converter."),
+    key("brake", "front_fraction", "", Some(Range::FRACTION), "", "Front axle's share of the brake torque."),
+];
 
 /// A vehicle file as written.
 #[derive(Debug, Clone, Deserialize, Serialize)]
@@ -741,6 +861,96 @@ mod tests {
         assert_eq!(
             (e.field.as_str(), e.expected.as_str()),
             ("[gearbox].input_inertia_kg_m2[0]", "a finite number at least 0")
+        );
+    }
+
+    /// The sedan with `key = value` in `[section]`: the key's line replaced, or added at the
+    /// section's top when the sedan does not set it (an optional key).
+    fn with_key(section: &str, key: &str, value: &str) -> String {
+        let (header, line) = (format!("[{section}]"), format!("{key} = {value}"));
+        let mut in_section = false;
+        let mut out = Vec::new();
+        for l in SEDAN.lines() {
+            if l.starts_with('[') {
+                in_section = l == header;
+            }
+            if in_section && l.split('=').next().map(str::trim) == Some(key) {
+                continue;
+            }
+            out.push(l.to_string());
+            if l == header {
+                out.push(line.clone());
+            }
+        }
+        out.join("\n")
+    }
+
+    /// `v` as TOML writes it: an array (the sedan's, with the element at `index` set to `v`) or a number.
+    fn probe_value(sedan: &toml::Value, index: Option<usize>, v: f64) -> String {
+        match (sedan, index) {
+            (toml::Value::Array(a), Some(i)) => {
+                let mut values: Vec<f64> = a.iter().map(|x| x.as_float().unwrap()).collect();
+                values[i] = v;
+                format!("[{}]", values.iter().map(|x| format!("{x:?}")).collect::<Vec<_>>().join(", "))
+            }
+            _ => format!("{v:?}"),
+        }
+    }
+
+    /// Every row of [`SCHEMA`] with a range is the validator's: just beyond each end (the end
+    /// itself when it is open) the file is refused on that key with exactly the range's text, and
+    /// at the end (just inside when it is open) that range does not refuse it. For an array the
+    /// probe is its smallest (lower end) or largest (upper end) element.
+    #[test]
+    fn every_schema_range_is_the_validators() {
+        let sedan: toml::Table = SEDAN.parse().unwrap();
+        for row in SCHEMA {
+            let Some(range) = row.range else { continue };
+            let name = field(row.section, row.key);
+            let value = sedan.get(row.section).and_then(|s| s.get(row.key)).cloned().unwrap_or(toml::Value::Float(0.0));
+            let numbers: Vec<f64> = match &value {
+                toml::Value::Array(a) => a.iter().map(|x| x.as_float().unwrap()).collect(),
+                v => vec![v.as_float().unwrap_or(0.0)],
+            };
+            let arg = |pick: fn(f64, f64) -> bool| {
+                let i = (0..numbers.len()).fold(0, |b, i| if pick(numbers[i], numbers[b]) { i } else { b });
+                value.is_array().then_some(i)
+            };
+            let ends = [(range.low, -1.0, arg(|a, b| a < b)), (range.high, 1.0, arg(|a, b| a > b))];
+            for (end, outward, index) in ends {
+                let Some((bound, closed)) = end else { continue };
+                let delta = 1e-6 * bound.abs().max(1.0) * outward;
+                let (outside, inside) = if closed { (bound + delta, bound) } else { (bound, bound - delta) };
+                let text = with_key(row.section, row.key, &probe_value(&value, index, outside));
+                let e = read_vehicle(&text).expect_err(&format!("{name} = {outside} must be refused"));
+                assert!(e.field == name || e.field.starts_with(&format!("{name}[")), "{name} = {outside}: {e}");
+                assert_eq!(e.expected, range.expected(), "{name} = {outside}");
+                if let Err(e) = read_vehicle(&with_key(row.section, row.key, &probe_value(&value, index, inside))) {
+                    let on_key = e.field == name || e.field.starts_with(&format!("{name}["));
+                    assert!(!(on_key && e.expected.starts_with("a finite number")), "{name} = {inside}: {e}");
+                }
+            }
+        }
+    }
+
+    /// [`SCHEMA`] lists every key the file's deserialiser knows, section by section, in file order.
+    #[test]
+    fn the_schema_lists_every_key() {
+        for section in ["", "engine", "gearbox", "lockup", "driveline", "tyres", "body", "brake"] {
+            let text = if section.is_empty() {
+                format!("unknown_key = 1\n{SEDAN}")
+            } else {
+                with_key(section, "unknown_key", "1")
+            };
+            let e = error(&text);
+            let known = e.expected.split(": ").nth(1).unwrap().split(" (").next().unwrap();
+            let known: Vec<&str> = known.split(", ").filter(|k| !SECTIONS.contains(k) && *k != "sources").collect();
+            let rows: Vec<&str> = SCHEMA.iter().filter(|r| r.section == section).map(|r| r.key).collect();
+            assert_eq!(rows, known, "[{section}]");
+        }
+        assert_eq!(
+            SCHEMA.iter().find(|r| r.key == "mass_kg").unwrap().range_text(),
+            "a finite number at least 50 and at most 200000"
         );
     }
 }

@@ -16,7 +16,7 @@
 //! Modes link or hold coordinates: a gear in mesh links `ω_t = i_k ω_o`, a locked lock-up clutch
 //! `ω_p = ω_t`, a held brake holds the axles at zero, and the converter's own modes hold the stator
 //! or the flow. The states of a mode are generalised coordinates `x` with `u = P x`; the reduced
-//! system `PᵀMP ẋ = PᵀF` goes to diffsol's BDF. When a link closes (lock-up locks, a shift
+//! system `PᵀMP ẋ = PᵀF` goes to the BDF integrator. When a link closes (lock-up locks, a shift
 //! synchronises) the new state is the momentum-conserving projection `(PᵀMP) x = PᵀM u`, and the
 //! kinetic energy it removes is booked as a clutch loss, so the energy balance closes exactly.
 //! Equations and parameters: docs/vehicle.md.

@@ -1,0 +1,87 @@
+//! Event location on the dense output, as CVODE's rootfinding (Hindmarsh et al. 2005, §2.4 of the
+//! CVODE guide): after every step the event functions `g` are evaluated at its end; an event function
+//! that was positive at the step's start and is ≤ 0 at its end has a root in the step ("positive while
+//! the mode holds": only that direction ends a mode). The first root is bracketed by the Illinois
+//! variant of regula falsi on the interpolant, each trial point taken for the function that is crossed
+//! furthest (largest `|g_hi| / |g_hi − g_lo|`), until the bracket is narrower than
+//! `100 ε (|t_hi| + |t_hi − t_lo|)`. The upper end of the bracket is returned (its `g ≤ 0`), so the
+//! event has always happened at the time given.
+
+/// Work arrays for the event functions of one segment (allocated once per segment).
+pub struct RootFinder {
+    lo: Vec<f64>,
+    hi: Vec<f64>,
+    mid: Vec<f64>,
+}
+
+/// The event function crossed furthest from `lo` (> 0) to `hi` (≤ 0), if any.
+fn crossing(lo: &[f64], hi: &[f64]) -> Option<usize> {
+    let mut best: Option<(usize, f64)> = None;
+    for (i, (&a, &b)) in lo.iter().zip(hi).enumerate() {
+        if a > 0.0 && b <= 0.0 {
+            let frac = (b / (b - a)).abs();
+            if best.is_none_or(|(_, f)| frac > f) {
+                best = Some((i, frac));
+            }
+        }
+    }
+    best.map(|(i, _)| i)
+}
+
+impl RootFinder {
+    /// Start from the event functions `g0` at the segment's start.
+    pub fn new(g0: Vec<f64>) -> Self {
+        let count = g0.len();
+        Self { lo: g0, hi: vec![0.0; count], mid: vec![0.0; count] }
+    }
+
+    /// After a step from `t_lo` to `t_hi`: `g_at(t, out)` gives the event functions on the step's
+    /// interpolant. Returns the first root `(t, index)` in `(t_lo, t_hi]`, or None (and then the end
+    /// of this step becomes the start of the next).
+    pub fn check(&mut self, t_lo: f64, t_hi: f64, mut g_at: impl FnMut(f64, &mut [f64])) -> Option<(f64, usize)> {
+        g_at(t_hi, &mut self.hi);
+        let Some(mut imax) = crossing(&self.lo, &self.hi) else {
+            std::mem::swap(&mut self.lo, &mut self.hi);
+            return None;
+        };
+        let (mut t0, mut t1) = (t_lo, t_hi);
+        let tol = 100.0 * f64::EPSILON * (t1.abs() + (t1 - t0).abs());
+        let (mut alpha, mut last_two) = (1.0, [false, true]);
+        let mut i = 0usize;
+        // a copy of the lower end: the bracket moves, the next step starts from g(t_hi)
+        let mut lo = self.lo.clone();
+        while (t1 - t0).abs() > tol {
+            let (g1, g0) = (self.hi[imax], lo[imax]);
+            let mut t = t1 - (t1 - t0) * g1 / (g1 - alpha * g0);
+            let fraction = if (t1 - t0).abs() / tol > 5.0 { 0.1 } else { 0.5 * tol / (t1 - t0).abs() };
+            if (t - t0).abs() < 0.5 * tol {
+                t = t0 + fraction * (t1 - t0);
+            }
+            if (t1 - t).abs() < 0.5 * tol {
+                t = t1 - fraction * (t1 - t0);
+            }
+            g_at(t, &mut self.mid);
+            let lower = crossing(&lo, &self.mid);
+            if let Some(j) = lower {
+                t1 = t;
+                imax = j;
+                std::mem::swap(&mut self.hi, &mut self.mid);
+            } else {
+                t0 = t;
+                lo.copy_from_slice(&self.mid);
+            }
+            last_two[i % 2] = lower.is_some();
+            if i >= 2 {
+                alpha = if last_two[0] != last_two[1] {
+                    1.0
+                } else if last_two[0] {
+                    0.5 * alpha
+                } else {
+                    2.0 * alpha
+                };
+            }
+            i += 1;
+        }
+        Some((t1, imax))
+    }
+}

@@ -1,0 +1,392 @@
+"""Monte Carlo study files (``tcsim monte-carlo FILE``, docs/study.md "Monte Carlo studies"): a
+vehicle launch repeated ``runs`` times with converter and vehicle parameters drawn from the
+distributions the file gives.
+
+The file is TOML, read by one pydantic model, :class:`MonteCarloFile` (the field-by-field reference
+of the documentation site is generated from it). A ``[distributions]`` key names a parameter as the
+converter or vehicle file writes it, prefixed by the file: ``converter.<section>.<key>`` (a number
+of ``[inertia]``, ``[geometry]`` or ``[quasi_dynamic]``, or ``converter.characteristic.lag_time_constant_s``)
+or ``vehicle.<section>.<key>`` (a real number of a vehicle section; not an array element). Its
+value is one of :class:`Normal`, :class:`Uniform`, :class:`Lognormal`, :class:`TruncatedNormal`.
+
+**The support is checked, not the samples.** Before anything runs, the converter (or vehicle) is
+built with the parameter at each end of its distribution's support (an open end: the nearest
+number inside it; an unbounded end: ±1.797e308), the other values as the file has them, and
+validated by the converter's schema or the core's vehicle checks, the one owners of the ranges. A
+distribution whose support reaches a refused value is an :class:`~tcsim.errors.InputError` naming
+the study file, the distribution and the value refused: a ``normal`` on a positive quantity is
+refused (its support is every real number), a ``truncated-normal`` or ``lognormal`` is not.
+Constraints between parameters (the core's geometry checks) can still refuse a drawn case; that
+case's rows carry the reason in ``error`` and the study goes on.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import tomllib
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Literal
+
+import tomli_w
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from .. import _core
+from ..errors import InputError, from_core
+from .converter import MODELS, Converter, bundled_names, parse_converter
+from .vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, _load_named_converter, load_vehicle
+
+#: The most cases of one study, and the most without ``--chunk-size`` (all rows in memory).
+MAX_RUNS = 10_000_000
+MAX_RUNS_UNCHUNKED = 100_000
+#: The built-in scenarios a study can run (:mod:`tcsim.simulation.scenarios`).
+SCENARIOS = ("flip-flop", "part-pedal")
+#: The converter sections whose numbers a study can draw, and the one key of ``[characteristic]``.
+CONVERTER_SECTIONS = ("inertia", "geometry", "quasi_dynamic")
+CHARACTERISTIC_KEYS = ("lag_time_constant_s",)
+#: The smallest probability of a truncated normal's interval (below it the bounds are a mistake).
+MIN_TRUNCATED_MASS = 1e-9
+_FINITE = Field(allow_inf_nan=False)
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+
+class Normal(_Strict):
+    """``{ kind = "normal", mean, std }``: the normal distribution of mean ``mean`` and standard
+    deviation ``std``."""
+
+    kind: Literal["normal"]
+    mean: float = _FINITE
+    std: float = Field(gt=0, allow_inf_nan=False)
+
+    def support(self) -> tuple[float, float, bool]:
+        """``(low, high, open)``: the support's ends and whether they are excluded."""
+        return -math.inf, math.inf, True
+
+
+class Uniform(_Strict):
+    """``{ kind = "uniform", low, high }``: every value from low to high equally likely."""
+
+    kind: Literal["uniform"]
+    low: float = _FINITE
+    high: float = _FINITE
+
+    @model_validator(mode="after")
+    def _ordered(self):
+        if not self.low < self.high:
+            raise ValueError(f"low < high (low = {self.low:g}, high = {self.high:g})")
+        return self
+
+    def support(self) -> tuple[float, float, bool]:
+        return self.low, self.high, False
+
+
+class Lognormal(_Strict):
+    """``{ kind = "lognormal", mean, std }``: mean and standard deviation of the quantity itself
+    (not of its logarithm): ``ln X`` is normal with ``σ² = ln(1 + (std/mean)²)`` and
+    ``μ = ln(mean) − σ²/2``; support above 0."""
+
+    kind: Literal["lognormal"]
+    mean: float = Field(gt=0, allow_inf_nan=False)
+    std: float = Field(gt=0, allow_inf_nan=False)
+
+    def log_parameters(self) -> tuple[float, float]:
+        """``(μ, σ)`` of ``ln X``."""
+        s2 = math.log1p((self.std / self.mean) ** 2)
+        return math.log(self.mean) - s2 / 2, math.sqrt(s2)
+
+    def support(self) -> tuple[float, float, bool]:
+        return 0.0, math.inf, True
+
+
+class TruncatedNormal(_Strict):
+    """``{ kind = "truncated-normal", mean, std, low, high }``: the normal of ``mean`` and ``std``
+    restricted to ``[low, high]`` (``mean`` and ``std`` are the untruncated normal's)."""
+
+    kind: Literal["truncated-normal"]
+    mean: float = _FINITE
+    std: float = Field(gt=0, allow_inf_nan=False)
+    low: float = _FINITE
+    high: float = _FINITE
+
+    @model_validator(mode="after")
+    def _interval(self):
+        if not self.low < self.high:
+            raise ValueError(f"low < high (low = {self.low:g}, high = {self.high:g})")
+        if self.mass() < MIN_TRUNCATED_MASS:
+            raise ValueError(f"low and high within a few std of mean (the interval holds {self.mass():.3g} of it)")
+        return self
+
+    def mass(self) -> float:
+        """The normal's probability within ``[low, high]``."""
+        a, b = (self.low - self.mean) / self.std, (self.high - self.mean) / self.std
+        if a > 0:  # both in the upper tail: the mirror image, for precision
+            a, b = -b, -a
+        return 0.5 * (math.erfc(-b / math.sqrt(2)) - math.erfc(-a / math.sqrt(2)))
+
+    def support(self) -> tuple[float, float, bool]:
+        return self.low, self.high, False
+
+
+def describe(distribution: BaseModel) -> str:
+    """``normal(mean=1900, std=50)``: a distribution as one short text."""
+    values = distribution.model_dump()
+    kind = values.pop("kind")
+    return f"{kind}(" + ", ".join(f"{k}={v:g}" for k, v in values.items()) + ")"
+
+
+Distribution = Annotated[Normal | Uniform | Lognormal | TruncatedNormal, Field(discriminator="kind")]
+
+
+class MonteCarloFile(BaseModel):
+    """The study file's top level."""
+
+    model_config = ConfigDict(extra="forbid", strict=True, frozen=True)
+
+    #: The study's name (default: the file's stem).
+    name: str | None = None
+    description: str | None = None
+    #: A bundled vehicle (tcsim vehicles lists them) or a vehicle .toml, relative to this file.
+    vehicle: str = DEFAULT_VEHICLE
+    #: A bundled converter or a converter .toml relative to this file (default: the vehicle's).
+    converter: str | None = None
+    #: The launch: flip-flop (full pedal at the brake release, to 100 km/h) or part-pedal (pedal 0.3, to 50 km/h).
+    scenario: Literal["flip-flop", "part-pedal"] = "flip-flop"
+    #: The converter models run in each case (default: every model the converter supports).
+    models: list[Literal["table", "hrovat-tobler", "quasi-dynamic"]] | None = Field(default=None, min_length=1)
+    #: Cases (launches of every model), each drawn from the seed and its index alone.
+    runs: int = Field(ge=1, le=MAX_RUNS)
+    #: The random seed: the same file and seed give the same cases bit for bit, however the study is chunked.
+    seed: int = Field(ge=0, le=2**63 - 1)
+    #: Launch summary columns (docs/launch_summary.md) kept per case and model.
+    outputs: list[str] = Field(
+        default=["time_0_50_km_h_s", "time_0_100_km_h_s", "effective_torque_ratio_dip_first_0_5_s"], min_length=1
+    )
+    #: Parameter (converter.<section>.<key> or vehicle.<section>.<key>) → its distribution (below).
+    distributions: dict[str, Distribution] = Field(min_length=1)
+
+
+@dataclass(frozen=True)
+class Parameter:
+    """A drawn parameter: its key as the study file writes it, the file it belongs to
+    (``converter`` or ``vehicle``), the section and key there, and its distribution."""
+
+    key: str
+    target: str
+    section: str
+    name: str
+    distribution: Normal | Uniform | Lognormal | TruncatedNormal
+
+
+@dataclass(frozen=True)
+class StudyFile:
+    """A validated study file: the file, the vehicle and converter it names, its models and parameters."""
+
+    path: str
+    doc: MonteCarloFile
+    vehicle: Vehicle
+    converter: Converter
+    models: tuple[str, ...]
+    parameters: tuple[Parameter, ...]
+
+    @property
+    def name(self) -> str:
+        return self.doc.name or Path(self.path).stem
+
+
+def _flatten(table: Any, prefix: str = "") -> dict[str, Any]:
+    """``[distributions]`` with dotted keys written bare (``vehicle.body.mass_kg = {...}`` is a
+    nested table in TOML) flattened to ``{"vehicle.body.mass_kg": {...}}``; a table with ``kind`` is a leaf."""
+    if not isinstance(table, dict) or "kind" in table:
+        return {prefix: table}
+    out: dict[str, Any] = {}
+    for k, v in table.items():
+        out.update(_flatten(v, f"{prefix}.{k}" if prefix else str(k)))
+    return out
+
+
+def _field_name(loc: tuple[Any, ...]) -> str:
+    parts = [str(x) for x in loc if x not in ("normal", "uniform", "lognormal", "truncated-normal")]
+    if len(parts) >= 2 and parts[0] == "distributions":
+        return f'distributions."{parts[1]}"' + "".join(f".{p}" for p in parts[2:])
+    return ".".join(parts) or "(file)"
+
+
+def _validation_error(err: ValidationError, path: str) -> InputError:
+    e = err.errors()[0]
+    field = _field_name(tuple(e["loc"]))
+    value = e.get("input", "")
+    msg = e["msg"].removeprefix("Input should be ").removeprefix("Value error, ")
+    if e["type"] == "extra_forbidden":
+        msg = "a known key (docs/study.md lists the keys of a study file)"
+    elif e["type"] == "missing":
+        value, msg = "missing", "this required key"
+    elif e["type"] in ("union_tag_invalid", "union_tag_not_found"):
+        value = value.get("kind", "missing") if isinstance(value, dict) else value
+        field, msg = f"{field}.kind", "one of 'normal', 'uniform', 'lognormal', 'truncated-normal'"
+    if isinstance(value, dict | list) and len(str(value)) > 60:
+        value = f"{type(value).__name__} of {len(value)}"
+    return InputError(path, field, value, msg)
+
+
+def read_monte_carlo_file(path: str | Path) -> MonteCarloFile:
+    """The study file's schema checked (no converter or vehicle read yet)."""
+    path = Path(path)
+    if path.suffix.lower() != ".toml" or not path.is_file():
+        raise InputError(str(path), "study file", str(path), "an existing Monte Carlo study .toml file")
+    try:
+        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
+    except (OSError, UnicodeDecodeError) as e:
+        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
+    except tomllib.TOMLDecodeError as e:
+        raise InputError(str(path), "(syntax)", str(e), "valid TOML") from None
+    if isinstance(data.get("distributions"), dict):
+        data["distributions"] = _flatten(data["distributions"])
+    try:
+        return MonteCarloFile.model_validate(data)
+    except ValidationError as err:
+        raise _validation_error(err, str(path)) from None
+
+
+def _relative(spec: str, path: Path) -> str:
+    """A file name relative to the study file; a bundled name as it is."""
+    candidate = Path(spec)
+    if candidate.is_absolute() or not candidate.suffix:
+        return spec
+    return str(path.parent / candidate)
+
+
+def _converter(spec: str, path: Path) -> Converter:
+    """The study file's ``converter``: a bundled name or a converter .toml relative to the study file."""
+    try:
+        return _load_named_converter(spec, str(path))
+    except InputError as e:
+        if e.source != str(path):  # the converter file itself is bad: its own message
+            raise
+        names = ", ".join(bundled_names())
+        expected = f"a bundled converter ({names}) or a converter .toml file relative to the study file"
+        raise InputError(str(path), "converter", spec, expected) from None
+
+
+def _parameter(key: str, dist: Any, path: str, converter: Converter, vehicle: Vehicle) -> Parameter:
+    """The parameter a ``[distributions]`` key names, or :class:`InputError` naming it."""
+    field = f'distributions."{key}"'
+    target, _, rest = key.partition(".")
+    section, _, name = rest.partition(".")
+    if target == "converter":
+        if section in CONVERTER_SECTIONS:
+            model = getattr(converter, section)
+            known = model is not None and name in type(model).model_fields
+        else:
+            known = section == "characteristic" and name in CHARACTERISTIC_KEYS and converter.characteristic is not None
+        if known:
+            return Parameter(key, target, section, name, dist)
+        where = f"the converter {converter.name!r} ({converter.path})"
+        expected = (
+            f"a number of {where}: converter.<section>.<key> with <section> one of "
+            f"{', '.join(CONVERTER_SECTIONS)} (present in the file) or converter.characteristic.lag_time_constant_s"
+        )
+        raise InputError(path, field, key, expected)
+    if target == "vehicle":
+        values = vehicle.core_spec().get(section, {}) if section in SECTIONS else {}
+        if isinstance(values.get(name), float):
+            return Parameter(key, target, section, name, dist)
+        expected = (
+            f"a real number of the vehicle {vehicle.name!r}: vehicle.<section>.<key> with <section> one of "
+            f"{', '.join(SECTIONS)} (not an array or an integer)"
+        )
+        raise InputError(path, field, key, expected)
+    raise InputError(path, field, key, "a parameter converter.<section>.<key> or vehicle.<section>.<key>")
+
+
+def converter_data(data: dict[str, Any], values: dict[tuple[str, str], float]) -> dict[str, Any]:
+    """A converter's TOML ``data`` (:meth:`Converter.to_toml_dict`) with ``values`` (by section and
+    key) set; ``data`` is not changed."""
+    data = dict(data)
+    for (section, key), value in values.items():
+        if section == "characteristic" and isinstance(data["characteristic"], list):
+            data["characteristic"] = [{**data["characteristic"][0], key: value}, *data["characteristic"][1:]]
+        else:
+            data[section] = {**data.get(section, {}), key: value}
+    return data
+
+
+def build_converter(data: dict[str, Any], path: str) -> Converter:
+    """A converter of TOML ``data`` (:func:`converter_data`), validated; no warnings (a study draws
+    thousands; the support's check shows the implausible ones once)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return parse_converter(data, path)
+
+
+def vehicle_data(data: dict[str, Any], values: dict[tuple[str, str], float]) -> dict[str, Any]:
+    """A vehicle's TOML ``data`` (:meth:`Vehicle.to_toml_dict`) with ``values`` (by section and key)
+    set; ``data`` is not changed."""
+    data = dict(data)
+    for (section, key), value in values.items():
+        data[section] = {**data[section], key: value}
+    return data
+
+
+def build_vehicle(data: dict[str, Any], path: str, converter: Converter) -> Vehicle:
+    """A vehicle of TOML ``data`` (:func:`vehicle_data`) checked by the core, driving ``converter``."""
+    try:
+        core = _core.read_vehicle(tomli_w.dumps(data), path)
+    except _core.CoreInputError as e:
+        raise from_core(e, path) from None
+    return Vehicle(core, path, converter)
+
+
+def _probes(dist: Any) -> list[float]:
+    """The ends of the support of ``dist``: an open end the nearest number inside, an unbounded end ±max."""
+    low, high, is_open = dist.support()
+    big = sys.float_info.max
+    lo = -big if low == -math.inf else (math.nextafter(low, math.inf) if is_open else low)
+    hi = big if high == math.inf else (math.nextafter(high, -math.inf) if is_open else high)
+    return [lo, hi]
+
+
+def _check_support(p: Parameter, path: str, converter: Converter, vehicle: Vehicle) -> None:
+    """Refuse ``p`` if the converter or vehicle is refused at an end of its distribution's support."""
+    for value in _probes(p.distribution):
+        try:
+            values = {(p.section, p.name): value}
+            if p.target == "converter":
+                build_converter(converter_data(converter.to_toml_dict(), values), converter.path)
+            else:
+                build_vehicle(vehicle_data(vehicle.to_toml_dict(), values), vehicle.path, converter)
+        except InputError as e:
+            low, high, is_open = p.distribution.support()
+            support = f"{'(' if is_open else '['}{low:g}, {high:g}{')' if is_open else ']'}"
+            hint = " (a truncated-normal bounds a normal)" if isinstance(p.distribution, Normal) else ""
+            expected = (
+                f"a distribution whose support {support} lies within the valid range of {p.key}{hint}: "
+                f"at {value:.6g}, {e.field}: expected {e.expected}"
+            )
+            raise InputError(path, f'distributions."{p.key}"', describe(p.distribution), expected) from None
+
+
+def load_study_file(path: str | Path) -> StudyFile:
+    """A Monte Carlo study file read and checked: its schema, the vehicle and converter it names
+    (relative to the file), its models (each buildable from the converter), and each parameter
+    (known, and its distribution's support within the parameter's valid range); an
+    :class:`InputError` (one line naming the file and field) before anything runs."""
+    doc = read_monte_carlo_file(path)
+    p = Path(path)
+    vehicle = load_vehicle(_relative(doc.vehicle, p))
+    converter = vehicle.converter if doc.converter is None else _converter(doc.converter, p)
+    models = tuple(dict.fromkeys(doc.models)) if doc.models else converter.models
+    for m in models:
+        if m not in converter.models:
+            raise InputError(str(p), "models", m, f"a model of the converter {converter.name!r}: {converter.models}")
+    if not models or any(m not in MODELS for m in models):
+        raise InputError(str(p), "models", list(models), f"some of {', '.join(MODELS)}")
+    vehicle = Vehicle(vehicle.core, vehicle.path, converter)
+    params = tuple(_parameter(k, d, str(p), converter, vehicle) for k, d in doc.distributions.items())
+    for param in params:
+        _check_support(param, str(p), converter, vehicle)
+    return StudyFile(str(p), doc, vehicle, converter, models, params)
