@@ -7,6 +7,7 @@ wrong is a failure of tcsim or of a solver (exit code 1).
 
 from __future__ import annotations
 
+import signal
 import unicodedata
 from collections.abc import Mapping
 from typing import Any
@@ -26,6 +27,28 @@ class InputError(Exception):
 
     def __str__(self) -> str:
         return escape_controls(f"{self.source}: {self.field} = {_show(self.value)}: expected {self.expected}")
+
+
+class Interrupted(KeyboardInterrupt):
+    """SIGINT or SIGTERM turned into an exception by :func:`tcsim.cli.main`, so that the run unwinds
+    and cleans up as on Ctrl-C; ``signum`` is the signal's number."""
+
+    def __init__(self, signum: int):
+        super().__init__(signal.Signals(signum).name)
+        self.signum = signum
+
+
+#: The signals the command line turned into :class:`Interrupted` in this run. Python drops an
+#: exception raised inside a weakref callback or a ``__del__`` (a signal handler runs there when the
+#: garbage collector does), so the exception can be lost; this record is not.
+received_signals: list[int] = []
+
+
+def raise_if_interrupted() -> None:
+    """Raise :class:`Interrupted` for a signal received in this run whose exception was lost, so that
+    nothing is committed after an interrupt."""
+    if received_signals:
+        raise Interrupted(received_signals[-1])
 
 
 class TcsimWarning(UserWarning):

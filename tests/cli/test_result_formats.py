@@ -13,8 +13,8 @@ import numpy as np
 import pandas as pd
 import pytest
 import scipy.io
-import test_signals
 
+from interrupts import interrupt
 from tcsim import transient
 from tcsim.errors import TcsimWarning
 from tcsim.io import tables
@@ -283,9 +283,8 @@ def test_a_run_that_fails_while_writing_leaves_nothing(cli, tmp_path, monkeypatc
 
 @pytest.mark.subprocess
 @pytest.mark.parametrize("file_format", ["parquet", "mat"])
-def test_an_interrupt_while_writing_a_format_leaves_nothing(tmp_path, monkeypatch, file_format):
-    monkeypatch.setitem(test_signals.COMMANDS, "launch", [*LAUNCH, "--out", "o", "--format", file_format])
-    r = test_signals.interrupt("launch", signal.SIGTERM, "writing", tmp_path)
+def test_an_interrupt_while_writing_a_format_leaves_nothing(tmp_path, file_format):
+    r = interrupt([*LAUNCH, "--out", "o", "--format", file_format], signal.SIGTERM, "writing", tmp_path)
     assert r.returncode == 128 + signal.SIGTERM, (r.returncode, r.stderr)
     assert r.stderr.strip().splitlines() == ["interrupted (SIGTERM): nothing written"], r.stderr
     assert os.listdir(tmp_path) == []

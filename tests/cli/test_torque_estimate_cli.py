@@ -8,9 +8,6 @@ from __future__ import annotations
 import hashlib
 import os
 import signal
-import subprocess
-import sys
-import time
 from collections.abc import Callable
 from pathlib import Path
 
@@ -19,6 +16,7 @@ import pandas as pd
 import pytest
 import scipy.io
 
+from interrupts import interrupt
 from torque_steps import load_response
 
 DELAY_S = 0.2
@@ -188,20 +186,9 @@ def test_an_interrupt_while_writing_leaves_nothing(tmp_path, sig):
     _dyno(tmp_path)
     _ecm(tmp_path)
     inputs = sha(list(tmp_path.iterdir()))
-    cmd = [sys.executable, "-m", "tcsim", "torque-estimate", "ecm.csv", "dyno.csv", "--out", "o"]
-    p = subprocess.Popen(cmd, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        while not any(n.startswith(".o.") and n.endswith(".partial") for n in os.listdir(tmp_path)):
-            if p.poll() is not None:
-                pytest.fail(f"ended (exit {p.returncode}) before writing: {p.communicate()[1]}")
-            time.sleep(0.005)
-        p.send_signal(sig)
-        _, err = p.communicate(timeout=HANG_GUARD_S)
-    finally:
-        if p.poll() is None:
-            p.kill()
-            p.communicate()
-    assert p.returncode == 128 + sig, err
+    r = interrupt(["torque-estimate", "ecm.csv", "dyno.csv", "--out", "o"], sig, "writing", tmp_path)
+    err = r.stderr
+    assert r.returncode == 128 + sig, err
     assert err.strip().splitlines()[-1] == f"interrupted ({sig.name}): nothing written", err
     assert sorted(os.listdir(tmp_path)) == ["dyno.csv", "ecm.csv"]
     assert sha(list(inputs)) == inputs

@@ -8,9 +8,6 @@ from __future__ import annotations
 import math
 import os
 import signal
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -18,6 +15,7 @@ import pandas as pd
 import pytest
 
 import tcsim
+from interrupts import interrupt
 from tcsim.errors import InputError, TcsimWarning
 from tcsim.io.results import non_finite_columns
 from tcsim.models.converter import bundled_names, load_converter
@@ -235,20 +233,9 @@ def test_an_interrupted_run_leaves_nothing(tmp_path):
     pd.DataFrame(frame).to_parquet(points)
     work = tmp_path / "work"
     work.mkdir()
-    cmd = [sys.executable, "-m", "tcsim", "operating-point", "li-sunden-2016", str(points), "--out", "o"]
-    p = subprocess.Popen(cmd, cwd=work, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    try:
-        while not any(c.name.endswith(".partial") for c in work.iterdir()):
-            if p.poll() is not None:
-                pytest.fail(f"ended (exit {p.returncode}) before writing: {p.communicate()[1]}")
-            time.sleep(0.002)
-        p.send_signal(signal.SIGINT)
-        out, err = p.communicate(timeout=600)  # hang guard
-    finally:
-        if p.poll() is None:
-            p.kill()
-            p.communicate()
-    assert p.returncode == 130, err
+    r = interrupt(["operating-point", "li-sunden-2016", str(points), "--out", "o"], signal.SIGINT, "writing", work)
+    err = r.stderr
+    assert r.returncode == 130, err
     lines = [line for line in err.strip().splitlines() if not line.startswith("warning: ")]  # the mirror's
     assert lines == ["interrupted (SIGINT): nothing written"], err
     assert os.listdir(work) == []

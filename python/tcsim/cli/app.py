@@ -14,12 +14,12 @@ import sys
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
 
-from ..errors import InputError, TcsimWarning
+from ..errors import InputError, Interrupted, TcsimWarning, received_signals
 from ..reports.format import rich_text
 
 if TYPE_CHECKING:
@@ -110,17 +110,8 @@ def _show_warning(message, category, filename, lineno, file=None, line=None):
         console.print(f"warning: {category.__name__}: {rich_text(message)}", highlight=False, soft_wrap=True)
 
 
-class Interrupted(KeyboardInterrupt):
-    """SIGINT or SIGTERM turned into an exception by :func:`tcsim.cli.main`, so that the run unwinds
-    and cleans up as on Ctrl-C; ``signum`` is the signal's number."""
-
-    def __init__(self, signum: int):
-        super().__init__(signal.Signals(signum).name)
-        self.signum = signum
-
-
 #: The signals :func:`_raise_interrupted` turned into :class:`Interrupted` in this run.
-_received: list[int] = []
+_received = received_signals
 
 #: The exit code typer returns for a ``KeyboardInterrupt`` it caught (the exception is lost).
 _TYPER_INTERRUPT = 130
@@ -151,6 +142,25 @@ def _signals_raise() -> contextlib.AbstractContextManager[None]:
     """SIGINT and SIGTERM raise :class:`Interrupted` (and are recorded, also when the exception is
     swallowed, e.g. raised in a ``__del__``) while the block runs."""
     return _signal_handlers(_raise_interrupted)
+
+
+@contextlib.contextmanager
+def _lost_interrupts_unreported() -> Iterator[None]:
+    """Python prints an exception raised in a weakref callback or a ``__del__`` ("Exception ignored
+    in …") and drops it; a signal's handler runs there when the garbage collector does. Such an
+    :class:`Interrupted` is not printed while the block runs: it is in ``received_signals``, and the
+    run stops at its next commit (:func:`tcsim.errors.raise_if_interrupted`) or at its end."""
+    previous = sys.unraisablehook
+
+    def hook(unraisable: Any) -> None:
+        if not isinstance(unraisable.exc_value, Interrupted):
+            previous(unraisable)
+
+    sys.unraisablehook = hook
+    try:
+        yield
+    finally:
+        sys.unraisablehook = previous
 
 
 def _signals_ignored() -> contextlib.AbstractContextManager[None]:
@@ -193,7 +203,7 @@ def main(argv: list[str] | None = None) -> int:
         shards.resumable.clear()
     _received.clear()
     try:
-        with _signals_raise():
+        with _signals_raise(), _lost_interrupts_unreported():
             return _run(argv)
     except KeyboardInterrupt as e:  # also raised by a second signal while the first is handled
         line, code = interrupt_line(e)

@@ -16,7 +16,8 @@ Output directories (``--out DIR``)
 * The rule is checked before the compute (:func:`check_output_dir`) and again at the commit, which
   holds an exclusive ``flock`` on the parent directory (no lock file), so that two runs into the same
   ``DIR`` give two complete results one after the other, or a result and an error, never a mixture.
-  SIGINT and SIGTERM are blocked during the commit; a signal that arrived before it cancels it.
+  SIGINT and SIGTERM are held back during the commit (:func:`_blocked`); a signal that arrived before
+  it cancels it.
 
 Output files (``export-fmu -o FILE.fmu``)
 -----------------------------------------
@@ -36,11 +37,13 @@ import shutil
 import signal
 import sys
 import tempfile
-from collections.abc import Iterable, Iterator, Sequence
+import threading
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from importlib import metadata
 from pathlib import Path
+from typing import Any
 
-from ..errors import InputError
+from ..errors import InputError, raise_if_interrupted
 
 #: The manifest every output directory holds.
 MANIFEST = "tcsim-manifest.json"
@@ -170,19 +173,15 @@ def _manifest(stage: Path) -> str:
 
 @contextlib.contextmanager
 def _locked_and_uninterrupted(directory: Path) -> Iterator[None]:
-    """An exclusive ``flock`` on ``directory`` with SIGINT and SIGTERM blocked; a signal that is
-    already pending is let through first, so that the commit does not start."""
+    """An exclusive ``flock`` on ``directory`` with SIGINT and SIGTERM held back (:func:`_blocked`); a
+    signal that arrived before is let through first (it raises on entry, also when its exception
+    was lost earlier: :func:`~tcsim.errors.raise_if_interrupted`), so that the commit does not start."""
     fd = os.open(directory, os.O_RDONLY)
     try:
         fcntl.flock(fd, fcntl.LOCK_EX)
-        old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
-        try:
-            if _SIGNALS & signal.sigpending():
-                signal.pthread_sigmask(signal.SIG_SETMASK, old)  # the handler raises here
-                signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+        with _blocked():
+            raise_if_interrupted()
             yield
-        finally:
-            signal.pthread_sigmask(signal.SIG_SETMASK, old)
     finally:
         os.close(fd)  # also releases the lock
 
@@ -249,10 +248,16 @@ def output_dir(out: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[P
         done = True
     finally:
         if not done:
-            with _blocked():
-                if stage is not None:
-                    shutil.rmtree(stage, ignore_errors=True)
-                _remove_empty(created)
+            _held_back(lambda: _discard(stage, created))
+
+
+def _discard(staged: Path | None, created: Sequence[Path]) -> None:
+    """Remove the staging folder or file ``staged`` and the ``created`` parent directories left empty."""
+    if staged is not None and staged.is_dir() and not staged.is_symlink():
+        shutil.rmtree(staged, ignore_errors=True)
+    elif staged is not None:
+        staged.unlink(missing_ok=True)
+    _remove_empty(created)
 
 
 def _remove_empty(directories: Sequence[Path]) -> None:
@@ -263,12 +268,75 @@ def _remove_empty(directories: Sequence[Path]) -> None:
 
 @contextlib.contextmanager
 def _blocked() -> Iterator[None]:
-    """SIGINT and SIGTERM held back (delivered when the block ends)."""
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+    """SIGINT and SIGTERM held back while the block runs, and raised (by the handler they had) when it ends.
+
+    Blocking them in this thread (``pthread_sigmask``) is not enough: the process has other threads
+    (the core's workers, BLAS), the kernel hands the signal to one of them, and Python runs its
+    handler in the main thread at the next bytecode, inside the block. So the block also replaces the
+    Python handlers by one that only records the signal; a signal that arrived before the block
+    raises on entry (``signal.signal`` runs pending handlers first), before anything in it has run.
+    Outside the main thread (where Python runs no handler) only the mask applies."""
+    if threading.current_thread() is not threading.main_thread():
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        return
+    held: list[int] = []
+    previous: dict[int, Any] = {}
     try:
-        yield
+        for sig in sorted(s for s in _SIGNALS if signal.getsignal(s) is not None):  # None: not set by Python
+            previous[sig] = signal.signal(sig, lambda signum, frame: held.append(signum))
+        old = signal.pthread_sigmask(signal.SIG_BLOCK, _SIGNALS)
+        try:
+            yield
+        finally:
+            signal.pthread_sigmask(signal.SIG_SETMASK, old)  # a pending signal is recorded here
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        late = _restore(previous)
+        if held:
+            _deliver(held[0], previous[held[0]])
+        if late is not None:
+            raise late
+
+
+def _restore(previous: dict[int, Any]) -> KeyboardInterrupt | None:
+    """Put the ``previous`` handlers back, all of them also when a signal lands meanwhile (the handler
+    already put back raises it: it is returned, to be raised after)."""
+    late: KeyboardInterrupt | None = None
+    for sig, handler in previous.items():
+        while signal.getsignal(sig) != handler:
+            try:
+                signal.signal(sig, handler)
+            except KeyboardInterrupt as e:  # raised before the handler is set: set it again
+                late = late or e
+    return late
+
+
+def _deliver(sig: int, handler: Any) -> None:
+    """Act on a signal held back by :func:`_blocked` as its ``handler`` would have."""
+    if callable(handler):
+        handler(sig, None)
+    elif handler == signal.SIG_DFL:
+        signal.raise_signal(sig)
+
+
+def _held_back(action: Callable[[], object]) -> None:
+    """Run ``action`` (which may be run again) in :func:`_blocked`, also when a signal lands while the
+    block is being entered (a second Ctrl-C during the clean-up after the first): that one raises after
+    ``action`` has run."""
+    interrupt: KeyboardInterrupt | None = None
+    done = False
+    while not done:
+        try:
+            with _blocked():
+                action()
+                done = True
+        except KeyboardInterrupt as e:
+            interrupt = interrupt or e
+    if interrupt is not None:
+        raise interrupt
 
 
 def check_output_file(out: str | Path, inputs: Iterable[str | Path] = ()) -> None:
@@ -311,7 +379,4 @@ def output_file(out: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[
             done = True
     finally:
         if not done:
-            with _blocked():
-                if tmp is not None:
-                    tmp.unlink(missing_ok=True)
-                _remove_empty(created)
+            _held_back(lambda: _discard(tmp, created))

@@ -49,7 +49,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from ..analysis.chunked import ChunkedStudy, check_chunk_size, check_scheduler, chunk_count, iter_chunks
-from ..errors import InputError
+from ..errors import InputError, raise_if_interrupted
 from .outputs import _blocked, _contained_inputs, _sha256
 from .tables import SPEED_UNITS, to_speed_unit
 
@@ -291,19 +291,22 @@ def _store(out: Path, manifest: dict[str, Any], index: int, table: pa.Table) -> 
     elif manifest["columns"] != columns:
         raise RuntimeError(f"chunk {index} has the columns {columns}, not the study's {manifest['columns']}")
     rel = f"{SHARDS}/{shard_name(index)}"
-    with _blocked():
-        fd, name = tempfile.mkstemp(prefix=f".{shard_name(index)}.", suffix=".partial", dir=out / SHARDS)
-        os.close(fd)
-    try:
+    name: str | None = None
+    try:  # entered before the file exists: a signal held back while it is made raises inside
+        with _blocked():
+            fd, name = tempfile.mkstemp(prefix=f".{shard_name(index)}.", suffix=".partial", dir=out / SHARDS)
+            os.close(fd)
         pq.write_table(table, name)
         entry = {"file": rel, "rows": table.num_rows, "size": os.path.getsize(name), "sha256": _sha256(Path(name))}
         with _blocked():
             os.replace(name, out / rel)
             manifest["chunks"][str(index)] = entry
             _write_manifest(out, manifest)
+        raise_if_interrupted()  # a signal whose exception was lost stops the study after this chunk
     finally:
-        with _blocked(), contextlib.suppress(FileNotFoundError):
-            os.unlink(name)
+        if name is not None:
+            with _blocked(), contextlib.suppress(FileNotFoundError):
+                os.unlink(name)
 
 
 def read_shards(out: str | Path, columns: Sequence[str] | None = None) -> pd.DataFrame:
