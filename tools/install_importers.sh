@@ -35,9 +35,16 @@ if installed; then
     exit 0
 fi
 start=$SECONDS
-# fmi-sys (fmi-sim's C bindings) runs bindgen at build time, which needs libclang: Debian's libclang-dev
-if [ -z "${LIBCLANG_PATH:-}" ] && ! compgen -G "/usr/lib/llvm-*/lib/libclang.so*" >/dev/null \
-    && ! compgen -G "/usr/lib/x86_64-linux-gnu/libclang*.so*" >/dev/null; then
+# fmi-sys (fmi-sim's C bindings) runs bindgen at build time, which needs libclang: Debian's libclang-dev.
+# (libclang-cpp, the C++ interface some machines have alone, is not it: bindgen skips it.)
+have_libclang() {
+    local d
+    for d in /usr/lib/llvm-*/lib /usr/lib/x86_64-linux-gnu /usr/lib64 /usr/lib; do
+        compgen -G "$d/libclang.so*" >/dev/null || compgen -G "$d/libclang-[0-9]*.so*" >/dev/null && return 0
+    done
+    return 1
+}
+if [ -z "${LIBCLANG_PATH:-}" ] && ! have_libclang; then
     echo "installing libclang-dev (Debian) for bindgen" >&2
     { apt-get install -y -qq libclang-dev || { apt-get update -qq && apt-get install -y -qq libclang-dev; }; } >&2
 fi
