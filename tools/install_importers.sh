@@ -3,7 +3,8 @@
 # pure-Rust FMI 2.0/3.0 simulator (Model Exchange and Co-Simulation) from crates.io, written outside
 # this project. This script owns its pinned version and where it lives.
 #
-#   bash tools/install_importers.sh          install it if it is not there; print the binary's path
+#   bash tools/install_importers.sh          install it if it is not there (and the CVODE peer's
+#                                            libsundials-dev, tools/install_peers.sh); print its path
 #   bash tools/install_importers.sh --where  print the binary's path only (what the tests run)
 #
 # It is built from source by `cargo install --locked` (the crate's own Cargo.lock) into a cache outside
@@ -12,6 +13,10 @@
 # installs from scratch (a few minutes on 2 cores; it needs only cargo and crates.io).
 set -euo pipefail
 FMI_SIM_VERSION=0.7.0
+# The other independent implementation the tests compare against: the C + CVODE peer (its own script)
+if [ "${1:-}" != "--where" ]; then
+    bash "$(dirname "$0")/install_peers.sh"
+fi
 root="${TCSIM_IMPORTERS_DIR:-${XDG_CACHE_HOME:-$HOME/.cache}/tcsim/importers}/fmi-sim-$FMI_SIM_VERSION"
 bin="$root/bin/fmi-sim"
 
