@@ -198,35 +198,39 @@ impl<'a> Segment<'a> {
         self.drive.lockup().filter(|_| !self.mode.lockup.is_locked())
     }
 
-    /// External torques on the free coordinates (drive, load, slipping clutch) and their Jacobian.
-    fn external(&self, u: &Vec4, t: f64) -> (Vec4, Mat4) {
+    /// External torques on the free coordinates (drive, load, slipping clutch), and their Jacobian
+    /// into `jac` when asked (the right-hand side does not need it).
+    fn external(&self, u: &Vec4, t: f64, mut jac: Option<&mut Mat4>) -> Vec4 {
         let mut e = [0.0; 4];
-        let mut de = [[0.0; 4]; 4];
         if self.role[PUMP] == Role::Free {
             e[PUMP] = self.drive.pump_torque().map_or(0.0, |s| s.value(t));
         }
         if let (Some(load), Role::Free | Role::Linked) = (self.drive.load(), self.role[TURBINE]) {
             let w = u[TURBINE];
             e[TURBINE] = -(load.torque_nm.value(t) + load.drag_nm_s2 * w * w.abs());
-            de[TURBINE][TURBINE] = -2.0 * load.drag_nm_s2 * w.abs();
+            if let Some(de) = jac.as_deref_mut() {
+                de[TURBINE][TURBINE] = -2.0 * load.drag_nm_s2 * w.abs();
+            }
         }
         if let Some(cmd) = self.slipping() {
             let (cap, slip) = (cmd.capacity(t), u[PUMP] - u[TURBINE]);
             let torque = lockup::slipping_torque_nm(cap, slip);
-            let k = lockup::slipping_torque_slope(cap, slip);
             e[PUMP] -= torque;
             e[TURBINE] += torque;
-            de[PUMP][PUMP] -= k;
-            de[PUMP][TURBINE] += k;
-            de[TURBINE][PUMP] += k;
-            de[TURBINE][TURBINE] -= k;
+            if let Some(de) = jac {
+                let k = lockup::slipping_torque_slope(cap, slip);
+                de[PUMP][PUMP] -= k;
+                de[PUMP][TURBINE] += k;
+                de[TURBINE][PUMP] += k;
+                de[TURBINE][TURBINE] -= k;
+            }
         }
-        (e, de)
+        e
     }
 
     /// Right-hand side of the reduced system, `Pᵀ(F + T − M ż)`, given `u` and `f = F(u)`.
     fn reduced_rhs(&self, u: &Vec4, f: &Vec4, t: f64, out: &mut [f64]) {
-        let (e, _) = self.external(u, t);
+        let e = self.external(u, t, None);
         let zd = self.given_rates(t);
         out.iter_mut().for_each(|o| *o = 0.0);
         for r in 0..4 {
@@ -254,7 +258,8 @@ impl<'a> Segment<'a> {
         }
         let u = self.full(x, t);
         let j = self.model.force_jacobian(&u, self.mode.flow_sign);
-        let (_, de) = self.external(&u, t);
+        let mut de = [[0.0; 4]; 4];
+        self.external(&u, t, Some(&mut de));
         for r in 0..4 {
             let Some(i) = self.col[r] else { continue };
             for c in 0..4 {

@@ -4,6 +4,9 @@
 
 use crate::engine::bdf::roots::RootFinder;
 use crate::engine::bdf::{Bdf, N_MAX};
+
+/// The integrator's size for segments of at most 4 states (every converter segment).
+const N_SMALL: usize = 4;
 use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
 
 /// A smooth system `M ẋ = f(x, t)` with event functions, as one mode of a piecewise-smooth model.
@@ -47,13 +50,33 @@ pub fn run_segment<S: SmoothSegment>(
     if crate::engine::bdf::crosscheck::diffsol_selected() {
         return crate::engine::bdf::crosscheck::run_segment(seg, x0, t0, t_end, times_s, o, samples, steps);
     }
+    if x0.len() <= N_SMALL {
+        run_segment_on::<S, N_SMALL>(seg, x0, t0, t_end, times_s, o, samples, steps)
+    } else {
+        run_segment_on::<S, N_MAX>(seg, x0, t0, t_end, times_s, o, samples, steps)
+    }
+}
+
+/// [`run_segment`] on an integrator of `N` states at most: its arrays are `N` long, so that the
+/// converter's segments (4 states at most) do not carry the vehicle's 12.
+#[allow(clippy::too_many_arguments)]
+fn run_segment_on<S: SmoothSegment, const N: usize>(
+    seg: &S,
+    x0: Vec<f64>,
+    t0: f64,
+    t_end: f64,
+    times_s: &[f64],
+    o: &SolverOptions,
+    samples: &mut Vec<S::Sample>,
+    steps: &mut usize,
+) -> TransientResult<SegmentEnd<S::Root>> {
     while samples.len() < times_s.len() && times_s[samples.len()] <= t0 {
         samples.push(seg.sample(&x0, times_s[samples.len()]));
     }
     if t0 >= t_end {
         return Ok(None);
     }
-    let mut bdf = Bdf::new(seg, &x0, t0, t_end, o)?;
+    let mut bdf = Bdf::<S, N>::new(seg, &x0, t0, t_end, o)?;
     let n = x0.len();
     let roots = seg.roots();
     let mut finder = RootFinder::new(if roots.is_empty() {
@@ -63,7 +86,7 @@ pub fn run_segment<S: SmoothSegment>(
         seg.root_values(&x0, t0, &o.hysteresis, &mut g0);
         g0
     });
-    let mut x = [0.0; N_MAX];
+    let mut x = [0.0; N];
     loop {
         if *steps >= o.max_steps {
             let (t, x) = (bdf.t(), bdf.x());

@@ -1,24 +1,24 @@
 //! Dense LU factorisation with partial pivoting on fixed-size stack arrays (`n ≤ N_MAX`).
 
-use super::{Matrix, Vector, N_MAX};
+use super::{Matrix, Vector};
 
 /// An LU factorisation `P A = L U` of the leading `n × n` block of a [`Matrix`], in place
 /// (`L` below the diagonal with a unit diagonal, `U` on and above it).
 #[derive(Clone, Copy)]
-pub(super) struct Lu {
-    a: Matrix,
-    piv: [usize; N_MAX],
+pub(super) struct Lu<const N: usize> {
+    a: Matrix<N>,
+    piv: [usize; N],
     n: usize,
 }
 
-impl Lu {
+impl<const N: usize> Lu<N> {
     pub(super) fn empty(n: usize) -> Self {
-        Self { a: [[0.0; N_MAX]; N_MAX], piv: [0; N_MAX], n }
+        Self { a: [[0.0; N]; N], piv: [0; N], n }
     }
 
     /// Factorise `a` (its leading `n × n` block). False when a pivot is zero or not finite (a
     /// singular or NaN matrix); the factorisation is then unusable.
-    pub(super) fn factor(&mut self, a: &Matrix) -> bool {
+    pub(super) fn factor(&mut self, a: &Matrix<N>) -> bool {
         self.factor_from(|i, j| a[i][j])
     }
 
@@ -63,7 +63,7 @@ impl Lu {
     }
 
     /// Solve `A x = b` in place (`b` becomes `x`).
-    pub(super) fn solve(&self, b: &mut Vector) {
+    pub(super) fn solve(&self, b: &mut Vector<N>) {
         let (n, m) = (self.n, &self.a);
         for k in 0..n {
             b.swap(k, self.piv[k]);
@@ -82,6 +82,7 @@ impl Lu {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::engine::bdf::N_MAX;
 
     #[test]
     fn solves_a_system_that_needs_pivoting_and_refuses_singular_and_nan_matrices() {
@@ -95,7 +96,7 @@ mod tests {
         for i in 0..3 {
             b[i] = (0..3).map(|j| a[i][j] * x[j]).sum();
         }
-        let mut lu = Lu::empty(3);
+        let mut lu = Lu::<N_MAX>::empty(3);
         assert!(lu.factor(&a));
         lu.solve(&mut b);
         for i in 0..3 {

@@ -54,13 +54,15 @@ pub const N_MAX: usize = 12;
 /// The highest order.
 pub const MAX_ORDER: usize = 5;
 
-pub(crate) type Vector = [f64; N_MAX];
-pub(crate) type Matrix = [[f64; N_MAX]; N_MAX];
+pub(crate) type Vector<const N: usize> = [f64; N];
+pub(crate) type Matrix<const N: usize> = [[f64; N]; N];
 
 const KAPPA: [f64; MAX_ORDER + 2] = [0.0, -0.1850, -1.0 / 9.0, -0.0823, -0.0415, 0.0, 0.0];
 const GAMMA: [f64; MAX_ORDER + 2] = gammas();
 const ALPHA: [f64; MAX_ORDER + 2] = alphas();
 const ERROR_CONST: [f64; MAX_ORDER + 2] = error_constants();
+/// `1/j` (index 0 unused).
+const RECIPROCALS: [f64; MAX_ORDER + 1] = [0.0, 1.0, 0.5, 1.0 / 3.0, 0.25, 0.2];
 
 const NEWTON_MAX_ITERS: usize = 3;
 /// Convergence test of the Newton iteration, relative to the error test's bound on `‖d‖`, at most.
@@ -125,20 +127,20 @@ pub struct Stats {
 }
 
 /// The integrator's state over one segment.
-pub struct Bdf<'s, S: SmoothSegment> {
+pub struct Bdf<'s, S: SmoothSegment, const N: usize> {
     seg: &'s S,
     n: usize,
     rtol: f64,
-    atol: Vector,
-    mass: Matrix,
-    jac: Matrix,
+    atol: Vector<N>,
+    mass: Matrix<N>,
+    jac: Matrix<N>,
     jac_age: usize,
     jac_fresh: bool,
-    lu: Lu,
+    lu: Lu<N>,
     lu_c: f64,
     lu_age: usize,
     rate: f64,
-    d: [Vector; MAX_ORDER + 3],
+    d: [Vector<N>; MAX_ORDER + 3],
     t: f64,
     h: f64,
     order: usize,
@@ -147,30 +149,30 @@ pub struct Bdf<'s, S: SmoothSegment> {
     select_due: bool,
     last_error: f64,
     last_safety: f64,
-    weights: Vector,
+    weights: Vector<N>,
     pub stats: Stats,
 }
 
 /// `‖v‖`: the RMS of `v_i w_i` over the first `n`.
-fn wrms(n: usize, v: &Vector, w: &Vector) -> f64 {
+fn wrms<const N: usize>(n: usize, v: &Vector<N>, w: &Vector<N>) -> f64 {
     let s: f64 = (0..n).map(|i| (v[i] * w[i]) * (v[i] * w[i])).sum();
     (s / n as f64).sqrt()
 }
 
-impl<'s, S: SmoothSegment> Bdf<'s, S> {
+impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
     /// Start at `(x0, t0)` with the step `o.first_step_s` (at most `t_end − t0`), order 1.
     pub fn new(seg: &'s S, x0: &[f64], t0: f64, t_end: f64, o: &SolverOptions) -> TransientResult<Self> {
         let n = seg.n_states();
         let state = if x0.len() == n { seg.coordinates(x0, t0) } else { x0.to_vec() };
         let fail = |m: String| TransientError::Solver { time_s: t0, state: state.clone(), message: m };
-        if n == 0 || n > N_MAX || x0.len() != n {
-            return Err(fail(format!("{n} states ({} given): the solver takes 1 to {N_MAX}", x0.len())));
+        if n == 0 || n > N || x0.len() != n {
+            return Err(fail(format!("{n} states ({} given): the solver takes 1 to {N}", x0.len())));
         }
         let atol_v = seg.atol(o);
-        let mut atol = [0.0; N_MAX];
+        let mut atol = [0.0; N];
         atol[..n].copy_from_slice(&atol_v[..n]);
-        let mut mass = [[0.0; N_MAX]; N_MAX];
-        let (mut e, mut col) = ([0.0; N_MAX], [0.0; N_MAX]);
+        let mut mass = [[0.0; N]; N];
+        let (mut e, mut col) = ([0.0; N], [0.0; N]);
         for j in 0..n {
             e[j] = 1.0;
             col.iter_mut().for_each(|c| *c = 0.0);
@@ -178,7 +180,7 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
             (0..n).for_each(|i| mass[i][j] = col[i]);
             e[j] = 0.0;
         }
-        let mut d = [[0.0; N_MAX]; MAX_ORDER + 3];
+        let mut d = [[0.0; N]; MAX_ORDER + 3];
         d[0][..n].copy_from_slice(x0);
         let mut b = Self {
             seg,
@@ -186,7 +188,7 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
             rtol: o.rtol,
             atol,
             mass,
-            jac: [[0.0; N_MAX]; N_MAX],
+            jac: [[0.0; N]; N],
             jac_age: usize::MAX,
             jac_fresh: false,
             lu: Lu::empty(n),
@@ -201,7 +203,7 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
             select_due: false,
             last_error: 0.0,
             last_safety: 1.0,
-            weights: [0.0; N_MAX],
+            weights: [0.0; N],
             stats: Stats::default(),
         };
         b.init_derivative().map_err(fail)?;
@@ -211,7 +213,7 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
     /// `D_1 = h ẋ(t0)`, from `M ẋ = f`.
     fn init_derivative(&mut self) -> Result<(), String> {
         let n = self.n;
-        let mut f = [0.0; N_MAX];
+        let mut f = [0.0; N];
         self.seg.rhs(&self.d[0][..n], self.t, &mut f[..n]);
         self.stats.rhs += 1;
         if !f[..n].iter().all(|v| v.is_finite()) {
@@ -252,8 +254,8 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
         out.copy_from_slice(&self.d[0][..n]);
         let (s, mut p) = ((t - self.t) / h, 1.0);
         for j in 1..=self.order {
-            // Π_{m<j} (t − (t_n − m h)) / ((m + 1) h) = Π_{m<j} (s + m)/(m + 1)
-            p *= (s + (j - 1) as f64) / j as f64;
+            // Π_{m<j} (t − (t_n − m h)) / ((m + 1) h) = Π_{m<j} (s + m)/(m + 1), without a chain of divisions
+            p *= (s + (j - 1) as f64) * RECIPROCALS[j];
             for (o, v) in out.iter_mut().zip(&self.d[j][..n]) {
                 *o += p * v;
             }
@@ -268,7 +270,7 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
     fn rescale(&mut self, factor: f64) {
         let (k, n) = (self.order, self.n);
         let ru = rescale_matrix(k, factor);
-        let mut out = [[0.0; N_MAX]; MAX_ORDER + 1];
+        let mut out = [[0.0; N]; MAX_ORDER + 1];
         for (j, o) in out.iter_mut().enumerate().take(k + 1) {
             for i in 0..=k {
                 let c = ru[i][j];
@@ -327,7 +329,7 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
     /// Try the step to `t_new` with the current `h` and order.
     fn attempt(&mut self, t_new: f64) -> Attempt {
         let (n, k) = (self.n, self.order);
-        let (mut pred, mut psi) = ([0.0; N_MAX], [0.0; N_MAX]);
+        let (mut pred, mut psi) = ([0.0; N], [0.0; N]);
         for j in 0..=k {
             for (p, v) in pred[..n].iter_mut().zip(&self.d[j][..n]) {
                 *p += v;
@@ -366,10 +368,10 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
 
     /// Factorise `M − cJ`, re-evaluating `J` at `(pred, t)` first when `new_jacobian`. A Newton
     /// failure when the matrix is singular (a smaller step may help), fatal when `J` is not finite.
-    fn refactor(&mut self, t: f64, pred: &Vector, c: f64, new_jacobian: bool) -> Result<(), Attempt> {
+    fn refactor(&mut self, t: f64, pred: &Vector<N>, c: f64, new_jacobian: bool) -> Result<(), Attempt> {
         let n = self.n;
         if new_jacobian {
-            let (mut e, mut col) = ([0.0; N_MAX], [0.0; N_MAX]);
+            let (mut e, mut col) = ([0.0; N], [0.0; N]);
             for j in 0..n {
                 e[j] = 1.0;
                 self.seg.jacobian_times(&pred[..n], t, &e[..n], &mut col[..n]);
@@ -401,20 +403,20 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
     }
 
     /// The corrector: `(x, d, iterations)`, or None when it does not converge.
-    fn newton(&mut self, t: f64, c: f64, pred: &Vector, psi: &Vector) -> Option<(Vector, Vector, usize)> {
+    fn newton(&mut self, t: f64, c: f64, pred: &Vector<N>, psi: &Vector<N>) -> Option<(Vector<N>, Vector<N>, usize)> {
         let n = self.n;
         // CVODE's bound, or SciPy's `max(10 ε / rtol, min(0.03, √rtol))` when tighter: a state at rest
         // is then an equilibrium to about √rtol of the tolerance
         let tol = (NEWTON_TOL / ERROR_CONST[self.order])
             .min((10.0 * f64::EPSILON / self.rtol).max(self.rtol.sqrt().min(0.03)));
         let scale = 2.0 / (1.0 + c / self.lu_c);
-        let (mut x, mut d) = (*pred, [0.0; N_MAX]);
+        let (mut x, mut d) = (*pred, [0.0; N]);
         let mut previous = 0.0;
         for m in 0..NEWTON_MAX_ITERS {
-            let mut f = [0.0; N_MAX];
+            let mut f = [0.0; N];
             self.seg.rhs(&x[..n], t, &mut f[..n]);
             self.stats.rhs += 1;
-            let mut r = [0.0; N_MAX];
+            let mut r = [0.0; N];
             for i in 0..n {
                 let md: f64 = (0..n).map(|j| self.mass[i][j] * (psi[j] + d[j])).sum();
                 r[i] = c * f[i] - md;
@@ -444,7 +446,7 @@ impl<'s, S: SmoothSegment> Bdf<'s, S> {
     }
 
     /// Accept the corrected step or give the factor to cut it by.
-    fn error_test(&mut self, t_new: f64, x: Vector, d: Vector, iters: usize) -> Attempt {
+    fn error_test(&mut self, t_new: f64, x: Vector<N>, d: Vector<N>, iters: usize) -> Attempt {
         let (n, k) = (self.n, self.order);
         for i in 0..n {
             self.weights[i] = 1.0 / (self.atol[i] + self.rtol * x[i].abs());
@@ -521,22 +523,36 @@ enum Attempt {
 /// `R(k, r) U(k)` of Shampine & Reichelt (1997) eq. (2.6): the differences for a step `r h` are
 /// `D ← (R U)ᵀ D` (`U = R(k, 1)`; `R(k, r)_{ij} = Π_{m=1..i} (m − 1 − r j)/m`).
 fn rescale_matrix(k: usize, factor: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] {
-    let r_of = |f: f64| {
-        let mut r = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
-        r[0][..=k].iter_mut().for_each(|v| *v = 1.0);
-        for i in 1..=k {
-            for j in 0..=k {
-                r[i][j] = r[i - 1][j] * ((i - 1) as f64 - f * j as f64) / i as f64;
-            }
-        }
-        r
-    };
-    let (r, u) = (r_of(factor), r_of(1.0));
+    let r = r_matrix(k, factor);
     let mut ru = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
     for i in 0..=k {
         for j in 0..=k {
-            ru[i][j] = (0..=k).map(|m| r[i][m] * u[m][j]).sum();
+            ru[i][j] = (0..=k).map(|m| r[i][m] * U[m][j]).sum();
         }
     }
     ru
 }
+
+/// `R(k, f)` (zero beyond row and column `k`).
+const fn r_matrix(k: usize, f: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] {
+    let mut r = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
+    let mut j = 0;
+    while j <= k {
+        r[0][j] = 1.0;
+        j += 1;
+    }
+    let mut i = 1;
+    while i <= k {
+        let mut j = 0;
+        while j <= k {
+            r[i][j] = r[i - 1][j] * ((i - 1) as f64 - f * j as f64) / i as f64;
+            j += 1;
+        }
+        i += 1;
+    }
+    r
+}
+
+/// `U = R(k, 1)`: its entries up to row and column `k` do not depend on `k`, so one table serves
+/// every order.
+const U: [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] = r_matrix(MAX_ORDER, 1.0);

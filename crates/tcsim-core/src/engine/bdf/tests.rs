@@ -13,8 +13,8 @@ type Fun = fn(&[f64], f64, &mut [f64]);
 /// `M ẋ = A x + b(x, t)` with `A` dense and an optional nonlinear/failing part, event functions `g`.
 struct Linear {
     n: usize,
-    mass: Matrix,
-    a: Matrix,
+    mass: Matrix<N_MAX>,
+    a: Matrix<N_MAX>,
     extra: Option<Fun>,
     nan_jacobian: bool,
     roots: Vec<usize>,
@@ -22,12 +22,12 @@ struct Linear {
 }
 
 impl Linear {
-    fn new(n: usize, mass: Matrix, a: Matrix) -> Self {
+    fn new(n: usize, mass: Matrix<N_MAX>, a: Matrix<N_MAX>) -> Self {
         Self { n, mass, a, extra: None, nan_jacobian: false, roots: vec![], g: None }
     }
 }
 
-fn identity() -> Matrix {
+fn identity() -> Matrix<N_MAX> {
     let mut m = [[0.0; N_MAX]; N_MAX];
     (0..N_MAX).for_each(|i| m[i][i] = 1.0);
     m
@@ -123,7 +123,7 @@ fn exponential_decay_error_follows_the_tolerance_and_the_order_rises() {
     }
     // a high order is reached on a smooth problem at a tight tolerance
     let o = options(1e-10);
-    let mut bdf = Bdf::new(&seg, &[1.0], 0.0, 5.0, &o).unwrap();
+    let mut bdf = Bdf::<_, N_MAX>::new(&seg, &[1.0], 0.0, 5.0, &o).unwrap();
     let mut max_order = 1;
     while bdf.t() < 5.0 {
         bdf.step(5.0).unwrap();
@@ -169,7 +169,7 @@ fn the_run_stops_exactly_at_the_end_time() {
     let seg = oscillator();
     let t_end = 1.234_567_890_123;
     let o = options(1e-6);
-    let mut bdf = Bdf::new(&seg, &[1.0, 0.0], 0.0, t_end, &o).unwrap();
+    let mut bdf = Bdf::<_, N_MAX>::new(&seg, &[1.0, 0.0], 0.0, t_end, &o).unwrap();
     while bdf.t() < t_end {
         bdf.step(t_end).unwrap();
         assert!(bdf.t() <= t_end, "passed the end: {}", bdf.t());
@@ -271,7 +271,7 @@ fn one_and_twelve_states() {
     assert!(max_error(&s, |t| vec![t.exp()]) < 1e-6 * 3.0);
     // thirteen states are an error, not a panic
     let too_many = Linear { n: N_MAX + 1, ..Linear::new(1, identity(), a1) };
-    let e = Bdf::new(&too_many, &[1.0; N_MAX + 1], 0.0, 1.0, &options(1e-6)).err().expect("an error");
+    let e = Bdf::<_, N_MAX>::new(&too_many, &[1.0; N_MAX + 1], 0.0, 1.0, &options(1e-6)).err().expect("an error");
     assert!(matches!(e, TransientError::Solver { ref message, .. } if message.contains("1 to 12")), "{e}");
 }
 
