@@ -29,7 +29,8 @@ of the core, any sign change), then restarts in the next mode from the momentum-
 projection ``(PᵀMP) x = PᵀM u``. Before a mode is integrated, a switch whose condition already
 holds fires at once (:meth:`Mode.due`: stop speed, a brake that cannot hold, lock-up release, a due
 shift or lock-up engagement). Runs also restart (same mode, no such check) at the breakpoints of
-the pedal signals, where the forcing has a kink (a documented choice; the core steps over them).
+the pedal signals, where the forcing has a kink (the core ends its steps there without a restart:
+``run_segment_with_stops``).
 
 Phases, as in the core: a shift hands the torque over during ``shift_handover_s`` (a time root);
 if the on-coming slip is then within 0.5 rad/s the shift is over ("shift-end"), else it ends when

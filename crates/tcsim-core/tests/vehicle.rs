@@ -281,3 +281,39 @@ fn a_logged_engine_torque_replaces_the_engine_model() {
         r2.events.iter().map(|e| e.kind).collect::<Vec<_>>()
     );
 }
+
+#[test]
+fn the_run_up_to_a_time_does_not_depend_on_the_pedals_after_it() {
+    // Causality. The coasting scenario lifts the pedal at 8 s; up to 8 s it is the flip-flop launch.
+    // Before the integrator's steps ended on the pedals' breakpoints, a step grown over the 5 s of
+    // braked idle reached past 8 s, saw the lifted pedal there and was accepted: the engine never saw
+    // the 5.00–5.05 s pedal ramp (its torque stayed at idle while the pedal output read 0.8), the
+    // brake released 9e-5 s later and the first upshift came 23 ms later than in the flip-flop launch
+    // (bench/bench_launch.py found it against the SciPy reference).
+    let lifted = coast_and_brake(0.6);
+    let held = flip_flop(1.0, 40.0, 1e3);
+    for (name, model) in models() {
+        let (a, b) = (run(model.as_ref(), &lifted), run(model.as_ref(), &held));
+        let before = |r: &LaunchTrajectory| -> Vec<(f64, &'static str)> {
+            r.events.iter().filter(|e| e.time_s < 8.0).map(|e| (e.time_s, e.kind)).collect()
+        };
+        let (ea, eb) = (before(&a), before(&b));
+        assert_eq!(ea.iter().map(|e| e.1).collect::<Vec<_>>(), eb.iter().map(|e| e.1).collect::<Vec<_>>(), "{name}");
+        for (x, y) in ea.iter().zip(&eb) {
+            assert!((x.0 - y.0).abs() < 1e-6, "{name}: {} at {} and {}", x.1, x.0, y.0);
+        }
+        // the same inputs: the same run to the solver's tolerance (10 rtol; the last step before
+        // 8 s ends on the lifted run's breakpoint there); before the fix 1.5e-2 and 18 N·m apart
+        let close = |x: f64, y: f64| (x - y).abs() <= 1e-5 * y.abs().max(1.0);
+        for (s, r) in a.samples.iter().zip(&b.samples).take_while(|(s, _)| s.time_s <= 8.0) {
+            assert_eq!(s.time_s, r.time_s);
+            let (v, w) = (s.u[SPEED], r.u[SPEED]);
+            assert!(close(v, w), "{name}: speed at {} s: {v} and {w}", s.time_s);
+            let (p, q) = (s.engine_torque_nm, r.engine_torque_nm);
+            assert!(close(p, q), "{name}: engine torque at {} s: {p} and {q}", s.time_s);
+        }
+        // the engine follows the pedal ramp (it stayed at idle through it before)
+        let torque_at = |t: f64| a.samples.iter().find(|s| s.time_s >= t - 1e-9).unwrap().engine_torque_nm;
+        assert!(torque_at(5.04) > torque_at(4.99) + 10.0, "{name}: {} then {}", torque_at(4.99), torque_at(5.04));
+    }
+}

@@ -46,14 +46,36 @@ pub fn run_segment<S: SmoothSegment>(
     samples: &mut Vec<S::Sample>,
     steps: &mut usize,
 ) -> TransientResult<SegmentEnd<S::Root>> {
+    run_segment_with_stops(seg, x0, t0, t_end, &[], times_s, o, samples, steps)
+}
+
+/// [`run_segment`] whose steps end exactly on each of `stops` (sorted) they would pass: the
+/// breakpoints of the piecewise-linear inputs (a launch scenario's pedals), where the forcing has a
+/// kink (CVODE's stop time). Without them, a step grown over a long steady phase (the braked idle
+/// before a launch) could pass a whole pedal ramp with no evaluation inside it, and the engine did
+/// not see the ramp. The integrator goes on through a stop (its error control sees the kink), so
+/// a densely logged pedal costs at most one step per sample.
+#[allow(clippy::too_many_arguments)]
+pub fn run_segment_with_stops<S: SmoothSegment>(
+    seg: &S,
+    x0: Vec<f64>,
+    t0: f64,
+    t_end: f64,
+    stops: &[f64],
+    times_s: &[f64],
+    o: &SolverOptions,
+    samples: &mut Vec<S::Sample>,
+    steps: &mut usize,
+) -> TransientResult<SegmentEnd<S::Root>> {
     #[cfg(test)]
     if crate::engine::bdf::crosscheck::diffsol_selected() {
         return crate::engine::bdf::crosscheck::run_segment(seg, x0, t0, t_end, times_s, o, samples, steps);
     }
+    let stops = &stops[stops.partition_point(|&s| s <= t0)..];
     if x0.len() <= N_SMALL {
-        run_segment_on::<S, N_SMALL>(seg, x0, t0, t_end, times_s, o, samples, steps)
+        run_segment_on::<S, N_SMALL>(seg, x0, t0, t_end, stops, times_s, o, samples, steps)
     } else {
-        run_segment_on::<S, N_MAX>(seg, x0, t0, t_end, times_s, o, samples, steps)
+        run_segment_on::<S, N_MAX>(seg, x0, t0, t_end, stops, times_s, o, samples, steps)
     }
 }
 
@@ -65,6 +87,7 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
     x0: Vec<f64>,
     t0: f64,
     t_end: f64,
+    stops: &[f64],
     times_s: &[f64],
     o: &SolverOptions,
     samples: &mut Vec<S::Sample>,
@@ -87,6 +110,7 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
         g0
     });
     let mut x = [0.0; N];
+    let mut next_stop = 0;
     loop {
         if *steps >= o.max_steps {
             let (t, x) = (bdf.t(), bdf.x());
@@ -95,7 +119,10 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
         }
         *steps += 1;
         let t_lo = bdf.t();
-        bdf.step(t_end)?;
+        while next_stop < stops.len() && stops[next_stop] <= t_lo {
+            next_stop += 1;
+        }
+        bdf.step(stops.get(next_stop).map_or(t_end, |&s| s.min(t_end)))?;
         let t_hi = bdf.t();
         let root = if roots.is_empty() {
             None

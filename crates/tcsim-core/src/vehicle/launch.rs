@@ -11,7 +11,7 @@ use super::{GEARBOX_OUT, N_COORDS, SPEED, TORQUE_BOOST, TORQUE_FAST, TWIST_F, TW
 use crate::converter::dynamics::{ConverterDynamics, PUMP, TURBINE};
 use crate::engine::converter_events::{self, Mode as ConverterMode};
 use crate::engine::options::{try_reserve, OutputSize, SolverOptions, TransientError, TransientResult};
-use crate::engine::segment::{run_segment, SmoothSegment};
+use crate::engine::segment::{run_segment_with_stops, SmoothSegment};
 use crate::error::{CoreError, CoreResult, InputSource};
 
 /// A launch run: samples, events, the kinetic energy removed at clutch locking events
@@ -302,6 +302,7 @@ pub fn simulate_launch(
     try_reserve(&mut traj.samples, times.len())?;
     let (mut t, mut u, mut sync) = (0.0, u0, 1.0);
     let mut energy_before: Option<f64> = None;
+    let stops = sc.breakpoints();
     loop {
         let plant = Plant::new(model, v, sc, mode, sync);
         let x0 = plant.state_of(&u);
@@ -312,7 +313,17 @@ pub fn simulate_launch(
         }
         let end = match pending_switch(&plant, &plant.full(&x0), t) {
             Some(root) => Some((t, root, x0)),
-            None => run_segment(&plant, x0, t, sc.end_time_s, &times, options, &mut traj.samples, &mut traj.steps)?,
+            None => run_segment_with_stops(
+                &plant,
+                x0,
+                t,
+                sc.end_time_s,
+                &stops,
+                &times,
+                options,
+                &mut traj.samples,
+                &mut traj.steps,
+            )?,
         };
         match end {
             None => return Ok(traj),

@@ -443,6 +443,19 @@ pub struct Scenario {
     pub shift_pedal: Option<Signal>,
 }
 
+impl Scenario {
+    /// The pedals' breakpoints, sorted, each once: where a launch's forcing has a kink, so where
+    /// its integrator's steps end ([`crate::engine::segment::run_segment_with_stops`]). The
+    /// filtered shift pedal enters only root functions, and a logged engine torque is a
+    /// measurement: neither adds stops.
+    pub fn breakpoints(&self) -> Vec<f64> {
+        let mut b: Vec<f64> = self.accelerator_pedal.times().iter().chain(self.brake_pedal.times()).copied().collect();
+        b.sort_by(f64::total_cmp);
+        b.dedup();
+        b
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::file::read_vehicle;
