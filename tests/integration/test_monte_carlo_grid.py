@@ -119,7 +119,7 @@ def test_shards_of_a_grid_at_any_chunk_size_are_the_unchunked_rows_bit_for_bit(t
     pd.testing.assert_frame_equal(read_shards(tmp_path / "s"), unchunked, check_exact=True)
 
 
-def test_a_grid_alone_may_omit_runs_one_case_per_point(tmp_path):
+def test_a_grid_alone_may_omit_runs_one_case_per_point(cli, tmp_path):
     path = write(
         tmp_path / "g.toml",
         f'seed = 0\nmodels = ["table"]\noutputs = ["time_0_50_km_h_s"]\n[distributions]\n"{PUMP}" = '
@@ -135,6 +135,8 @@ def test_a_grid_alone_may_omit_runs_one_case_per_point(tmp_path):
     assert study.definition()["distributions"] == [
         {"parameter": PUMP, "kind": "grid", "start": 0.0, "stop": 0.003, "num": 4}
     ]
+    r = cli("monte-carlo", path, "--out", tmp_path / "o", "--no-plots", "--no-progress")
+    assert r.code == 0 and "g: 4 cases (4 grid points) × 1 models (table), 0 of 4 runs without outputs" in r.stdout
 
 
 # --------------------------------------------------------------------------------------------
@@ -311,3 +313,12 @@ def test_the_unchunked_command_line_table_is_the_python_rows(cli, tmp_path, grid
     assert "shape-sweep: 18 cases (9 grid points × 2 runs) × 2 models (table, quasi-dynamic), 0 of 36" in r.stdout
     written = pd.read_csv(tmp_path / "o" / "monte_carlo.csv", dtype={"error": str}, keep_default_na=False)
     pd.testing.assert_frame_equal(written, unchunked, check_dtype=False, check_exact=False, rtol=1e-15)
+
+
+def test_the_docs_shape_effect_sweep_is_a_valid_study_file(tmp_path):
+    """docs/study.md "A shape-effect sweep": its file loads, 5 × 4 grid points, one run each."""
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "study.md").read_text(encoding="utf-8")
+    text = doc.split("**A shape-effect sweep**", 1)[1].split("```toml\n", 1)[1].split("```", 1)[0]
+    sf = load_study_file(write(tmp_path / "shape-sweep.toml", text))
+    assert [p.key for p in sf.parameters] == [PUMP, TURBINE]
+    assert sf.doc.grid_points == sf.doc.n_cases == 20 and sf.doc.n_runs == 1

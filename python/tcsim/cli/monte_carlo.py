@@ -95,7 +95,7 @@ def monte_carlo(
     inputs = [file, sf.vehicle.path, sf.converter.path]
     cases = f"{study.n_cases} cases"
     if sf.doc.grid_points > 1:
-        cases += f" ({sf.doc.grid_points} grid points × {sf.doc.n_runs} runs)"
+        cases += f" ({sf.doc.grid_points} grid points" + (f" × {sf.doc.n_runs} runs)" if sf.doc.n_runs > 1 else ")")
     head = f"{sf.name}: {cases} × {len(study.models)} models ({', '.join(study.models)})"
     if chunk_size is not None:
         run = run_sharded(study, out, chunk_size, tf.speed_unit, scheduler, workers, inputs, not no_progress)

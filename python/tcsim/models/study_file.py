@@ -296,7 +296,8 @@ class MonteCarloFile(BaseModel):
     def cases_text(self) -> str:
         """``3 × 4 grid points × 10 runs = 120 cases``."""
         sizes = " × ".join(str(len(d)) for d in self.distributions.values() if isinstance(d, Grid))
-        return f"{sizes} grid points × {self.n_runs} runs = {self.n_cases} cases"
+        runs = f"{self.n_runs} run{'s' if self.n_runs > 1 else ''}"
+        return f"{sizes} grid points × {runs} = {self.n_cases} cases"
 
 
 @dataclass(frozen=True)
