@@ -119,6 +119,13 @@ def test_shards_of_a_grid_at_any_chunk_size_are_the_unchunked_rows_bit_for_bit(t
     pd.testing.assert_frame_equal(read_shards(tmp_path / "s"), unchunked, check_exact=True)
 
 
+@pytest.mark.subprocess
+def test_a_local_cluster_gives_the_unchunked_rows_of_a_grid_bit_for_bit(tmp_path, cluster, study, unchunked):
+    run = run_to_shards(study, tmp_path / "s", 7, scheduler=cluster.scheduler_address)
+    assert sorted(run.computed) == [0, 1, 2]
+    pd.testing.assert_frame_equal(read_shards(tmp_path / "s"), unchunked, check_exact=True)
+
+
 def test_a_grid_alone_may_omit_runs_one_case_per_point(cli, tmp_path):
     path = write(
         tmp_path / "g.toml",

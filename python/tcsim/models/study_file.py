@@ -158,9 +158,10 @@ class TruncatedNormal(_Strict):
 class Grid(_Strict):
     """``{ kind = "grid", values }`` or ``{ kind = "grid", start, stop, num }``: swept, not drawn (the
     grids of a file form a full factorial, each point run ``runs`` times). ``values``: distinct finite
-    numbers, run in the order given; ``start, stop, num``: ``num`` values evenly spaced from ``start`` to ``stop``, both
-    included (value ``k`` is ``start + k·(stop − start)/(num − 1)``, the last exactly ``stop``, as
-    ``numpy.linspace``; ``num = 1``: ``start`` alone). Exactly one of the two forms."""
+    numbers, run in the order given; ``start, stop, num``: ``num`` values evenly spaced from
+    ``start`` to ``stop``, both included (value ``k`` is ``start + k·(stop − start)/(num − 1)``, the
+    last exactly ``stop``, as ``numpy.linspace``; ``num = 1``: ``start`` alone). Exactly one of the
+    two forms."""
 
     kind: Literal["grid"]
     values: list[Annotated[float, Field(allow_inf_nan=False)]] | None = None
@@ -231,8 +232,6 @@ def describe(distribution: BaseModel) -> str:
     return f"{kind}(" + ", ".join(f"{k}={show(v)}" for k, v in values.items()) + ")"
 
 
-#: A random distribution (drawn) of a parameter.
-Random = Normal | Uniform | Lognormal | TruncatedNormal
 Distribution = Annotated[Normal | Uniform | Lognormal | TruncatedNormal | Grid, Field(discriminator="kind")]
 
 
