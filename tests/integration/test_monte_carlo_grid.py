@@ -198,6 +198,7 @@ HALF = MAX_RUNS // 2 + 1
         ("", "start = 0.0, num = 3", f"{FIELD}.stop", "missing", "start, stop and num together"),
         ("", "start = 0.5, stop = 0.5, num = 2", f"{FIELD}.stop", 0.5, "a stop other than start (0.5) when num > 1"),
         ("", "start = -1e308, stop = 1e308, num = 3", f"{FIELD}.stop", 1e308, "stop − start a finite number"),
+        ("", "start = 1.0, stop = 1.000000000000001, num = 9", f"{FIELD}.num", 9, "as many values as distinct numbers"),
         ("", "start = inf, stop = 1.0, num = 2", f"{FIELD}.start", math.inf, "a finite number"),
         ("", "", f"{FIELD}.values", "missing", "values, or start, stop and num"),
         ("", "values = [0.1], step = 0.1", f"{FIELD}.step", 0.1, "a known key"),

@@ -195,6 +195,9 @@ class Grid(_Strict):
             raise FieldError(("stop",), self.stop, f"a stop other than start ({self.start:g}) when num > 1")
         if self.num > 1 and not math.isfinite(self.stop - self.start):
             raise FieldError(("stop",), self.stop, "stop − start a finite number")
+        if len(set(self.points())) < self.num:  # rounding: start and stop too close for num values
+            expected = f"at most as many values as distinct numbers lie from {self.start!r} to {self.stop!r}"
+            raise FieldError(("num",), self.num, expected)
         return self
 
     def __len__(self) -> int:
