@@ -329,10 +329,14 @@ def study_file_part() -> list[str]:
         "### Monte Carlo study (`tcsim monte-carlo`)",
         "",
         "A TOML file: the `FILE` argument of `tcsim monte-carlo`, a vehicle launch repeated `runs` times with",
-        'converter and vehicle parameters drawn from the distributions it gives ([study](../study.md), "Monte',
-        'Carlo studies"). The example column is the starting file `tcsim init monte-carlo` writes.',
+        "converter and vehicle parameters drawn from the distributions it gives, at each point of its grids",
+        '([study](../study.md), "Monte Carlo studies"). The example column is the starting file',
+        "`tcsim init monte-carlo` writes.",
         "",
-        *schema_table(MonteCarloFile, raw, comment_notes(MonteCarloFile), ranges=False),
+        *[
+            row.replace("| `runs` |  | optional |", "| `runs` |  | required with a drawn parameter |")
+            for row in schema_table(MonteCarloFile, raw, comment_notes(MonteCarloFile), ranges=False)
+        ],
         "",
         "#### `[distributions]`",
         "",
@@ -351,14 +355,16 @@ def study_file_part() -> list[str]:
             for k in model.model_fields
             if k != "kind"
         )
-        low, high, is_open = model.model_construct(low=0.0, high=1.0, mean=1.0, std=1.0).support()
-        support = "every real number" if low == -math.inf else ("above 0" if is_open else "`low` to `high`")
+        if kind == "grid":
+            support = "its values (swept, not drawn)"
+        else:
+            low, high, is_open = model.model_construct(low=0.0, high=1.0, mean=1.0, std=1.0).support()
+            support = "every real number" if low == -math.inf else ("above 0" if is_open else "`low` to `high`")
         doc = " ".join((inspect.getdoc(model) or "").split()).split(": ", 1)[-1]
         out.append(f"| `{kind}` | {keys} | {support} | {_cell(_markdown(doc))} |")
     out += [
         "",
-        _markdown(" ".join((inspect.getdoc(study_file) or "").split("\n\n")[2].split())),
-        "",
+        *(_markdown(" ".join(part.split())) + "\n" for part in (inspect.getdoc(study_file) or "").split("\n\n")[2:4]),
         *_starting_file("monte-carlo", ".toml"),
     ]
     return out

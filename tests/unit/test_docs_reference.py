@@ -60,9 +60,10 @@ def test_every_monte_carlo_file_field_and_distribution_kind_is_listed(page):
     part = _part(page, "Study files").split("### Monte Carlo study", 1)[1]
     for key in MonteCarloFile.model_fields:
         assert re.search(rf"^\| `{key}` \|", part, flags=re.M), key
-    for kind in ("normal", "uniform", "lognormal", "truncated-normal"):
+    for kind in ("normal", "uniform", "lognormal", "truncated-normal", "grid"):
         assert re.search(rf"^\| `{kind}` \| `", part, flags=re.M), kind
-    assert re.search(r"^\| `runs` \|  \| required \| ≥ 1 and ≤ 1e\+07 \|", part, flags=re.M)
+    assert "**Grids.** The grid parameters form a full factorial" in part
+    assert re.search(r"^\| `runs` \|  \| required with a drawn parameter \| ≥ 1 and ≤ 1e\+07 \|", part, flags=re.M)
 
 
 def test_the_bounds_and_defaults_are_the_schemas(page):

@@ -1,12 +1,15 @@
 """Monte Carlo studies of the vehicle launch (``tcsim monte-carlo FILE``, docs/study.md "Monte Carlo
-studies"): ``runs`` cases, each a launch of every model of the study with converter and vehicle
-parameters drawn from the study file's distributions (:mod:`tcsim.models.study_file`).
+studies"): ``runs`` cases per grid point, each a launch of every model of the study with converter
+and vehicle parameters drawn from the study file's distributions or swept over its grids
+(:mod:`tcsim.models.study_file`).
 
-**Reproducible whatever the chunking.** Case ``i`` draws its parameters, in the order the file
-lists them, from its own generator ``numpy.random.Generator(PCG64(SeedSequence([seed, i])))``: its
-values depend on the seed and ``i`` alone, so the rows of a study are bit for bit the same computed
-in one piece, in chunks of any size, or on any dask worker (:class:`MonteCarloStudy` is a
-:class:`~tcsim.analysis.chunked.ChunkedStudy`).
+**Reproducible whatever the chunking.** Case ``i`` draws its random parameters, in the order the
+file lists them, from its own generator ``numpy.random.Generator(PCG64(SeedSequence([seed, i])))``,
+and takes the grid values of grid point ``i // runs`` (the grid parameters a full factorial, the
+first of the file varying slowest; a grid takes nothing from the generator, so a file without a
+grid draws as before grids existed): its values depend on the seed and ``i`` alone, so the rows of
+a study are bit for bit the same computed in one piece, in chunks of any size, or on any dask worker
+(:class:`MonteCarloStudy` is a :class:`~tcsim.analysis.chunked.ChunkedStudy`).
 
 **A case.** The converter (when a ``converter.*`` parameter is drawn) and the vehicle (when a
 ``vehicle.*`` one is) are rebuilt with the drawn values and validated as files are; every model
@@ -16,8 +19,8 @@ the dip and recovery against the ``table`` run of the same case) gives the outpu
 converter or vehicle checks refuse (a combination of drawn values), or a model's run that fails,
 keeps its rows with NaN outputs and the one-line reason in ``error``.
 
-**Rows** (:meth:`MonteCarloStudy.columns`): ``case`` (int), ``model``, each drawn parameter (named by
-its key, ``vehicle.body.mass_kg``), each output (float; ``shift_count`` too, for NaN), ``error``
+**Rows** (:meth:`MonteCarloStudy.columns`): ``case`` (int), ``model``, each parameter, drawn or swept
+(named by its key, ``vehicle.body.mass_kg``), each output (float; ``shift_count`` too, for NaN), ``error``
 (empty when the run finished); one row per case and model, cases in order, models in the study's order.
 """
 
@@ -37,6 +40,7 @@ from ..errors import InputError
 from ..models.converter import Converter
 from ..models.dynamic import DynamicModel, dynamic_model
 from ..models.study_file import (
+    Grid,
     Lognormal,
     Normal,
     Parameter,
@@ -105,12 +109,35 @@ def draw(distribution: Normal | Uniform | Lognormal | TruncatedNormal, rng: np.r
     return _truncated_normal(distribution, float(rng.random()))
 
 
-def draw_cases(parameters: Sequence[Parameter], seed: int, start: int, stop: int) -> np.ndarray:
-    """The drawn values of the cases ``start`` to ``stop`` (exclusive): shape (cases, parameters)."""
+def grid_values(parameters: Sequence[Parameter], point: int) -> dict[int, float]:
+    """The values of grid point ``point`` by the index of each grid parameter in ``parameters``: the
+    full factorial of the grids, the first grid parameter varying slowest."""
+    out: dict[int, float] = {}
+    for j in reversed(range(len(parameters))):
+        grid = parameters[j].distribution
+        if isinstance(grid, Grid):
+            point, k = divmod(point, len(grid))
+            out[j] = grid.value(k)
+    return out
+
+
+def grid_points(parameters: Sequence[Parameter]) -> int:
+    """The number of grid points of ``parameters`` (1 without a grid)."""
+    return math.prod(len(p.distribution) for p in parameters if isinstance(p.distribution, Grid))
+
+
+def draw_cases(parameters: Sequence[Parameter], seed: int, start: int, stop: int, runs: int = 1) -> np.ndarray:
+    """The values of the cases ``start`` to ``stop`` (exclusive), ``runs`` cases per grid point:
+    shape (cases, parameters); a grid parameter's values those of point ``i // runs``, the others
+    drawn in order from :func:`case_generator` ``(seed, i)``."""
     out = np.empty((max(stop - start, 0), len(parameters)))
+    random = [j for j, p in enumerate(parameters) if not isinstance(p.distribution, Grid)]
     for row, i in enumerate(range(start, stop)):
         rng = case_generator(seed, i)
-        out[row] = [draw(p.distribution, rng) for p in parameters]
+        for j in random:
+            out[row, j] = draw(parameters[j].distribution, rng)  # type: ignore[arg-type]
+        for j, v in grid_values(parameters, i // runs).items():
+            out[row, j] = v
     return out
 
 
@@ -127,9 +154,9 @@ class _Case:
 @dataclass(frozen=True)
 class MonteCarloStudy:
     """A Monte Carlo launch study as plain, picklable data (:class:`~tcsim.analysis.chunked.ChunkedStudy`):
-    the converter's and vehicle's TOML data and files, the scenario's name, the models, the number
-    of cases, the seed, the outputs and the drawn parameters. ``threads``: core workers of each
-    call (0: all cores); it does not change the rows."""
+    the converter's and vehicle's TOML data and files, the scenario's name, the models, the runs per
+    grid point (:attr:`n_cases` in all), the seed, the outputs and the parameters (drawn or swept).
+    ``threads``: core workers of each call (0: all cores); it does not change the rows."""
 
     converter_path: str
     converter_toml: dict[str, Any]
@@ -146,7 +173,8 @@ class MonteCarloStudy:
 
     @property
     def n_cases(self) -> int:
-        return self.runs
+        """Grid points × runs."""
+        return grid_points(self.parameters) * self.runs
 
     @property
     def columns(self) -> tuple[str, ...]:
@@ -162,7 +190,9 @@ class MonteCarloStudy:
             "runs": self.runs,
             "seed": self.seed,
             "outputs": list(self.outputs),
-            "distributions": [{"parameter": p.key, **p.distribution.model_dump()} for p in self.parameters],
+            "distributions": [
+                {"parameter": p.key, **p.distribution.model_dump(exclude_none=p.is_grid)} for p in self.parameters
+            ],
         }
 
     def __getstate__(self) -> dict[str, Any]:
@@ -193,7 +223,7 @@ class MonteCarloStudy:
 
     def rows(self, start: int, stop: int) -> pd.DataFrame:
         """The rows of the cases ``start`` to ``stop`` (exclusive): see the module's docstring."""
-        values = draw_cases(self.parameters, self.seed, start, stop)
+        values = draw_cases(self.parameters, self.seed, start, stop, self.runs)
         cases = [self._case(start + k, values[k]) for k in range(len(values))]
         runs = _run_cases(cases, SCENARIOS[self.scenario](), self.threads)
         release = SCENARIOS[self.scenario]().brake_release_time_s
@@ -277,7 +307,7 @@ def monte_carlo_study(file: StudyFile, threads: int = 0) -> MonteCarloStudy:
         vehicle_toml=file.vehicle.to_toml_dict(),
         scenario=file.doc.scenario,
         models=file.models,
-        runs=file.doc.runs,
+        runs=file.doc.n_runs,
         seed=file.doc.seed,
         outputs=tuple(dict.fromkeys(file.doc.outputs)),
         parameters=file.parameters,
@@ -307,6 +337,8 @@ __all__ = [
     "case_generator",
     "draw",
     "draw_cases",
+    "grid_points",
+    "grid_values",
     "monte_carlo_study",
     "run_monte_carlo",
 ]

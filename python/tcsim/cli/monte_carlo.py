@@ -85,12 +85,18 @@ def monte_carlo(
         check_scheduler(scheduler, workers)
         refuse_format_with_shards(file_format)
     sf = load_study_file(file)
-    if chunk_size is None and sf.doc.runs > MAX_RUNS_UNCHUNKED:
-        expected = f"at most {MAX_RUNS_UNCHUNKED} without --chunk-size (more: --chunk-size streams them to shards)"
-        raise InputError(file, "runs", sf.doc.runs, expected)
+    if chunk_size is None and sf.doc.n_cases > MAX_RUNS_UNCHUNKED:
+        more = "more: --chunk-size streams them to shards"
+        grid = sf.doc.grid_points > 1
+        expected = f"at most {MAX_RUNS_UNCHUNKED}{' cases' if grid else ''} without --chunk-size ("
+        expected += f"{sf.doc.cases_text()}; {more})" if grid else f"{more})"
+        raise InputError(file, "runs", sf.doc.n_runs, expected)
     study = monte_carlo_study(sf)
     inputs = [file, sf.vehicle.path, sf.converter.path]
-    head = f"{sf.name}: {study.n_cases} cases × {len(study.models)} models ({', '.join(study.models)})"
+    cases = f"{study.n_cases} cases"
+    if sf.doc.grid_points > 1:
+        cases += f" ({sf.doc.grid_points} grid points" + (f" × {sf.doc.n_runs} runs)" if sf.doc.n_runs > 1 else ")")
+    head = f"{sf.name}: {cases} × {len(study.models)} models ({', '.join(study.models)})"
     if chunk_size is not None:
         run = run_sharded(study, out, chunk_size, tf.speed_unit, scheduler, workers, inputs, not no_progress)
         say(f"{head}, {run.rows} rows in {shards_line(run)}")

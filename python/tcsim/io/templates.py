@@ -487,7 +487,9 @@ def monte_carlo_template(out_name: str) -> Template:
     doc.key("converter", vehicle.converter_spec, commented=True)
     doc.key("scenario", "flip-flop", "flip-flop (full pedal, to 100 km/h) | part-pedal (pedal 0.3, to 50 km/h)")
     doc.key("models", list(vehicle.converter.models), "launched in each case; the dip is against the table run")
-    doc.key("runs", TEMPLATE_RUNS, "cases; run with --chunk-size N for many (resumable Parquet shards)")
+    doc.key(
+        "runs", TEMPLATE_RUNS, "cases (per grid point); run with --chunk-size N for many (resumable Parquet shards)"
+    )
     doc.key("seed", 1, "the same file and seed give the same cases bit for bit, however the study is chunked")
     outputs = ["time_0_50_km_h_s", "time_0_100_km_h_s", "effective_torque_ratio_dip_first_0_5_s"]
     doc.key("outputs", outputs, "launch summary columns kept per case and model (docs/launch_summary.md)")
@@ -495,7 +497,8 @@ def monte_carlo_template(out_name: str) -> Template:
         "distributions",
         "parameter as the file writes it (converter.<section>.<key>, vehicle.<section>.<key>) = normal "
         "{mean, std} | uniform {low, high} | lognormal {mean, std of the value itself} | truncated-normal "
-        "{mean, std, low, high}; the means below are the bundled values",
+        "{mean, std, low, high} | grid {values} or {start, stop, num} (swept: the grids a full factorial, "
+        "runs cases per grid point); the means below are the bundled values",
     )
     for key, kind, spread in TEMPLATE_DISTRIBUTIONS:
         target, section, name = key.split(".")

@@ -7,7 +7,8 @@ of the documentation site is generated from it). A ``[distributions]`` key names
 converter or vehicle file writes it, prefixed by the file: ``converter.<section>.<key>`` (a number
 of ``[inertia]``, ``[geometry]`` or ``[quasi_dynamic]``, or ``converter.characteristic.lag_time_constant_s``)
 or ``vehicle.<section>.<key>`` (a real number of a vehicle section; not an array element). Its
-value is one of :class:`Normal`, :class:`Uniform`, :class:`Lognormal`, :class:`TruncatedNormal`.
+value is one of :class:`Normal`, :class:`Uniform`, :class:`Lognormal`, :class:`TruncatedNormal`
+(drawn at random), or :class:`Grid` (swept).
 
 **The support is checked, not the samples.** Before anything runs, the converter (or vehicle) is
 built with the parameter at each end of its distribution's support (an open end: the nearest
@@ -16,8 +17,15 @@ validated by the converter's schema or the core's vehicle checks, the one owners
 distribution whose support reaches a refused value is an :class:`~tcsim.errors.InputError` naming
 the study file, the distribution and the value refused: a ``normal`` on a positive quantity is
 refused (its support is every real number), a ``truncated-normal`` or ``lognormal`` is not.
-Constraints between parameters (the core's geometry checks) can still refuse a drawn case; that
-case's rows carry the reason in ``error`` and the study goes on.
+A grid's every value is checked the same way. Constraints between parameters (the core's geometry
+checks) can still refuse a drawn case; that case's rows carry the reason in ``error`` and the study
+goes on.
+
+**Grids.** The grid parameters form a full factorial, the first grid parameter of the file varying
+slowest; each grid point is run ``runs`` times with the random parameters drawn, so a study has
+(grid points × ``runs``) cases, at most :data:`MAX_RUNS` (10⁷; :data:`MAX_RUNS_UNCHUNKED`, 10⁵, without
+``--chunk-size``). ``runs`` is required when a parameter is drawn at random; when every parameter
+is a grid it may be omitted and may only be 1 (the runs of a grid point would be the same case).
 """
 
 from __future__ import annotations
@@ -48,7 +56,22 @@ CONVERTER_SECTIONS = ("inertia", "geometry", "quasi_dynamic")
 CHARACTERISTIC_KEYS = ("lag_time_constant_s",)
 #: The smallest probability of a truncated normal's interval (below it the bounds are a mistake).
 MIN_TRUNCATED_MASS = 1e-9
+#: The most values of one grid parameter (each is built and checked before the study runs).
+MAX_GRID_POINTS = 100_000
 _FINITE = Field(allow_inf_nan=False)
+#: The ``kind`` of each distribution (:data:`Distribution`).
+KINDS = ("normal", "uniform", "lognormal", "truncated-normal", "grid")
+
+
+class FieldError(ValueError):
+    """A validator's error naming its field below the model validated (``loc``, e.g. ``("start",)``)
+    and the value refused: the study file's error names that field, not the whole table."""
+
+    def __init__(self, loc: tuple[str | int, ...], value: Any, expected: str):
+        super().__init__(expected)
+        self.loc = loc
+        self.value = value
+        self.expected = expected
 
 
 class _Strict(BaseModel):
@@ -132,14 +155,87 @@ class TruncatedNormal(_Strict):
         return self.low, self.high, False
 
 
+class Grid(_Strict):
+    """``{ kind = "grid", values }`` or ``{ kind = "grid", start, stop, num }``: swept, not drawn (the
+    grids of a file form a full factorial, each point run ``runs`` times). ``values``: distinct finite
+    numbers, run in the order given; ``start, stop, num``: ``num`` values evenly spaced from
+    ``start`` to ``stop``, both included (value ``k`` is ``start + k·(stop − start)/(num − 1)``, the
+    last exactly ``stop``, as ``numpy.linspace``; ``num = 1``: ``start`` alone). Exactly one of the
+    two forms."""
+
+    kind: Literal["grid"]
+    values: list[Annotated[float, Field(allow_inf_nan=False)]] | None = None
+    start: float | None = Field(default=None, allow_inf_nan=False)
+    stop: float | None = Field(default=None, allow_inf_nan=False)
+    num: int | None = Field(default=None, ge=1, le=MAX_GRID_POINTS)
+
+    @model_validator(mode="after")
+    def _one_form(self):
+        if self.values is not None:
+            extra = next((k for k in ("start", "stop", "num") if getattr(self, k) is not None), None)
+            if extra is not None:
+                raise FieldError((extra,), getattr(self, extra), "values or start, stop and num, not both")
+            if not self.values:
+                raise FieldError(("values",), [], "at least one value")
+            if len(self.values) > MAX_GRID_POINTS:
+                raise FieldError(("values",), f"{len(self.values)} values", f"at most {MAX_GRID_POINTS} values")
+            seen: set[float] = set()
+            for j, v in enumerate(self.values):
+                if v in seen:
+                    raise FieldError(("values", j), v, "distinct values (this one is given twice)")
+                seen.add(v)
+            return self
+        missing = [k for k in ("start", "stop", "num") if getattr(self, k) is None]
+        if len(missing) == 3:
+            raise FieldError(("values",), "missing", "values, or start, stop and num (one of the two forms)")
+        if missing:
+            raise FieldError((missing[0],), "missing", "start, stop and num together (or values alone)")
+        assert self.start is not None and self.stop is not None and self.num is not None
+        if self.num > 1 and self.start == self.stop:
+            raise FieldError(("stop",), self.stop, f"a stop other than start ({self.start:g}) when num > 1")
+        if self.num > 1 and not math.isfinite(self.stop - self.start):
+            raise FieldError(("stop",), self.stop, "stop − start a finite number")
+        if len(set(self.points())) < self.num:  # rounding: start and stop too close for num values
+            expected = f"at most as many values as distinct numbers lie from {self.start!r} to {self.stop!r}"
+            raise FieldError(("num",), self.num, expected)
+        return self
+
+    def __len__(self) -> int:
+        """The number of values."""
+        return len(self.values) if self.values is not None else int(self.num or 0)
+
+    def value(self, k: int) -> float:
+        """Value ``k`` (0 ≤ k < len) of the grid."""
+        if self.values is not None:
+            return self.values[k]
+        assert self.start is not None and self.stop is not None and self.num is not None
+        if k == self.num - 1 and self.num > 1:
+            return self.stop
+        if k == 0:
+            return self.start
+        return k * ((self.stop - self.start) / (self.num - 1)) + self.start
+
+    def points(self) -> list[float]:
+        """Every value of the grid, in order."""
+        return [self.value(k) for k in range(len(self))]
+
+    def support(self) -> tuple[float, float, bool]:
+        points = self.points()
+        return min(points), max(points), False
+
+
 def describe(distribution: BaseModel) -> str:
-    """``normal(mean=1900, std=50)``: a distribution as one short text."""
-    values = distribution.model_dump()
+    """``normal(mean=1900, std=50)``, ``grid(values=[0, 0.001])``: a distribution as one short text."""
+    values = distribution.model_dump(exclude_none=True)
     kind = values.pop("kind")
-    return f"{kind}(" + ", ".join(f"{k}={v:g}" for k, v in values.items()) + ")"
+
+    def show(v: Any) -> str:
+        return "[" + ", ".join(f"{x:g}" for x in v) + "]" if isinstance(v, list) else f"{v:g}"
+
+    return f"{kind}(" + ", ".join(f"{k}={show(v)}" for k, v in values.items()) + ")"
 
 
-Distribution = Annotated[Normal | Uniform | Lognormal | TruncatedNormal, Field(discriminator="kind")]
+Distribution = Annotated[Normal | Uniform | Lognormal | TruncatedNormal | Grid, Field(discriminator="kind")]
 
 
 class MonteCarloFile(BaseModel):
@@ -158,8 +254,9 @@ class MonteCarloFile(BaseModel):
     scenario: Literal["flip-flop", "part-pedal"] = "flip-flop"
     #: The converter models run in each case (default: every model the converter supports).
     models: list[Literal["table", "hrovat-tobler", "quasi-dynamic"]] | None = Field(default=None, min_length=1)
-    #: Cases (launches of every model), each drawn from the seed and its index alone.
-    runs: int = Field(ge=1, le=MAX_RUNS)
+    #: Cases (launches of every model) per grid point, each drawn from the seed and its index alone;
+    #: required when a parameter is drawn at random, else at most 1 (default 1).
+    runs: int | None = Field(default=None, ge=1, le=MAX_RUNS)
     #: The random seed: the same file and seed give the same cases bit for bit, however the study is chunked.
     seed: int = Field(ge=0, le=2**63 - 1)
     #: Launch summary columns (docs/launch_summary.md) kept per case and model.
@@ -168,6 +265,41 @@ class MonteCarloFile(BaseModel):
     )
     #: Parameter (converter.<section>.<key> or vehicle.<section>.<key>) → its distribution (below).
     distributions: dict[str, Distribution] = Field(min_length=1)
+
+    @model_validator(mode="after")
+    def _cases(self):
+        random = [k for k, d in self.distributions.items() if not isinstance(d, Grid)]
+        if self.runs is None and random:
+            raise FieldError(
+                ("runs",), "missing", f"this key: {random[0]} is drawn at random (a grid alone may omit it)"
+            )
+        if self.runs is not None and self.runs > 1 and not random:
+            expected = "1 or no runs when every parameter is a grid (the runs of a grid point would be the same case)"
+            raise FieldError(("runs",), self.runs, expected)
+        if self.n_cases > MAX_RUNS:
+            raise FieldError(("runs",), self.n_runs, f"at most {MAX_RUNS} cases: {self.cases_text()}")
+        return self
+
+    @property
+    def n_runs(self) -> int:
+        """The runs per grid point (``runs``, 1 when omitted)."""
+        return 1 if self.runs is None else self.runs
+
+    @property
+    def grid_points(self) -> int:
+        """The number of grid points (1 without a grid)."""
+        return math.prod(len(d) for d in self.distributions.values() if isinstance(d, Grid))
+
+    @property
+    def n_cases(self) -> int:
+        """The study's cases: grid points × runs."""
+        return self.grid_points * self.n_runs
+
+    def cases_text(self) -> str:
+        """``3 × 4 grid points × 10 runs = 120 cases``."""
+        sizes = " × ".join(str(len(d)) for d in self.distributions.values() if isinstance(d, Grid))
+        runs = f"{self.n_runs} run{'s' if self.n_runs > 1 else ''}"
+        return f"{sizes} grid points × {runs} = {self.n_cases} cases"
 
 
 @dataclass(frozen=True)
@@ -179,7 +311,11 @@ class Parameter:
     target: str
     section: str
     name: str
-    distribution: Normal | Uniform | Lognormal | TruncatedNormal
+    distribution: Normal | Uniform | Lognormal | TruncatedNormal | Grid
+
+    @property
+    def is_grid(self) -> bool:
+        return isinstance(self.distribution, Grid)
 
 
 @dataclass(frozen=True)
@@ -210,14 +346,19 @@ def _flatten(table: Any, prefix: str = "") -> dict[str, Any]:
 
 
 def _field_name(loc: tuple[Any, ...]) -> str:
-    parts = [str(x) for x in loc if x not in ("normal", "uniform", "lognormal", "truncated-normal")]
+    parts = [x for x in loc if x not in KINDS]
     if len(parts) >= 2 and parts[0] == "distributions":
-        return f'distributions."{parts[1]}"' + "".join(f".{p}" for p in parts[2:])
-    return ".".join(parts) or "(file)"
+        rest = "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in parts[2:])
+        return f'distributions."{parts[1]}"' + rest
+    return ".".join(str(p) for p in parts) or "(file)"
 
 
 def _validation_error(err: ValidationError, path: str) -> InputError:
     e = err.errors()[0]
+    cause = e.get("ctx", {}).get("error")
+    if isinstance(cause, FieldError):  # a validator naming its field
+        field = _field_name((*tuple(e["loc"]), *cause.loc))
+        return InputError(path, field, cause.value, cause.expected)
     field = _field_name(tuple(e["loc"]))
     value = e.get("input", "")
     msg = e["msg"].removeprefix("Input should be ").removeprefix("Value error, ")
@@ -227,7 +368,7 @@ def _validation_error(err: ValidationError, path: str) -> InputError:
         value, msg = "missing", "this required key"
     elif e["type"] in ("union_tag_invalid", "union_tag_not_found"):
         value = value.get("kind", "missing") if isinstance(value, dict) else value
-        field, msg = f"{field}.kind", "one of 'normal', 'uniform', 'lognormal', 'truncated-normal'"
+        field, msg = f"{field}.kind", "one of " + ", ".join(f"'{k}'" for k in KINDS)
     if isinstance(value, dict | list) and len(str(value)) > 60:
         value = f"{type(value).__name__} of {len(value)}"
     return InputError(path, field, value, msg)
@@ -350,16 +491,44 @@ def _probes(dist: Any) -> list[float]:
     return [lo, hi]
 
 
+def _refusal(p: Parameter, value: float, converter: Converter, vehicle: Vehicle) -> InputError | None:
+    """Why the converter or vehicle is refused with ``p`` at ``value`` (the rest as the files have it), or None."""
+    try:
+        values = {(p.section, p.name): value}
+        if p.target == "converter":
+            build_converter(converter_data(converter.to_toml_dict(), values), converter.path)
+        else:
+            build_vehicle(vehicle_data(vehicle.to_toml_dict(), values), vehicle.path, converter)
+    except InputError as e:
+        return e
+    return None
+
+
+def _check_grid(p: Parameter, grid: Grid, path: str, converter: Converter, vehicle: Vehicle) -> None:
+    """Refuse ``p`` if the converter or vehicle is refused at any value of its grid."""
+    for k, value in enumerate(grid.points()):
+        e = _refusal(p, value, converter, vehicle)
+        if e is None:
+            continue
+        if grid.values is not None:
+            expected = f"a value within the valid range of {p.key}: {e.field}: expected {e.expected}"
+            raise InputError(path, f'distributions."{p.key}".values[{k}]', value, expected)
+        expected = (
+            f"a grid whose values lie within the valid range of {p.key}: "
+            f"at value {k} ({value:.6g}), {e.field}: expected {e.expected}"
+        )
+        raise InputError(path, f'distributions."{p.key}"', describe(grid), expected)
+
+
 def _check_support(p: Parameter, path: str, converter: Converter, vehicle: Vehicle) -> None:
-    """Refuse ``p`` if the converter or vehicle is refused at an end of its distribution's support."""
+    """Refuse ``p`` if the converter or vehicle is refused at an end of its distribution's support
+    (a grid: at any of its values)."""
+    if isinstance(p.distribution, Grid):
+        _check_grid(p, p.distribution, path, converter, vehicle)
+        return
     for value in _probes(p.distribution):
-        try:
-            values = {(p.section, p.name): value}
-            if p.target == "converter":
-                build_converter(converter_data(converter.to_toml_dict(), values), converter.path)
-            else:
-                build_vehicle(vehicle_data(vehicle.to_toml_dict(), values), vehicle.path, converter)
-        except InputError as e:
+        e = _refusal(p, value, converter, vehicle)
+        if e is not None:
             low, high, is_open = p.distribution.support()
             support = f"{'(' if is_open else '['}{low:g}, {high:g}{')' if is_open else ']'}"
             hint = " (a truncated-normal bounds a normal)" if isinstance(p.distribution, Normal) else ""
