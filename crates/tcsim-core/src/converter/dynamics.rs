@@ -386,7 +386,7 @@ impl HtDynamics {
 
     /// `ρ L_f / A`, the fluid's own inertance.
     pub fn fluid_inertance(&self) -> f64 {
-        self.mass_matrix_bound().inertance_kg_m4
+        inertance_kg_m4(&self.geometry, self.fluid_length_m)
     }
 
     /// The admissibility of the mass matrix with these parameters.
@@ -499,7 +499,7 @@ impl MassMatrixBound {
         MassMatrixBound {
             density_kg_m3: rho,
             inertia_kg_m2: inertia,
-            inertance_kg_m4: rho * fluid_length_m / geometry.get(HtParam::FlowArea),
+            inertance_kg_m4: inertance_kg_m4(geometry, fluid_length_m),
             shape_terms_kg_m4: std::array::from_fn(|i| rho * rho * shape_effect_m2[i].powi(2) / inertia[i]),
         }
     }
@@ -539,6 +539,11 @@ impl MassMatrixBound {
 }
 
 /// Shock velocities of eqs 2.20–2.22 at speeds ω and q = Q/A.
+/// `ρ L_f / A`, kg/m⁴: the fluid's own inertance (the mass matrix's flow diagonal, eq. 2.14).
+fn inertance_kg_m4(geometry: &HtGeometry<f64>, fluid_length_m: f64) -> f64 {
+    geometry.get(HtParam::FluidDensity) * fluid_length_m / geometry.get(HtParam::FlowArea)
+}
+
 fn shock_velocities(k: &HtConst, w: &[f64; 3], q: f64) -> [f64; 3] {
     [k.r[2] * (w[2] - w[0]) + q * k.b[0], k.r[0] * (w[0] - w[1]) + q * k.b[1], k.r[1] * (w[1] - w[2]) + q * k.b[2]]
 }
