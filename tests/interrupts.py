@@ -15,7 +15,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import pytest
@@ -94,3 +94,19 @@ def _interrupt_once(
         assert p.returncode == 0, (p.returncode, err)
         return None
     return subprocess.CompletedProcess(p.args, p.returncode, stdout, err)
+
+
+class ClientStopped(Exception):
+    """Raised from a sharded study's ``on_chunk`` hook: the client stops mid-study as if killed."""
+
+
+def stop_after(n: int, written: list[int]) -> Callable[[int], None]:
+    """An ``on_chunk`` hook that records each chunk written in ``written`` and stops the client
+    (:class:`ClientStopped`) after the ``n``-th."""
+
+    def hook(index: int) -> None:
+        written.append(index)
+        if len(written) == n:
+            raise ClientStopped
+
+    return hook

@@ -21,6 +21,7 @@ import pytest
 from scipy import stats
 
 import tcsim.analysis.monte_carlo as mc
+from interrupts import ClientStopped, stop_after
 from tcsim.analysis.monte_carlo import draw_cases, monte_carlo_study, run_monte_carlo
 from tcsim.errors import InputError
 from tcsim.io.shards import MANIFEST, SHARDS, read_shards, run_to_shards, shard_name
@@ -333,21 +334,11 @@ def test_a_study_file_changed_between_runs_is_refused(cli, tmp_path):
     assert snapshot(out) == before
 
 
-class ClientStopped(Exception):
-    """Raised from the hook: the client stops mid-study as if killed."""
-
-
 def test_a_study_whose_client_stops_resumes_without_recomputing(tmp_path, study, unchunked):
     out = tmp_path / "s"
     written: list[int] = []
-
-    def hook(index: int) -> None:
-        written.append(index)
-        if len(written) == 2:
-            raise ClientStopped
-
     with pytest.raises(ClientStopped):
-        run_to_shards(study, out, 4, on_chunk=hook)
+        run_to_shards(study, out, 4, on_chunk=stop_after(2, written))
     assert sorted(int(i) for i in listed(out)) == written == [0, 1]
     run = run_to_shards(study, out, 4)
     assert run.kept == [0, 1] and run.computed == [2, 3]

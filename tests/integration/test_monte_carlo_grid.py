@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 import pytest
 
+from interrupts import ClientStopped, stop_after
 from tcsim.analysis.monte_carlo import case_generator, draw, draw_cases, monte_carlo_study, run_monte_carlo
 from tcsim.errors import InputError
 from tcsim.io.shards import MANIFEST, read_shards, run_to_shards
@@ -288,21 +289,11 @@ def test_more_grid_cases_than_fit_in_memory_need_chunks(cli, tmp_path):
 # the command line: a sharded shape-effect sweep, resumed
 
 
-class ClientStopped(Exception):
-    """Raised from the hook: the client stops mid-study as if killed."""
-
-
 def test_a_sharded_shape_effect_sweep_from_the_command_line_resumes(cli, tmp_path, grid_path, study, unchunked):
     out = tmp_path / "s"
     written: list[int] = []
-
-    def hook(index: int) -> None:
-        written.append(index)
-        if len(written) == 2:
-            raise ClientStopped
-
     with pytest.raises(ClientStopped):
-        run_to_shards(study, out, 4, on_chunk=hook)
+        run_to_shards(study, out, 4, on_chunk=stop_after(2, written))
     assert (out / MANIFEST).is_file()
     r = cli("monte-carlo", grid_path, "--out", out, "--chunk-size", "4", "--no-progress")
     assert r.code == 0, r.stderr

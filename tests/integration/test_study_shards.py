@@ -17,6 +17,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
+from interrupts import ClientStopped
 from tcsim.analysis.chunked import appendix_d_study
 from tcsim.analysis.study import COLUMNS, default_definition, run_study
 from tcsim.io.shards import MANIFEST, SHARDS, read_shards, run_to_shards, shard_name
@@ -237,10 +238,6 @@ def test_an_interrupted_study_keeps_its_finished_shards_and_resumes(tmp_path, si
 
 # --------------------------------------------------------------------------------------------
 # on a dask cluster (the optional extra tcsim[dask])
-
-
-class ClientStopped(Exception):
-    """Raised from the hook: the client stops mid-study as if killed."""
 
 
 @pytest.mark.subprocess
