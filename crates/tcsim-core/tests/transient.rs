@@ -483,3 +483,29 @@ fn a_standstill_rounded_below_zero_starts_like_zero() {
     let refused = start(-1e-6).err().map(|e| e.to_string()).unwrap_or_default();
     assert!(refused.contains("a turbine speed of zero or more"), "{refused}");
 }
+
+#[test]
+fn a_pulse_after_a_steady_phase_is_not_stepped_over() {
+    // Drive (a), the turbine held at 100 rad/s: 5 s at a steady 40 N·m, then a pump torque pulse
+    // to 250 N·m over 5.00–5.15 s. Before the steps ended on the drive's time stamps, a step grown
+    // over the steady phase passed the whole pulse and the pump speed stayed at its steady 129.6
+    // rad/s, whatever the output times.
+    let t = [0.0, 5.0, 5.05, 5.10, 5.15, 12.0];
+    let drive = Drive::PumpTorqueTurbineSpeed {
+        pump_torque_nm: Signal::new("pump_torque_nm", t.to_vec(), vec![40.0, 40.0, 250.0, 250.0, 40.0, 40.0], 0.0)
+            .unwrap(),
+        turbine_speed_rad_s: Signal::constant(100.0),
+        lockup: None,
+    };
+    let models: [(&str, Box<dyn ConverterDynamics>); 2] =
+        [("hrovat-tobler", Box::new(ht_fitted(SHAPE))), ("table", Box::new(table()))];
+    for (name, model) in models {
+        let (traj, cols) = run(model.as_ref(), &drive, &[0.0, 4.0, 5.1, 5.2, 6.0, 12.0], InitialState::default());
+        let w = col(&cols, "pump_speed_rad_s");
+        assert!((w[1] - w[0]).abs() < 1e-6 * w[0], "{name}: steady before the pulse: {w:?}");
+        // 210 N·m more for about 0.1 s on a pump of 0.109 kg·m²: well over 100 rad/s faster
+        assert!(w[2] > w[1] + 80.0, "{name}: the pulse was stepped over: {w:?}");
+        assert!((w[5] - w[0]).abs() < 1e-3 * w[0], "{name}: back to the steady speed: {w:?}");
+        assert!(traj.steps > 0);
+    }
+}

@@ -449,11 +449,12 @@ pub fn simulate_from(
     crate::engine::options::try_reserve(&mut traj.samples, times_s.len())?;
     let (mut t, mut u, mut mode) = (times_s[0], u0, mode0);
     let mut lock_energy_j = (0.0, 0.0);
+    let stops = drive.breakpoints();
     loop {
         let mut seg = Segment::new(model, drive, mode);
         seg.lock_energy_j = lock_energy_j;
         let integrated = t < t_end;
-        match run_segment(&seg, &u, t, t_end, times_s, options, &mut traj)? {
+        match run_segment(&seg, &u, t, t_end, &stops, times_s, options, &mut traj)? {
             None => {
                 if traj.samples.len() < times_s.len() {
                     let t_last = traj.samples.last().map_or(times_s[0], |s| s.time_s);
@@ -499,15 +500,19 @@ pub fn simulate_from(
     }
 }
 
-/// Integrate one segment (see [`crate::engine::segment::run_segment`]).
+/// Integrate one segment, its steps ending on `stops` (see
+/// [`crate::engine::segment::run_segment_with_stops`]).
+#[allow(clippy::too_many_arguments)]
 fn run_segment(
     seg: &Segment,
     u0: &Vec4,
     t0: f64,
     t_end: f64,
+    stops: &[f64],
     times_s: &[f64],
     o: &SolverOptions,
     traj: &mut Trajectory,
 ) -> TransientResult<Option<(f64, Root, Vec<f64>)>> {
-    crate::engine::segment::run_segment(seg, seg.state(u0), t0, t_end, times_s, o, &mut traj.samples, &mut traj.steps)
+    let (samples, steps) = (&mut traj.samples, &mut traj.steps);
+    crate::engine::segment::run_segment_with_stops(seg, seg.state(u0), t0, t_end, stops, times_s, o, samples, steps)
 }
