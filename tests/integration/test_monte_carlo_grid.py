@@ -83,14 +83,17 @@ def test_a_two_parameter_grid_times_runs_is_a_full_factorial_the_first_parameter
     assert qd["effective_torque_ratio_dip_first_0_5_s"].nunique() == N_CASES
 
 
-def test_the_drawn_parameters_of_case_i_come_from_seed_and_i_as_without_a_grid(study):
-    """A grid takes nothing from the case's generator: the mass of case i is the first draw of
-    (seed, i), the same as a study drawing the mass alone."""
+def test_every_grid_point_sees_the_same_draws(study):
+    """Common random numbers: the mass of case i is the first draw of (seed, i % runs), so run r of
+    every grid point has the same mass (trial finding: with a draw per case, the sampling noise of
+    the mass was twice the effect of the swept shape effects); a grid takes nothing from the
+    generator."""
     values = draw_cases(study.parameters, study.seed, 0, N_CASES, study.runs)
     mass = Uniform(kind="uniform", low=1800.0, high=2000.0)
-    expected = [draw(mass, case_generator(11, i)) for i in range(N_CASES)]
+    expected = [draw(mass, case_generator(11, i % study.runs)) for i in range(N_CASES)]
     assert values[:, 2].tolist() == expected
-    assert len(set(expected)) == N_CASES  # the runs of a grid point are different draws
+    per_point = values[:, 2].reshape(-1, study.runs)
+    assert (per_point == per_point[0]).all() and len(set(per_point[0])) == study.runs
 
 
 def test_a_case_has_the_same_values_whatever_the_range_it_is_drawn_in(study):
@@ -321,3 +324,19 @@ def test_the_docs_shape_effect_sweep_is_a_valid_study_file(tmp_path):
     sf = load_study_file(write(tmp_path / "shape-sweep.toml", text))
     assert [p.key for p in sf.parameters] == [PUMP, TURBINE]
     assert sf.doc.grid_points == sf.doc.n_cases == 20 and sf.doc.n_runs == 1
+
+
+@pytest.mark.parametrize("bare_first", [False, True])
+def test_a_parameter_written_quoted_and_bare_is_given_twice(cli, tmp_path, bare_first):
+    """Trial finding: TOML reads ``"a.b.c" = …`` and ``a.b.c = …`` as two keys; flattened to one
+    parameter, the later silently replaced the earlier and a 2-point sweep ran as 1 point."""
+    quoted = f'"{PUMP}" = {{ kind = "grid", values = [0.1, 0.2] }}\n'
+    bare = f'{PUMP} = {{ kind = "grid", values = [0.3] }}\n'
+    body = bare + quoted if bare_first else quoted + bare
+    path = write(tmp_path / "s.toml", f"{BASE}[distributions]\n{body}")
+    with pytest.raises(InputError) as err:
+        load_study_file(path)
+    assert err.value.field == f'distributions."{PUMP}"' and "given twice" in err.value.expected
+    r = cli("monte-carlo", path, "--out", tmp_path / "o")
+    assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1 and "given twice" in r.stderr, r.stderr
+    assert not (tmp_path / "o").exists()

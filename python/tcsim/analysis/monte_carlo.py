@@ -4,7 +4,8 @@ and vehicle parameters drawn from the study file's distributions or swept over i
 (:mod:`tcsim.models.study_file`).
 
 **Reproducible whatever the chunking.** Case ``i`` draws its random parameters, in the order the
-file lists them, from its own generator ``numpy.random.Generator(PCG64(SeedSequence([seed, i])))``,
+file lists them, from its own generator ``numpy.random.Generator(PCG64(SeedSequence([seed, r])))``,
+``r`` its run (``i`` without a grid, ``i % runs`` with one: every grid point sees the same draws),
 and takes the grid values of grid point ``i // runs`` (the grid parameters a full factorial, the
 first of the file varying slowest; a grid takes nothing from the generator, so a file without a
 grid draws as before grids existed): its values depend on the seed and ``i`` alone, so the rows of
@@ -129,11 +130,14 @@ def grid_points(parameters: Sequence[Parameter]) -> int:
 def draw_cases(parameters: Sequence[Parameter], seed: int, start: int, stop: int, runs: int = 1) -> np.ndarray:
     """The values of the cases ``start`` to ``stop`` (exclusive), ``runs`` cases per grid point:
     shape (cases, parameters); a grid parameter's values those of point ``i // runs``, the others
-    drawn in order from :func:`case_generator` ``(seed, i)``."""
+    drawn in order from :func:`case_generator` ``(seed, r)``, ``r`` the case's run: ``i % runs``
+    with a grid (every grid point sees the same draws, common random numbers, so that the sweep's
+    differences are the swept parameter's and not the sampling's), ``i`` without one."""
     out = np.empty((max(stop - start, 0), len(parameters)))
     random = [j for j, p in enumerate(parameters) if not isinstance(p.distribution, Grid)]
+    swept = len(random) < len(parameters)
     for row, i in enumerate(range(start, stop)):
-        rng = case_generator(seed, i)
+        rng = case_generator(seed, i % runs if swept else i)
         for j in random:
             out[row, j] = draw(parameters[j].distribution, rng)  # type: ignore[arg-type]
         for j, v in grid_values(parameters, i // runs).items():
@@ -181,8 +185,10 @@ class MonteCarloStudy:
         return ("case", "model", *(p.key for p in self.parameters), *self.outputs, "error")
 
     def definition(self) -> dict[str, Any]:
-        """Everything the rows depend on (the study file's name and description do not)."""
-        return {
+        """Everything the rows depend on (the study file's name and description do not). With a
+        grid, also how the runs draw (``draws``: every grid point the same), so that shards of a
+        grid study drawn otherwise are never resumed; a file without a grid is defined as before."""
+        record: dict[str, Any] = {
             "converter": {"file": self.converter_path, "toml": self.converter_toml},
             "vehicle": {"file": self.vehicle_path, "toml": self.vehicle_toml},
             "scenario": self.scenario,
@@ -194,6 +200,9 @@ class MonteCarloStudy:
                 {"parameter": p.key, **p.distribution.model_dump(exclude_none=p.is_grid)} for p in self.parameters
             ],
         }
+        if any(p.is_grid for p in self.parameters):
+            record["draws"] = "common random numbers: run r of every grid point draws from (seed, r)"
+        return record
 
     def __getstate__(self) -> dict[str, Any]:
         """Plain data only (what a dask worker receives): the converter, models and vehicle built from

@@ -334,14 +334,19 @@ class StudyFile:
         return self.doc.name or Path(self.path).stem
 
 
-def _flatten(table: Any, prefix: str = "") -> dict[str, Any]:
+def _flatten(table: Any, path: str, prefix: str = "") -> dict[str, Any]:
     """``[distributions]`` with dotted keys written bare (``vehicle.body.mass_kg = {...}`` is a
-    nested table in TOML) flattened to ``{"vehicle.body.mass_kg": {...}}``; a table with ``kind`` is a leaf."""
+    nested table in TOML) flattened to ``{"vehicle.body.mass_kg": {...}}``; a table with ``kind`` is a
+    leaf. A parameter written both quoted and bare (two TOML keys, one parameter) is an
+    :class:`InputError`: the later would silently replace the earlier."""
     if not isinstance(table, dict) or "kind" in table:
         return {prefix: table}
     out: dict[str, Any] = {}
     for k, v in table.items():
-        out.update(_flatten(v, f"{prefix}.{k}" if prefix else str(k)))
+        for key, leaf in _flatten(v, path, f"{prefix}.{k}" if prefix else str(k)).items():
+            if key in out:
+                raise InputError(path, f'distributions."{key}"', leaf, "each parameter once (it is given twice)")
+            out[key] = leaf
     return out
 
 
@@ -386,7 +391,7 @@ def read_monte_carlo_file(path: str | Path) -> MonteCarloFile:
     except tomllib.TOMLDecodeError as e:
         raise InputError(str(path), "(syntax)", str(e), "valid TOML") from None
     if isinstance(data.get("distributions"), dict):
-        data["distributions"] = _flatten(data["distributions"])
+        data["distributions"] = _flatten(data["distributions"], str(path))
     try:
         return MonteCarloFile.model_validate(data)
     except ValidationError as err:
