@@ -20,6 +20,7 @@ import pytest
 from interrupts import ClientStopped
 from tcsim.analysis.chunked import appendix_d_study
 from tcsim.analysis.study import COLUMNS, default_definition, run_study
+from tcsim.errors import InputError
 from tcsim.io.shards import MANIFEST, SHARDS, read_shards, run_to_shards, shard_name
 from tcsim.models.converter import load_converter
 from tcsim.units import RAD_S_PER_RPM
@@ -169,6 +170,33 @@ def test_a_directory_with_other_files_is_refused(cli, study_dir):
     (study_dir / "notes.txt").write_text("mine")
     err = _refused(cli, study_dir, "--chunk-size", "10", "--values-per-parameter", "3")
     assert "'notes.txt'" in err
+
+
+def test_the_shards_and_the_manifest_have_the_mode_of_any_output(study_dir):
+    """Trial finding: they were private (0600, from mkstemp), unlike every other output (the umask)."""
+    mask = os.umask(0o022)
+    os.umask(mask)
+    files = [study_dir / MANIFEST, *(study_dir / SHARDS).iterdir()]
+    assert len(files) == 7
+    for f in files:
+        assert f.stat().st_mode & 0o777 == 0o666 & ~mask, (f, oct(f.stat().st_mode))
+
+
+@pytest.mark.parametrize(
+    ("text", "expected"),
+    [
+        ("{not json", "a manifest.json that is not valid JSON"),
+        ('{"format": "something else"}', "a manifest.json that is not a tcsim study's"),
+    ],
+)
+def test_a_broken_manifest_is_named_as_such(cli, study_dir, text, expected):
+    """Trial finding: a corrupt manifest was reported as "no manifest; choose another --out", which
+    tells the user to give up the finished shards."""
+    (study_dir / MANIFEST).write_text(text)
+    err = _refused(cli, study_dir, "--chunk-size", "10", "--values-per-parameter", "3")
+    assert expected in err, err
+    with pytest.raises(InputError, match=expected.replace("'", ".")):
+        read_shards(study_dir)
 
 
 def test_a_study_another_run_is_writing_is_refused(cli, study_dir):

@@ -50,8 +50,11 @@ import pyarrow.parquet as pq
 
 from ..analysis.chunked import ChunkedStudy, check_chunk_size, check_scheduler, chunk_count, iter_chunks
 from ..errors import InputError, raise_if_interrupted
-from .outputs import _blocked, _contained_inputs, _sha256
+from .outputs import _blocked, _contained_inputs, _sha256, _umask
 from .tables import SPEED_UNITS, to_speed_unit
+
+#: The mode of a shard and of the manifest before the umask: that of any output file.
+FILE_MODE = 0o666
 
 #: The manifest of a study directory, and the folder of its shards.
 MANIFEST = "manifest.json"
@@ -107,11 +110,25 @@ def _refuse(out: Path, expected: str) -> InputError:
 
 
 def _read_manifest(out: Path) -> dict[str, Any] | None:
+    return _manifest_or_problem(out)[0]
+
+
+def _manifest_or_problem(out: Path) -> tuple[dict[str, Any] | None, str]:
+    """The study manifest in ``out``, or None and what is wrong with it: missing, unreadable (a
+    permission), not JSON or not a tcsim study's (a trial found all of them reported as missing,
+    with the advice to choose another directory: the finished shards would be given up)."""
+    path = out / MANIFEST
+    if not path.exists():
+        return None, f"no {MANIFEST}"
     try:
-        m = json.loads((out / MANIFEST).read_text(encoding="utf-8"))
-    except (OSError, ValueError):
-        return None
-    return m if isinstance(m, dict) and m.get("format") == FORMAT else None
+        m = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as e:
+        return None, f"a {MANIFEST} that cannot be read ({e.strerror})"
+    except ValueError as e:
+        return None, f"a {MANIFEST} that is not valid JSON ({e}): repair it, or remove the directory"
+    if not (isinstance(m, dict) and m.get("format") == FORMAT):
+        return None, f"a {MANIFEST} that is not a tcsim study's"
+    return m, ""
 
 
 def _is_ours(name: str) -> bool:
@@ -133,11 +150,14 @@ def _check_dir(out: Path, digest: str, chunk_size: int, inputs: Sequence[str | P
     names = [p.relative_to(out).as_posix() for p in out.rglob("*") if p.is_symlink() or not p.is_dir()]
     if not names and not any(p for p in out.iterdir() if p.name != SHARDS):
         return None
-    manifest = _read_manifest(out)
+    manifest, problem = _manifest_or_problem(out)
     foreign = sorted(n for n in names if not _is_ours(n))
-    if manifest is None or foreign:
-        what = f"{len(foreign)} files tcsim did not write as a study, e.g. {foreign[0]!r}" if foreign else "no manifest"
+    if foreign:
+        what = f"{len(foreign)} files tcsim did not write as a study, e.g. {foreign[0]!r}"
         raise _refuse(out, f"{EXPECTED} (it holds {what}; choose another --out)")
+    if manifest is None:
+        advice = "" if "repair" in problem or "cannot be read" in problem else "; choose another --out"
+        raise _refuse(out, f"{EXPECTED} (it holds {problem}{advice})")
     if manifest.get("definition_sha256") != digest:
         old = str(manifest.get("definition_sha256"))[:12]
         what = f"another study: definition {old}…, not {digest[:12]}…"
@@ -168,6 +188,7 @@ def _write_manifest(out: Path, manifest: dict[str, Any]) -> None:
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as f:
             f.write(json.dumps(manifest, allow_nan=True) + "\n")  # compact, by the C encoder
+        os.chmod(name, FILE_MODE & ~_umask())  # as any output (mkstemp makes it private)
         os.replace(name, out / MANIFEST)
     finally:
         with contextlib.suppress(FileNotFoundError):
@@ -297,6 +318,7 @@ def _store(out: Path, manifest: dict[str, Any], index: int, table: pa.Table) -> 
             fd, name = tempfile.mkstemp(prefix=f".{shard_name(index)}.", suffix=".partial", dir=out / SHARDS)
             os.close(fd)
         pq.write_table(table, name)
+        os.chmod(name, FILE_MODE & ~_umask())  # as any output (mkstemp makes it private)
         entry = {"file": rel, "rows": table.num_rows, "size": os.path.getsize(name), "sha256": _sha256(Path(name))}
         with _blocked():
             os.replace(name, out / rel)
@@ -314,9 +336,9 @@ def read_shards(out: str | Path, columns: Sequence[str] | None = None) -> pd.Dat
     Raises :class:`InputError` if ``out`` is not a study directory, is incomplete, or a shard is
     not as its manifest lists it."""
     out = Path(out)
-    manifest = _read_manifest(out)
+    manifest, problem = _manifest_or_problem(out)
     if manifest is None:
-        raise _refuse(out, "a study directory (with its manifest.json)")
+        raise _refuse(out, f"a study directory with its {MANIFEST} (it holds {problem})")
     n = int(manifest["n_chunks"])
     kept = _kept_chunks(out, manifest, n)
     missing = [i for i in range(n) if str(i) not in kept]
