@@ -340,3 +340,25 @@ def test_a_parameter_written_quoted_and_bare_is_given_twice(cli, tmp_path, bare_
     r = cli("monte-carlo", path, "--out", tmp_path / "o")
     assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1 and "given twice" in r.stderr, r.stderr
     assert not (tmp_path / "o").exists()
+
+
+def test_a_grid_value_a_model_of_the_study_refuses_is_refused_before_anything_runs(cli, tmp_path):
+    """Trial finding: a Hrovat & Tobler shape effect beyond the mass matrix's bound passed the
+    converter schema, and every run of its grid point failed (the table's and quasi-dynamic's too),
+    the reason naming the bundled converter file. A grid's values are fixed: the study's models are
+    built at each before anything runs."""
+    key = "converter.geometry.pump_shape_effect_m2"
+    body = f'"{key}" = {{ kind = "grid", values = [0.01, 0.5] }}\n'
+    with_ht = BASE.replace('"quasi-dynamic"]', '"quasi-dynamic", "hrovat-tobler"]')
+    path = write(tmp_path / "s.toml", f"{with_ht}[distributions]\n{body}")
+    with pytest.raises(InputError) as err:
+        load_study_file(path)
+    e = err.value
+    assert (e.source, e.field, e.value) == (str(path), f'distributions."{key}".values[1]', 0.5), str(e)
+    assert "(the hrovat-tobler model): expected |S| < " in e.expected, str(e)
+    r = cli("monte-carlo", path, "--out", tmp_path / "o")
+    assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert not (tmp_path / "o").exists()
+    # without the model that uses it, the value runs (the table and quasi-dynamic models ignore it)
+    path = write(tmp_path / "t.toml", f"{BASE}[distributions]\n{body}")
+    assert load_study_file(path).models == ("table", "quasi-dynamic")

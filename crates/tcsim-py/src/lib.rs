@@ -1530,6 +1530,14 @@ fn qd_coupling_time_constant_bound_s(spec: &Bound<'_, PyDict>) -> PyResult<f64> 
     })
 }
 
+/// Check a model dict as a run would build it (`transient_batch`, `launch_runs`): None, or the
+/// core's input error (a shape effect beyond the mass matrix's bound, …). A study checks the fixed
+/// values of its grids with it before anything runs.
+#[pyfunction]
+fn check_model(spec: &Bound<'_, PyDict>) -> PyResult<()> {
+    guard(|| model_from(spec).map(|_| ()))
+}
+
 /// Codes of the `stator_mode` column of `ht_steady_states` and their names: `{0: "locked",
 /// 1: "free-wheeling", 2: "no-flow", -1: "no-steady-state"}`. Replaces the former Python `STATOR_MODES` table
 /// and the bare `mode == 2` of `steady.py` and `study.py`.
@@ -1584,6 +1592,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(capacity_conventions, m)?)?;
     m.add_function(wrap_pyfunction!(default_flow_time_constant_s, m)?)?;
     m.add_function(wrap_pyfunction!(qd_coupling_time_constant_bound_s, m)?)?;
+    m.add_function(wrap_pyfunction!(check_model, m)?)?;
     m.add_function(wrap_pyfunction!(unit_constants, m)?)?;
     m.add_function(wrap_pyfunction!(lockup_limits, m)?)?;
     m.add_function(wrap_pyfunction!(plausibility_ranges, m)?)?;

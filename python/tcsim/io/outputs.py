@@ -346,7 +346,7 @@ def check_output_file(out: str | Path, inputs: Iterable[str | Path] = ()) -> Non
     if _contained_inputs(out, inputs):
         raise _refuse(out, "a file that is not an input of this run")
     if out.is_dir():
-        raise _refuse(out, f"a {out.suffix or 'file'} file (a directory of that name exists)")
+        raise _refuse(out, f"a {out.suffix + ' ' if out.suffix else ''}file (a directory of that name exists)")
     if out.exists() and not out.is_file():
         raise _refuse(out, "a regular file (a special file of that name exists)")
 

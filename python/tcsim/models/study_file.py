@@ -34,6 +34,7 @@ import math
 import sys
 import tomllib
 import warnings
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -509,10 +510,31 @@ def _refusal(p: Parameter, value: float, converter: Converter, vehicle: Vehicle)
     return None
 
 
-def _check_grid(p: Parameter, grid: Grid, path: str, converter: Converter, vehicle: Vehicle) -> None:
-    """Refuse ``p`` if the converter or vehicle is refused at any value of its grid."""
+def _model_refusal(p: Parameter, value: float, converter: Converter, models: Sequence[str]) -> InputError | None:
+    """Why a model of the study refuses the converter with ``p`` at ``value`` (the core's checks of a
+    run: the mass matrix's bound on the shape effects, …), or None."""
+    from .dynamic import dynamic_model  # noqa: PLC0415  (dynamic imports this module's neighbours)
+
+    if p.target != "converter":
+        return None
+    conv = build_converter(converter_data(converter.to_toml_dict(), {(p.section, p.name): value}), converter.path)
+    for m in models:
+        try:
+            _core.check_model(dynamic_model(conv, m).spec)
+        except _core.CoreInputError as e:
+            err = from_core(e, "study")
+            return InputError(err.source, f"{err.field} (the {m} model)", err.value, err.expected)
+    return None
+
+
+def _check_grid(
+    p: Parameter, grid: Grid, path: str, converter: Converter, vehicle: Vehicle, models: Sequence[str]
+) -> None:
+    """Refuse ``p`` if the converter or vehicle is refused at any value of its grid, or a model of the
+    study at any value (a grid's values are fixed: a value no run can use is refused before any runs,
+    not in every row of its grid point)."""
     for k, value in enumerate(grid.points()):
-        e = _refusal(p, value, converter, vehicle)
+        e = _refusal(p, value, converter, vehicle) or _model_refusal(p, value, converter, models)
         if e is None:
             continue
         if grid.values is not None:
@@ -525,11 +547,11 @@ def _check_grid(p: Parameter, grid: Grid, path: str, converter: Converter, vehic
         raise InputError(path, f'distributions."{p.key}"', describe(grid), expected)
 
 
-def _check_support(p: Parameter, path: str, converter: Converter, vehicle: Vehicle) -> None:
+def _check_support(p: Parameter, path: str, converter: Converter, vehicle: Vehicle, models: Sequence[str]) -> None:
     """Refuse ``p`` if the converter or vehicle is refused at an end of its distribution's support
-    (a grid: at any of its values)."""
+    (a grid: at any of its values, also by the study's models)."""
     if isinstance(p.distribution, Grid):
-        _check_grid(p, p.distribution, path, converter, vehicle)
+        _check_grid(p, p.distribution, path, converter, vehicle, models)
         return
     for value in _probes(p.distribution):
         e = _refusal(p, value, converter, vehicle)
@@ -562,5 +584,5 @@ def load_study_file(path: str | Path) -> StudyFile:
     vehicle = Vehicle(vehicle.core, vehicle.path, converter)
     params = tuple(_parameter(k, d, str(p), converter, vehicle) for k, d in doc.distributions.items())
     for param in params:
-        _check_support(param, str(p), converter, vehicle)
+        _check_support(param, str(p), converter, vehicle, models)
     return StudyFile(str(p), doc, vehicle, converter, models, params)
