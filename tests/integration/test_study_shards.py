@@ -157,8 +157,9 @@ def study_dir(cli, tmp_path):
 def test_another_definition_in_the_directory_is_refused(cli, study_dir):
     err = _refused(cli, study_dir, "--chunk-size", "10", "--values-per-parameter", "4")
     assert "--out" in err and "it holds another study" in err
+    assert "values_per_parameter = 3 there, 4 here" in err  # which setting differs, not only hashes
     err = _refused(cli, study_dir, "--chunk-size", "10", "--values-per-parameter", "3", "--speed-unit", "rpm")
-    assert "it holds another study" in err
+    assert "it holds another study" in err and "speed_unit = 'rad/s' there, 'rpm' here" in err
 
 
 def test_another_chunk_size_is_refused(cli, study_dir):

@@ -139,8 +139,12 @@ def _is_ours(name: str) -> bool:
     return folder == SHARDS and "/" not in base and (_SHARD.fullmatch(base) is not None or base.endswith(".partial"))
 
 
-def _check_dir(out: Path, digest: str, chunk_size: int, inputs: Sequence[str | Path]) -> dict[str, Any] | None:
-    """The manifest of the study directory ``out`` (None if it is new or empty), or refuse it."""
+def _check_dir(
+    out: Path, record: dict[str, Any], chunk_size: int, inputs: Sequence[str | Path]
+) -> dict[str, Any] | None:
+    """The manifest of the study directory ``out`` (None if it is new or empty), or refuse it; the
+    study's definition ``record`` (:func:`definition_record`)."""
+    digest = definition_sha256(record)
     if _contained_inputs(out, inputs):
         raise _refuse(out, f"{EXPECTED}, holding no input of this run")
     if not out.exists() and not out.is_symlink():
@@ -161,11 +165,39 @@ def _check_dir(out: Path, digest: str, chunk_size: int, inputs: Sequence[str | P
     if manifest.get("definition_sha256") != digest:
         old = str(manifest.get("definition_sha256"))[:12]
         what = f"another study: definition {old}…, not {digest[:12]}…"
+        as_kept = json.loads(json.dumps(record, allow_nan=True))  # tuples as the manifest's lists
+        where = _first_difference(manifest.get("definition"), as_kept)
+        if where:
+            what += f"; {where}"
         raise _refuse(out, f"{EXPECTED} (it holds {what}; choose another --out)")
     if manifest.get("chunk_size") != chunk_size:
         expected = f"{manifest.get('chunk_size')}, the chunk size of the study in {str(out)!r} (or another --out)"
         raise InputError("command line", "--chunk-size", chunk_size, expected)
     return manifest
+
+
+def _first_difference(there: Any, here: Any, path: str = "") -> str:
+    """Where the definition kept in a study directory first differs from this run's, as
+    ``speed_unit = 'rad/s' there, 'rpm' here`` ("" if the kept one is missing or the same): a trial
+    found the refusal naming only two hashes, with nothing to say which setting differed."""
+    if isinstance(there, dict) and isinstance(here, dict):
+        for key in sorted(set(there) | set(here), key=str):
+            if there.get(key) != here.get(key):
+                return _first_difference(there.get(key), here.get(key), f"{path}.{key}" if path else str(key))
+        return ""
+    if isinstance(there, list) and isinstance(here, list) and len(there) == len(here):
+        for i, (a, b) in enumerate(zip(there, here)):
+            if a != b:
+                return _first_difference(a, b, f"{path}[{i}]")
+        return ""
+    if there is None or there == here:
+        return ""
+
+    def short(v: Any) -> str:
+        text = repr(v)
+        return text if len(text) <= 40 else text[:37] + "…"
+
+    return f"{path} = {short(there)} there, {short(here)} here"
 
 
 def _kept_chunks(out: Path, manifest: dict[str, Any] | None, n_chunks: int) -> dict[str, dict[str, Any]]:
@@ -231,7 +263,7 @@ def _prepare(
     """Under the lock: check ``out`` again (another run may have changed it), keep its finished
     chunks, remove the rest, and write the manifest; the manifest."""
     digest = definition_sha256(record)
-    old = _check_dir(out, digest, chunk_size, inputs)
+    old = _check_dir(out, record, chunk_size, inputs)
     n_chunks = chunk_count(n_cases, chunk_size)
     kept = _kept_chunks(out, old, n_chunks)
     _clean(out, kept)
@@ -275,7 +307,7 @@ def run_to_shards(
         least = -(-n_cases // MAX_CHUNKS)
         raise InputError("command line", "--chunk-size", chunk_size, f"at least {least} ({MAX_CHUNKS} chunks at most)")
     record = definition_record(study, speed_unit)
-    _check_dir(out, definition_sha256(record), chunk_size, inputs)  # before anything is created
+    _check_dir(out, record, chunk_size, inputs)  # before anything is created
     try:
         (out / SHARDS).mkdir(parents=True, exist_ok=True)
     except OSError as e:
