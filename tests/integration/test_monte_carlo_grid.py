@@ -362,3 +362,12 @@ def test_a_grid_value_a_model_of_the_study_refuses_is_refused_before_anything_ru
     # without the model that uses it, the value runs (the table and quasi-dynamic models ignore it)
     path = write(tmp_path / "t.toml", f"{BASE}[distributions]\n{body}")
     assert load_study_file(path).models == ("table", "quasi-dynamic")
+
+
+def test_a_study_file_given_where_a_converter_is_expected_says_which_command_runs_it(cli, tmp_path):
+    """Trial finding: ``tcsim study STUDY.toml`` said ``source = 'missing'``, no hint of monte-carlo."""
+    path = write(tmp_path / "s.toml", f'{BASE}[distributions]\n"{PUMP}" = {{ kind = "grid", values = [0.1] }}\n')
+    r = cli("study", path, "--out", tmp_path / "o")
+    assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "expected a converter file (run a Monte Carlo study file with: tcsim monte-carlo FILE)" in r.stderr
+    assert not (tmp_path / "o").exists()

@@ -355,6 +355,13 @@ def warn_implausible_design(doc: ConverterFile, path: str) -> None:
 
 def parse_converter(data: dict[str, Any], path: str) -> Converter:
     """Validate a parsed TOML document."""
+    if "distributions" in data and "source" not in data:  # a trial passed one to `tcsim study`
+        raise InputError(
+            path,
+            "[distributions]",
+            "a Monte Carlo study file",
+            "a converter file (run a Monte Carlo study file with: tcsim monte-carlo FILE)",
+        )
     tables = None
     if isinstance(data.get("characteristic"), list):  # [[characteristic]]: torque-dependent capacity
         tables = _table_sections(data["characteristic"], path)
