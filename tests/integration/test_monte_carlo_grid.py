@@ -7,6 +7,7 @@ shape-effect sweep resumed from the command line."""
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -15,7 +16,7 @@ import pytest
 
 from interrupts import ClientStopped, stop_after
 from tcsim.analysis.monte_carlo import case_generator, draw, draw_cases, monte_carlo_study, run_monte_carlo
-from tcsim.errors import InputError
+from tcsim.errors import InputError, TcsimWarning
 from tcsim.io.shards import MANIFEST, read_shards, run_to_shards
 from tcsim.models.study_file import MAX_RUNS, Grid, Uniform, load_study_file
 
@@ -371,3 +372,17 @@ def test_a_study_file_given_where_a_converter_is_expected_says_which_command_run
     assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
     assert "expected a converter file (run a Monte Carlo study file with: tcsim monte-carlo FILE)" in r.stderr
     assert not (tmp_path / "o").exists()
+
+
+def test_an_implausible_grid_value_is_warned_of_once_naming_the_study_file(tmp_path):
+    """Trial finding: 50 kg·m² of pump inertia ran without a word, where ``tcsim launch`` warns."""
+    key = "converter.inertia.pump_kg_m2"
+    path = write(tmp_path / "s.toml", f'{BASE}[distributions]\n"{key}" = {{ kind = "grid", values = [0.109, 50.0] }}\n')
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        load_study_file(path)
+    said = [str(w.message) for w in caught if issubclass(w.category, TcsimWarning)]
+    assert said == [
+        f'{path}: distributions."{key}".values[1] = 50: [inertia].pump_kg_m2 = 50 is outside the plausible '
+        "0.0001 to 10 kg·m² (pump, turbine and stator inertias with their fluid)"
+    ], said

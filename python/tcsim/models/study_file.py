@@ -43,7 +43,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .. import _core
-from ..errors import InputError, from_core
+from ..errors import InputError, TcsimWarning, from_core
 from .converter import MODELS, Converter, bundled_names, parse_converter
 from .vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, _load_named_converter, load_vehicle
 
@@ -497,12 +497,22 @@ def _probes(dist: Any) -> list[float]:
     return [lo, hi]
 
 
-def _refusal(p: Parameter, value: float, converter: Converter, vehicle: Vehicle) -> InputError | None:
-    """Why the converter or vehicle is refused with ``p`` at ``value`` (the rest as the files have it), or None."""
+def _refusal(
+    p: Parameter, value: float, converter: Converter, vehicle: Vehicle, implausible: list[str] | None = None
+) -> InputError | None:
+    """Why the converter or vehicle is refused with ``p`` at ``value`` (the rest as the files have it), or None;
+    the converter's plausibility warnings at ``value`` appended to ``implausible``."""
     try:
         values = {(p.section, p.name): value}
         if p.target == "converter":
-            build_converter(converter_data(converter.to_toml_dict(), values), converter.path)
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always", TcsimWarning)
+                parse_converter(converter_data(converter.to_toml_dict(), values), converter.path)
+            if implausible is not None:
+                prefix = f"{converter.path}: "
+                implausible.extend(
+                    str(w.message).removeprefix(prefix) for w in caught if issubclass(w.category, TcsimWarning)
+                )
         else:
             build_vehicle(vehicle_data(vehicle.to_toml_dict(), values), vehicle.path, converter)
     except InputError as e:
@@ -534,7 +544,9 @@ def _check_grid(
     study at any value (a grid's values are fixed: a value no run can use is refused before any runs,
     not in every row of its grid point)."""
     for k, value in enumerate(grid.points()):
-        e = _refusal(p, value, converter, vehicle) or _model_refusal(p, value, converter, models)
+        implausible: list[str] = []
+        e = _refusal(p, value, converter, vehicle, implausible) or _model_refusal(p, value, converter, models)
+        _warn_implausible(path, f"distributions.{_quoted(p.key)}.values[{k}]", value, implausible)
         if e is None:
             continue
         if grid.values is not None:
@@ -547,6 +559,18 @@ def _check_grid(
         raise InputError(path, f'distributions."{p.key}"', describe(grid), expected)
 
 
+def _quoted(key: str) -> str:
+    return f'"{key}"'
+
+
+def _warn_implausible(path: str, field: str, value: float, messages: list[str]) -> None:
+    """The converter's plausibility warnings at a value of the study file, as the study file's: a
+    trial found them silent (50 kg·m² of pump inertia ran without a word, which ``tcsim launch``
+    warns of); once per value, not per case."""
+    for message in dict.fromkeys(messages):
+        warnings.warn(f"{path}: {field} = {value:g}: {message}", TcsimWarning, stacklevel=3)
+
+
 def _check_support(p: Parameter, path: str, converter: Converter, vehicle: Vehicle, models: Sequence[str]) -> None:
     """Refuse ``p`` if the converter or vehicle is refused at an end of its distribution's support
     (a grid: at any of its values, also by the study's models)."""
@@ -554,7 +578,9 @@ def _check_support(p: Parameter, path: str, converter: Converter, vehicle: Vehic
         _check_grid(p, p.distribution, path, converter, vehicle, models)
         return
     for value in _probes(p.distribution):
-        e = _refusal(p, value, converter, vehicle)
+        implausible: list[str] = []
+        e = _refusal(p, value, converter, vehicle, implausible)
+        _warn_implausible(path, f"distributions.{_quoted(p.key)} (an end of its support)", value, implausible)
         if e is not None:
             low, high, is_open = p.distribution.support()
             support = f"{'(' if is_open else '['}{low:g}, {high:g}{')' if is_open else ']'}"
