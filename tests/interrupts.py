@@ -50,8 +50,13 @@ def _still_writing(cwd: Path, out: str) -> bool:
 PHASES = {"start": lambda p, cwd, out: _handles_sigterm(p.pid), "writing": lambda p, cwd, out: bool(_stages(cwd, out))}
 
 
+#: A moment of a run: a name of :data:`PHASES`, or a test of the running process, its working
+#: directory and its output directory's name (e.g. "two shards are listed").
+Phase = str | Callable[[subprocess.Popen, Path, str], bool]
+
+
 def interrupt(
-    args: Sequence[str], sig: signal.Signals, phase: str, cwd: Path, out: str = "o"
+    args: Sequence[str], sig: signal.Signals, phase: Phase, cwd: Path, out: str = "o"
 ) -> subprocess.CompletedProcess:
     """Run ``tcsim *args`` in ``cwd`` (its output directory ``out``), send ``sig`` when ``phase`` is
     reached, return what it did."""
@@ -66,7 +71,7 @@ def interrupt(
 
 
 def _interrupt_once(
-    args: Sequence[str], sig: signal.Signals, phase: str, cwd: Path, out: str
+    args: Sequence[str], sig: signal.Signals, phase: Phase, cwd: Path, out: str
 ) -> subprocess.CompletedProcess | None:
     """One run of :func:`interrupt`; None if the run had passed the phase when it was stopped."""
     env = dict(os.environ, COLUMNS="200")
@@ -74,7 +79,8 @@ def _interrupt_once(
     p = subprocess.Popen(cmd, cwd=cwd, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     caught = True
     try:
-        while not PHASES[phase](p, cwd, out):
+        reached = PHASES[phase] if isinstance(phase, str) else phase
+        while not reached(p, cwd, out):
             if p.poll() is not None:
                 stdout, err = p.communicate()
                 pytest.fail(f"tcsim {args[0]} ended (exit {p.returncode}) before its phase {phase!r}: {err}")

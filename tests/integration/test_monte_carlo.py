@@ -8,11 +8,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import os
 import signal
-import subprocess
-import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -21,16 +17,13 @@ import pytest
 from scipy import stats
 
 import tcsim.analysis.monte_carlo as mc
-from interrupts import ClientStopped, stop_after
+from interrupts import ClientStopped, interrupt, stop_after
 from tcsim.analysis.monte_carlo import draw_cases, monte_carlo_study, run_monte_carlo
 from tcsim.errors import InputError
 from tcsim.io.shards import MANIFEST, SHARDS, read_shards, run_to_shards, shard_name
 from tcsim.models.converter import load_converter
 from tcsim.models.study_file import Lognormal, Normal, Parameter, TruncatedNormal, Uniform, load_study_file
 from tcsim.models.vehicle import load_vehicle
-
-HANG_GUARD_S = 600  # a hang guard only; nothing is asserted about durations
-POLL_S = 0.005
 
 #: A study of converter and vehicle parameters, every kind of distribution, the three models.
 STUDY = """\
@@ -349,26 +342,10 @@ def test_a_study_whose_client_stops_resumes_without_recomputing(tmp_path, study,
 def test_an_interrupted_study_exits_130_and_keeps_its_finished_shards(tmp_path):
     write_study(tmp_path / "s.toml", runs=200)
     args = ["monte-carlo", "s.toml", "--out", "o", "--chunk-size", "2"]
-    p = subprocess.Popen(
-        [sys.executable, "-m", "tcsim", *args],
-        cwd=tmp_path,
-        env=dict(os.environ, COLUMNS="200"),
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
-    )
     out = tmp_path / "o"
-    try:
-        while not ((out / MANIFEST).is_file() and len(listed(out)) >= 2):
-            assert p.poll() is None, p.communicate()
-            time.sleep(POLL_S)
-        p.send_signal(signal.SIGINT)
-        _, stderr = p.communicate(timeout=HANG_GUARD_S)
-    finally:
-        if p.poll() is None:
-            p.kill()
-            p.communicate()
-    assert p.returncode == 130, stderr
-    assert stderr.decode().strip().splitlines() == [
+    r = interrupt(args, signal.SIGINT, lambda p, cwd, o: (out / MANIFEST).is_file() and len(listed(out)) >= 2, tmp_path)
+    assert r.returncode == 130, r.stderr
+    assert r.stderr.strip().splitlines() == [
         "interrupted (SIGINT): the finished chunks in o are kept; run it again to resume"
     ]
     done = listed(out)
