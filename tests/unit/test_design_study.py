@@ -114,6 +114,8 @@ def test_check_sweep_limits_parameters_and_designs():
     with pytest.raises(InputError, match="finite"):
         check_sweep({"squash_ratio": [0.0, float("nan")]})
     check_sweep({"squash_ratio": np.zeros(1000), "pump_exit_radius_m": np.zeros(20)})  # 20000: the limit
+    # kept as shards (nothing in memory), only the counts per parameter bound it: 1000 × 1000
+    check_sweep({"squash_ratio": np.zeros(1000), "pump_exit_radius_m": np.zeros(1000)}, chunked=True)
 
 
 def test_pareto_front_is_the_non_dominated_set():

@@ -177,8 +177,9 @@ def design_sweep_study(
     design: DesignFile, sweep: Mapping[str, Sequence[float] | np.ndarray], threads: int = 0
 ) -> DesignSweepStudy:
     """The design study of ``sweep`` (one or two parameters → their values) around ``design`` for
-    chunked runs; the sweep checked as :func:`~tcsim.analysis.design_study.design_study` checks it."""
-    check_sweep(sweep)
+    chunked runs; the sweep checked as :func:`~tcsim.analysis.design_study.design_study` checks it,
+    without its cap on the designs held in memory."""
+    check_sweep(sweep, chunked=True)
     names = tuple(sweep)
     values = tuple(tuple(np.asarray(sweep[n], dtype=float).tolist()) for n in names)
     return DesignSweepStudy(study_base(design, names), names, values, threads)

@@ -96,9 +96,12 @@ def parse_sweep(text: str, source: str = "--sweep") -> tuple[str, np.ndarray]:
     return name, np.linspace(lo, hi, count)
 
 
-def check_sweep(sweep: Mapping[str, Sequence[float] | np.ndarray], source: str = "--sweep") -> None:
-    """One or two known parameters, each with finite values, at most :data:`MAX_DESIGNS` designs;
-    else :class:`InputError` naming ``source``."""
+def check_sweep(
+    sweep: Mapping[str, Sequence[float] | np.ndarray], source: str = "--sweep", chunked: bool = False
+) -> None:
+    """One or two known parameters, each with finite values, at most :data:`MAX_DESIGNS` designs
+    unless ``chunked`` (a study kept as shards holds no row in memory: the counts of
+    :data:`SWEEP_COUNT_RANGE` bound it); else :class:`InputError` naming ``source``."""
     if not 1 <= len(sweep) <= 2:
         raise InputError(source, "parameters", len(sweep), "one or two swept parameters")
     for name, values in sweep.items():
@@ -108,8 +111,9 @@ def check_sweep(sweep: Mapping[str, Sequence[float] | np.ndarray], source: str =
         if v.ndim != 1 or v.size < 1 or not np.isfinite(v).all():
             raise InputError(source, name, f"{v.size} values", "a non-empty sequence of finite numbers")
     total = math.prod(len(v) for v in sweep.values())
-    if total > MAX_DESIGNS:
-        raise InputError(source, "designs", total, f"at most {MAX_DESIGNS} designs in one study")
+    if total > MAX_DESIGNS and not chunked:
+        expected = f"at most {MAX_DESIGNS} designs in one study (more with --chunk-size)"
+        raise InputError(source, "designs", total, expected)
 
 
 @dataclass(frozen=True)

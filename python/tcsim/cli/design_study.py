@@ -68,7 +68,7 @@ def design_study(
     if len(set(names)) != len(names):
         raise InputError("--sweep", "NAME", names[-1], "two different parameters")
     values = dict(parsed)
-    check_sweep(values)
+    check_sweep(values, chunked=chunk_size is not None)
     if chunk_size is not None:
         check_chunk_size(chunk_size)
         check_scheduler(scheduler, workers)
