@@ -976,13 +976,7 @@ fn transient_runs<'py>(
     threads: usize,
 ) -> PyResult<Vec<TransientRun>> {
     guard(|| {
-        let init = init_from(init.as_ref())?;
-        let options = options_from(options.as_ref())?;
-        let (jobs, _skips) = transient_jobs(&models, &drives, init, options)?;
-        let samples = jobs.iter().map(|j| j.times_s.len()).sum();
-        isolated_output_size(1, samples, COLUMNS.len(), &options)
-            .check(InputSource::Drive, options.max_output_bytes)
-            .map_err(input_error)?;
+        let (jobs, _skips) = sized_transient_jobs(&models, &drives, init, options, COLUMNS.len())?;
         let results = cancellable_runs(py, jobs.len(), |cancel| {
             run_transient_jobs_cancellable(&jobs, threads, cancel).into_iter().collect::<Option<Vec<_>>>()
         })?;
@@ -1104,6 +1098,25 @@ fn transient_jobs(
     Ok((jobs, skips))
 }
 
+/// [`transient_jobs`] from the Python `init` and `options` dicts, refused (an input error) when the
+/// outputs of all runs with `columns` columns would pass `max_output_bytes`.
+fn sized_transient_jobs(
+    models: &[Bound<'_, PyDict>],
+    drives: &[Bound<'_, PyDict>],
+    init: Option<Bound<'_, PyDict>>,
+    options: Option<Bound<'_, PyDict>>,
+    columns: usize,
+) -> PyResult<(Vec<TransientJob>, Vec<usize>)> {
+    let init = init_from(init.as_ref())?;
+    let options = options_from(options.as_ref())?;
+    let (jobs, skips) = transient_jobs(models, drives, init, options)?;
+    let samples = jobs.iter().map(|j| j.times_s.len()).sum();
+    isolated_output_size(1, samples, columns, &options)
+        .check(InputSource::Drive, options.max_output_bytes)
+        .map_err(input_error)?;
+    Ok((jobs, skips))
+}
+
 /// Run transient jobs as [`transient_runs`] does, returning columnar results: a dict with `names`
 /// (the selected columns, `columns` or all of `transient_columns()`), `columns` (name → one float64
 /// array of all runs' rows, run `i` at rows `offsets[i]:offsets[i + 1]`, NaN for a run that failed
@@ -1130,13 +1143,7 @@ fn transient_batch<'py>(
             Some(names) => Selection::from_names(names).map_err(input_error)?,
             None => Selection::all(),
         };
-        let init = init_from(init.as_ref())?;
-        let options = options_from(options.as_ref())?;
-        let (jobs, skips) = transient_jobs(&models, &drives, init, options)?;
-        let samples = jobs.iter().map(|j| j.times_s.len()).sum();
-        isolated_output_size(1, samples, selection.len(), &options)
-            .check(InputSource::Drive, options.max_output_bytes)
-            .map_err(input_error)?;
+        let (jobs, skips) = sized_transient_jobs(&models, &drives, init, options, selection.len())?;
         let batch = cancellable_runs(py, jobs.len(), |cancel| {
             match run_transient_columns(&jobs, &skips, &selection, threads, cancel) {
                 Ok(Some(b)) => Some(Ok(b)),

@@ -51,6 +51,7 @@ from ..models.study_file import (
     build_converter,
     build_vehicle,
     converter_data,
+    count_grid_points,
     vehicle_data,
 )
 from ..models.vehicle import Vehicle
@@ -124,7 +125,7 @@ def grid_values(parameters: Sequence[Parameter], point: int) -> dict[int, float]
 
 def grid_points(parameters: Sequence[Parameter]) -> int:
     """The number of grid points of ``parameters`` (1 without a grid)."""
-    return math.prod(len(p.distribution) for p in parameters if isinstance(p.distribution, Grid))
+    return count_grid_points(p.distribution for p in parameters)
 
 
 def draw_cases(parameters: Sequence[Parameter], seed: int, start: int, stop: int, runs: int = 1) -> np.ndarray:

@@ -109,10 +109,6 @@ def _refuse(out: Path, expected: str) -> InputError:
     return InputError("command line", "--out", str(out), expected)
 
 
-def _read_manifest(out: Path) -> dict[str, Any] | None:
-    return _manifest_or_problem(out)[0]
-
-
 def _manifest_or_problem(out: Path) -> tuple[dict[str, Any] | None, str]:
     """The study manifest in ``out``, or None and what is wrong with it: missing, unreadable (a
     permission), not JSON or not a tcsim study's (a trial found all of them reported as missing,

@@ -34,7 +34,7 @@ import math
 import sys
 import tomllib
 import warnings
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -239,6 +239,11 @@ def describe(distribution: BaseModel) -> str:
 Distribution = Annotated[Normal | Uniform | Lognormal | TruncatedNormal | Grid, Field(discriminator="kind")]
 
 
+def count_grid_points(distributions: Iterable[Any]) -> int:
+    """The number of points of the full factorial of the grids among ``distributions`` (1 without a grid)."""
+    return math.prod(len(d) for d in distributions if isinstance(d, Grid))
+
+
 class MonteCarloFile(BaseModel):
     """The study file's top level."""
 
@@ -289,7 +294,7 @@ class MonteCarloFile(BaseModel):
     @property
     def grid_points(self) -> int:
         """The number of grid points (1 without a grid)."""
-        return math.prod(len(d) for d in self.distributions.values() if isinstance(d, Grid))
+        return count_grid_points(self.distributions.values())
 
     @property
     def n_cases(self) -> int:
