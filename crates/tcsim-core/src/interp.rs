@@ -2,12 +2,18 @@
 //! tables ([`crate::converter::table`]), the input signals ([`crate::engine::signal`]) and the
 //! vehicle's curves and pedal schedules ([`crate::vehicle`]).
 
+/// Tables of at most this many abscissae are scanned rather than bisected ([`segment`]).
+const SCAN_MAX: usize = 8;
+
 /// The segment `[x[i−1], x[i]]` of the sorted abscissae `x` (two or more) that holds `t`, clamped
 /// to the first or last segment, and the weight `w = (t − x[i−1])/(x[i] − x[i−1])` of `x[i]`.
 pub fn segment(x: &[f64], t: f64) -> (usize, f64) {
     let n = x.len();
-    // first index with x[i] > t, clamped so that [i-1, i] is a segment
-    let i = x.partition_point(|&v| v <= t).clamp(1, n - 1);
+    // first index with x[i] > t, clamped so that [i-1, i] is a segment (a short table is scanned:
+    // the branch follows t, which inputs sweep in order, where a bisection's branches are random)
+    let first_above =
+        if n <= SCAN_MAX { x.iter().take_while(|&&v| v <= t).count() } else { x.partition_point(|&v| v <= t) };
+    let i = first_above.clamp(1, n - 1);
     (i, (t - x[i - 1]) / (x[i] - x[i - 1]))
 }
 
@@ -47,5 +53,21 @@ mod tests {
         assert_eq!(linear_held(&[1.0], &[5.0], 9.0), 5.0);
         assert_eq!([-1.0, 0.25, 2.0].map(|p| blend_held(2.0, 6.0, p)), [2.0, 3.0, 6.0]);
         assert!(linear_held(&x, &y, f64::NAN).is_nan());
+    }
+
+    #[test]
+    fn a_scanned_segment_is_the_bisected_one() {
+        // short tables are scanned (`SCAN_MAX`), long ones bisected: the same segment and weight
+        for n in 2..=2 * SCAN_MAX {
+            let x: Vec<f64> = (0..n).map(|i| (i as f64).powf(1.3) - 2.0).collect();
+            let ts =
+                (0..=40 * n).map(|k| -3.0 + k as f64 * 0.05).chain(x.iter().copied()).chain([f64::NAN, 1e300, -1e300]);
+            for t in ts {
+                let i = x.partition_point(|&v| v <= t).clamp(1, n - 1);
+                let w = (t - x[i - 1]) / (x[i] - x[i - 1]);
+                let (j, v) = segment(&x, t);
+                assert!(j == i && (v == w || (v.is_nan() && w.is_nan())), "n {n}, t {t}: {j} {v} vs {i} {w}");
+            }
+        }
     }
 }

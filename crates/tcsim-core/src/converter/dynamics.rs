@@ -69,8 +69,13 @@ pub trait ConverterDynamics: Sync {
     /// Hrovat & Tobler, of the fluid with its coupling to the elements). With [`Self::loss_power_w`]
     /// it closes the energy identity `∫T_ext·ω dt = ΔE + ∫loss dt`.
     fn stored_energy_j(&self, u: &Vec4) -> f64 {
-        let m = self.mass();
-        0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| m[r][c] * u[c]).sum::<f64>()).sum::<f64>()
+        quadratic_energy_j(&self.energy_mass().unwrap_or_else(|| self.mass()), u)
+    }
+    /// The matrix `E` of a stored energy `½uᵀEu` ([`Self::stored_energy_j`]), when the model's is
+    /// such a form: its mass matrix by default. None for a model with another formula (then the
+    /// engine calls [`Self::stored_energy_j`] at every sample instead of using `E` kept once).
+    fn energy_mass(&self) -> Option<Mat4> {
+        Some(self.mass())
     }
     /// The steady state at the given pump and turbine speeds (0 ≤ SR ≤ 1, ω_p > 0).
     fn steady_point(&self, pump_speed_rad_s: f64, turbine_speed_rad_s: f64) -> CoreResult<SteadyPoint>;
@@ -94,6 +99,11 @@ pub trait ConverterDynamics: Sync {
     fn lag_state(&self) -> bool {
         false
     }
+}
+
+/// `½uᵀEu`, J: the stored energy of a model whose [`ConverterDynamics::energy_mass`] is `E`.
+pub fn quadratic_energy_j(e: &Mat4, u: &Vec4) -> f64 {
+    0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| e[r][c] * u[c]).sum::<f64>()).sum::<f64>()
 }
 
 /// Inertias of the rotating elements (each including the fluid it carries).
@@ -273,11 +283,12 @@ impl ConverterDynamics for TableDynamics {
         }
         -(u[0] * g[0] + u[1] * g[1] + u[2] * g[2] + u[3] * g[3])
     }
-    /// The kinetic energy of pump and turbine, J: the lag stores none.
-    fn stored_energy_j(&self, u: &Vec4) -> f64 {
+    /// The kinetic energy of pump and turbine (the lag stores none): the mass matrix without its
+    /// fourth diagonal entry.
+    fn energy_mass(&self) -> Option<Mat4> {
         let mut m = self.mass();
         m[FLOW][FLOW] = 0.0;
-        0.5 * (0..4).map(|r| u[r] * (0..4).map(|c| m[r][c] * u[c]).sum::<f64>()).sum::<f64>()
+        Some(m)
     }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         let tp = table_steady(&self.characteristic, wp, wt)?;
@@ -731,6 +742,9 @@ impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
     }
     fn stored_energy_j(&self, u: &Vec4) -> f64 {
         (**self).stored_energy_j(u)
+    }
+    fn energy_mass(&self) -> Option<Mat4> {
+        (**self).energy_mass()
     }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
         (**self).steady_point(wp, wt)

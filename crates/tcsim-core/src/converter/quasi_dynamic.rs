@@ -314,6 +314,10 @@ impl ConverterDynamics for QuasiDynamics {
             * (self.pump_shape_effect_m2 * u[PUMP] + self.turbine_shape_effect_m2 * u[TURBINE]);
         -(u[PUMP] * f[PUMP] + u[TURBINE] * f[TURBINE]) + fluid
     }
+    /// Its own formula ([`Self::stored_energy_j`]).
+    fn energy_mass(&self) -> Option<Mat4> {
+        None
+    }
     /// The kinetic energy of pump and turbine, J (the flow coordinate stores none).
     fn stored_energy_j(&self, u: &Vec4) -> f64 {
         0.5 * (self.inertia.pump_kg_m2 * u[PUMP] * u[PUMP] + self.inertia.turbine_kg_m2 * u[TURBINE] * u[TURBINE])

@@ -12,7 +12,7 @@
 //!
 //! See [`crate::engine::isolated`] for the physics of the events (the Filippov treatment of sgn Q).
 
-use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::converter::dynamics::{quadratic_energy_j, ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::lockup::ClutchMode;
 use crate::engine::options::Hysteresis;
 
@@ -220,21 +220,49 @@ pub fn external_torques(mass: &Mat4, u_dot: &Vec4, f: &Vec4) -> Vec4 {
     std::array::from_fn(|r| (0..4).map(|c| mass[r][c] * u_dot[c]).sum::<f64>() - f[r])
 }
 
-/// The converter's sample at time `t` from its coordinates `u`, rates `u_dot` and forces
-/// `f = F(u)` in `mode`: external torques with the converter's own mass, the transferred torques
-/// (with the stator reaction that balances them when the model has no stator), the loss power
-/// (none while the flow is held) and the stored kinetic energy.
-pub fn sample(model: &dyn ConverterDynamics, mode: Mode, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
-    let mass = model.mass();
-    let e = external_torques(&mass, &u_dot, &f);
-    let stored = model.stored_energy_j(&u);
-    let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
-    let transferred = model.transferred(&f);
-    if !model.coordinates()[STATOR] {
-        // the reaction that balances the transferred torques
-        torque[2] = transferred.1 - transferred.0;
+/// What a model's samples need that is the same at every sample, kept once per segment: its mass
+/// matrix, its stored energy's matrix ([`ConverterDynamics::energy_mass`]), whether it has a stator
+/// coordinate and whether the mode holds its flow.
+pub struct SampleConstants<'a> {
+    model: &'a dyn ConverterDynamics,
+    mode: Mode,
+    mass: Mat4,
+    energy_mass: Option<Mat4>,
+    stator: bool,
+    flow_held: bool,
+}
+
+impl<'a> SampleConstants<'a> {
+    pub fn new(model: &'a dyn ConverterDynamics, mode: Mode) -> Self {
+        let (mass, energy_mass) = (model.mass(), model.energy_mass());
+        let (stator, flow_held) = (model.coordinates()[STATOR], flow_held(model, mode));
+        Self { model, mode, mass, energy_mass, stator, flow_held }
     }
-    let loss = if flow_held(model, mode) { 0.0 } else { model.loss_power_w(&u, &f) };
-    let lockup = LockupSample::default();
-    Sample { time_s: t, u, u_dot, torque, transferred, mode, loss_power_w: loss, stored_energy_j: stored, lockup }
+
+    /// The converter's sample at time `t` from its coordinates `u`, rates `u_dot` and forces
+    /// `f = F(u)`: external torques with the converter's own mass, the transferred torques (with
+    /// the stator reaction that balances them when the model has no stator), the loss power (none
+    /// while the flow is held) and the stored kinetic energy.
+    pub fn sample(&self, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
+        let model = self.model;
+        let e = external_torques(&self.mass, &u_dot, &f);
+        let stored = match &self.energy_mass {
+            Some(m) => quadratic_energy_j(m, &u),
+            None => model.stored_energy_j(&u),
+        };
+        let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
+        let transferred = model.transferred(&f);
+        if !self.stator {
+            // the reaction that balances the transferred torques
+            torque[2] = transferred.1 - transferred.0;
+        }
+        let loss = if self.flow_held { 0.0 } else { model.loss_power_w(&u, &f) };
+        let (mode, lockup) = (self.mode, LockupSample::default());
+        Sample { time_s: t, u, u_dot, torque, transferred, mode, loss_power_w: loss, stored_energy_j: stored, lockup }
+    }
+}
+
+/// The converter's sample at time `t` in `mode` ([`SampleConstants::sample`]).
+pub fn sample(model: &dyn ConverterDynamics, mode: Mode, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
+    SampleConstants::new(model, mode).sample(t, u, u_dot, f)
 }

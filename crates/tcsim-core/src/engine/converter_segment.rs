@@ -10,8 +10,8 @@
 //! momentum `PᵀM u` of the free coordinates is conserved ([`Segment::project`]).
 
 use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
-use crate::engine::converter_events::{self, ConverterRoot, EventKind, LockupSample, Mode, Sample};
-use crate::engine::drive::Drive;
+use crate::engine::converter_events::{self, ConverterRoot, EventKind, LockupSample, Mode, Sample, SampleConstants};
+use crate::engine::drive::{Drive, TurbineLoad};
 use crate::engine::lockup::{self, ClutchMode, LockupCommand, LockupRoot};
 use crate::engine::options::{Hysteresis, SolverOptions};
 use crate::engine::segment::SmoothSegment;
@@ -45,13 +45,21 @@ pub(super) struct Segment<'a> {
     role: [Role; 4],
     /// The state column of each free or linked coordinate.
     col: [Option<usize>; 4],
-    /// The pump follows the turbine's signal (a locked lock-up in drive a).
-    pump_follows_turbine: bool,
     n: usize,
     /// `PᵀMP` and its inverse.
     reduced: Mat4,
     inv: Mat4,
     pub(super) roots: Vec<Root>,
+    /// The signal of each given coordinate (resolved once from the roles).
+    given: [Option<&'a Signal>; 4],
+    /// Whether any coordinate is given (else every rate of `z(t)` is zero).
+    any_given: bool,
+    /// The pump torque, when the pump is free.
+    pump_torque: Option<&'a Signal>,
+    /// The load, when the turbine is free or linked.
+    load: Option<&'a TurbineLoad>,
+    /// What every sample needs from the model in this mode.
+    sampled: SampleConstants<'a>,
     /// Dissipation and impulse work of the lock events before this segment, J (cumulative).
     pub(super) lock_energy_j: (f64, f64),
 }
@@ -121,6 +129,11 @@ impl<'a> Segment<'a> {
         }
         let inv = invert(n, &reduced).expect("the reduced mass matrix of a positive-definite M is invertible");
         let roots = roots(model, drive, mode);
+        let given_signal =
+            |c: usize| if c == PUMP && pump_follows_turbine { drive.given(TURBINE) } else { drive.given(c) };
+        let given = std::array::from_fn(|c| if role[c] == Role::Given { given_signal(c) } else { None });
+        let pump_torque = drive.pump_torque().filter(|_| role[PUMP] == Role::Free);
+        let load = drive.load().filter(|_| matches!(role[TURBINE], Role::Free | Role::Linked));
         Self {
             model,
             drive,
@@ -129,11 +142,15 @@ impl<'a> Segment<'a> {
             mode,
             role,
             col,
-            pump_follows_turbine,
             n,
             reduced,
             inv,
             roots,
+            given,
+            any_given: given.iter().any(Option::is_some),
+            pump_torque,
+            load,
+            sampled: SampleConstants::new(model, mode),
             lock_energy_j: (0.0, 0.0),
         }
     }
@@ -143,20 +160,11 @@ impl<'a> Segment<'a> {
         self.n.max(1)
     }
 
-    /// The signal that gives coordinate `c` in this segment.
-    fn given(&self, c: usize) -> Option<&Signal> {
-        if c == PUMP && self.pump_follows_turbine {
-            self.drive.given(TURBINE)
-        } else {
-            self.drive.given(c)
-        }
-    }
-
     pub(super) fn full(&self, x: &[f64], t: f64) -> Vec4 {
-        std::array::from_fn(|c| match (self.role[c], self.col[c]) {
-            (Role::Free | Role::Linked, Some(i)) => x[i],
-            (Role::Given, _) => self.given(c).map_or(0.0, |s| s.value(t)),
-            _ => 0.0,
+        std::array::from_fn(|c| match (self.col[c], self.given[c]) {
+            (Some(i), _) => x[i],
+            (None, Some(s)) => s.value(t),
+            (None, None) => 0.0,
         })
     }
 
@@ -188,9 +196,10 @@ impl<'a> Segment<'a> {
     }
 
     fn given_rates(&self, t: f64) -> Vec4 {
-        std::array::from_fn(
-            |c| if self.role[c] == Role::Given { self.given(c).map_or(0.0, |s| s.rate(t)) } else { 0.0 },
-        )
+        if !self.any_given {
+            return [0.0; 4];
+        }
+        std::array::from_fn(|c| self.given[c].map_or(0.0, |s| s.rate(t)))
     }
 
     /// The clutch's command while it slips (None without a clutch, or locked).
@@ -202,10 +211,10 @@ impl<'a> Segment<'a> {
     /// into `jac` when asked (the right-hand side does not need it).
     fn external(&self, u: &Vec4, t: f64, mut jac: Option<&mut Mat4>) -> Vec4 {
         let mut e = [0.0; 4];
-        if self.role[PUMP] == Role::Free {
-            e[PUMP] = self.drive.pump_torque().map_or(0.0, |s| s.value(t));
+        if let Some(s) = self.pump_torque {
+            e[PUMP] = s.value(t);
         }
-        if let (Some(load), Role::Free | Role::Linked) = (self.drive.load(), self.role[TURBINE]) {
+        if let Some(load) = self.load {
             let w = u[TURBINE];
             e[TURBINE] = -(load.torque_nm.value(t) + load.drag_nm_s2 * w * w.abs());
             if let Some(de) = jac.as_deref_mut() {
@@ -231,8 +240,16 @@ impl<'a> Segment<'a> {
     /// Right-hand side of the reduced system, `Pᵀ(F + T − M ż)`, given `u` and `f = F(u)`.
     fn reduced_rhs(&self, u: &Vec4, f: &Vec4, t: f64, out: &mut [f64]) {
         let e = self.external(u, t, None);
-        let zd = self.given_rates(t);
         out.iter_mut().for_each(|o| *o = 0.0);
+        if !self.any_given {
+            for r in 0..4 {
+                if let Some(i) = self.col[r] {
+                    out[i] += f[r] + e[r];
+                }
+            }
+            return;
+        }
+        let zd = self.given_rates(t);
         for r in 0..4 {
             if let Some(i) = self.col[r] {
                 let coupling: f64 = (0..4).map(|c| self.dyn_mass[r][c] * zd[c]).sum();
@@ -354,7 +371,7 @@ impl<'a> Segment<'a> {
 
     pub(super) fn sample(&self, x: &[f64], t: f64) -> Sample {
         let (u, ud, f) = self.kinematics(x, t);
-        let mut s = converter_events::sample(self.model, self.mode, t, u, ud, f);
+        let mut s = self.sampled.sample(t, u, ud, f);
         if let Some(cmd) = self.drive.lockup() {
             let torque = self.lockup_torque(&u, &ud, &f, t);
             let slip = u[PUMP] - u[TURBINE];

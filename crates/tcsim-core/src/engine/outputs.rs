@@ -299,34 +299,51 @@ impl Watch {
     }
 }
 
-/// Column `C` of `samples` into `out` (samples `skip..`; only looked at without `out`), the
-/// values of all samples shown to `watch`. A loop per column, with the column's formula
+/// Column `C` of the samples `block` (global indices `first..`) into its rows of `out` (the whole
+/// column; sample `i` goes to row `i − skip`, the first `skip` samples are only looked at), the
+/// values of all of them shown to `watch`. A loop per column, with the column's formula
 /// ([`RunConstants::value`]) specialised by the constant `C`: no dispatch per value, contiguous
 /// writes; the check scans the written values and looks closer only when one is not finite.
-fn fill<const C: usize>(k: &RunConstants, samples: &[Sample], skip: usize, out: Option<&mut [f64]>, watch: &mut Watch) {
+fn fill<const C: usize>(
+    k: &RunConstants,
+    block: &[Sample],
+    first: usize,
+    skip: usize,
+    out: Option<&mut [f64]>,
+    watch: &mut Watch,
+) {
     let Some(out) = out else {
-        samples.iter().enumerate().for_each(|(i, s)| watch.see(i, k.value(C, s)));
+        block.iter().enumerate().for_each(|(i, s)| watch.see(first + i, k.value(C, s)));
         return;
     };
-    for (o, s) in out.iter_mut().zip(&samples[skip..]) {
+    let lead = skip.saturating_sub(first).min(block.len());
+    block[..lead].iter().enumerate().for_each(|(i, s)| watch.see(first + i, k.value(C, s)));
+    if lead == block.len() {
+        return; // a block of skipped samples
+    }
+    let rows = &mut out[first + lead - skip..first + block.len() - skip];
+    for (o, s) in rows.iter_mut().zip(&block[lead..]) {
         *o = k.value(C, s);
     }
-    samples[..skip].iter().enumerate().for_each(|(i, s)| watch.see(i, k.value(C, s)));
-    if out.iter().all(|v| v.is_finite()) {
-        watch.has_number |= !out.is_empty();
+    if rows.iter().all(|v| v.is_finite()) {
+        watch.has_number |= !rows.is_empty();
     } else {
-        out.iter().enumerate().for_each(|(i, &v)| watch.see(skip + i, v));
+        rows.iter().enumerate().for_each(|(i, &v)| watch.see(first + lead + i, v));
     }
 }
+
+/// Samples per block of [`write_columns`]: a block's samples (about 200 bytes each) stay in the L1
+/// cache while every column is written from them, instead of all samples being read once per column.
+const BLOCK: usize = 64;
 
 // the arms of `fill_column!` in `write_columns` are the columns 0 to 32
 const _: () = assert!(COLUMNS.len() == 33);
 
 /// [`fill`] for the column `c`, a run-time index.
 macro_rules! fill_column {
-    ($c:expr, $k:expr, $samples:expr, $skip:expr, $out:expr, $watch:expr; $($n:literal)*) => {
+    ($c:expr, $k:expr, $block:expr, $first:expr, $skip:expr, $out:expr, $watch:expr; $($n:literal)*) => {
         match $c {
-            $($n => fill::<$n>($k, $samples, $skip, $out, $watch),)*
+            $($n => fill::<$n>($k, $block, $first, $skip, $out, $watch),)*
             c => panic!("output column {c} of {}", COLUMNS.len()),
         }
     };
@@ -348,13 +365,15 @@ pub fn write_columns(
     assert!(out.iter().all(|c| c.len() + skip == samples.len()), "output slices fit the samples");
     let k = RunConstants::new(model);
     let state_only = STATE_COLUMNS.filter(|c| !selection.indices.contains(c));
-    let mut watch: Vec<Watch> = Vec::with_capacity(selection.len() + STATE_COLUMNS.len());
-    let columns = selection.indices.iter().copied().zip(out.iter_mut().map(Some)).chain(state_only.map(|c| (c, None)));
-    for (c, col) in columns {
-        let mut w = Watch::new(c);
-        let col = col.map(|c| &mut **c);
-        fill_column!(c, &k, samples, skip, col, &mut w; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32);
-        watch.push(w);
+    let mut columns: Vec<(usize, Option<&mut [f64]>)> =
+        selection.indices.iter().copied().zip(out.iter_mut().map(|c| Some(&mut **c))).collect();
+    columns.extend(state_only.map(|c| (c, None)));
+    let mut watch: Vec<Watch> = columns.iter().map(|&(c, _)| Watch::new(c)).collect();
+    for (b, block) in samples.chunks(BLOCK).enumerate() {
+        for ((c, col), w) in columns.iter_mut().zip(&mut watch) {
+            let col = col.as_deref_mut();
+            fill_column!(*c, &k, block, b * BLOCK, skip, col, w; 0 1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16 17 18 19 20 21 22 23 24 25 26 27 28 29 30 31 32);
+        }
     }
     watch.sort_by_key(|w| w.column);
     watch.iter().find_map(|w| {
@@ -510,11 +529,14 @@ mod tests {
             }
             let sel = Selection::from_names(&["effective_torque_ratio", "time_s", "lockup_lock_work_j", "flow_m3_s"])
                 .unwrap();
-            let mut bufs = vec![vec![0.0; times.len() - 1]; sel.len()];
-            let mut out: Vec<&mut [f64]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
-            assert_eq!(write_columns(&model, &traj.samples, &sel, 1, &mut out), None);
-            for (k, &c) in sel.indices().iter().enumerate() {
-                assert_eq!(bits(&bufs[k]), bits(&all[c][1..]), "{}", COLUMNS[c]);
+            // skips within the first block, at a block's end, just past it, a few blocks in
+            for skip in [1, BLOCK, BLOCK + 1, 2 * BLOCK + 3] {
+                let mut bufs = vec![vec![0.0; times.len() - skip]; sel.len()];
+                let mut out: Vec<&mut [f64]> = bufs.iter_mut().map(|b| b.as_mut_slice()).collect();
+                assert_eq!(write_columns(&model, &traj.samples, &sel, skip, &mut out), None);
+                for (k, &c) in sel.indices().iter().enumerate() {
+                    assert_eq!(bits(&bufs[k]), bits(&all[c][skip..]), "{} (skip {skip})", COLUMNS[c]);
+                }
             }
             for s in &traj.samples[..5] {
                 assert_eq!(bits(&row(&model, s)), bits(&reference_row(&model, s)));
@@ -568,6 +590,19 @@ mod tests {
         zero_pump[0].u[TURBINE] = 0.0;
         assert!(check(&zero_pump, &["speed_ratio"]).is_none());
         assert!(nan_not_expected("pump_torque_nm") && !nan_not_expected("speed_ratio"));
+        // over several blocks: the first bad sample of the run, in a later block or a skipped one
+        let times: Vec<f64> = (0..301).map(|i| i as f64 * 0.01).collect();
+        let traj = simulate(&model, &drive, &times, &InitialState::default(), &SolverOptions::default()).unwrap();
+        let mut bad = traj.samples.clone();
+        bad[2 * BLOCK + 5].torque[2] = f64::NAN;
+        bad[BLOCK + 2].torque[2] = f64::INFINITY;
+        bad[BLOCK + 9].torque[2] = f64::NAN;
+        let sel = Selection::from_names(&["stator_torque_nm"]).unwrap();
+        for skip in [0, BLOCK + 3, 2 * BLOCK + 7] {
+            let mut buf = vec![0.0; times.len() - skip];
+            let o = write_columns(&model, &bad, &sel, skip, &mut [buf.as_mut_slice()]).unwrap();
+            assert_eq!((o.value, o.time_s), (f64::INFINITY, times[BLOCK + 2]), "skip {skip}");
+        }
         assert!(!nan_not_expected("k_factor_rpm_per_sqrt_nm"));
     }
 }

@@ -3,10 +3,8 @@
 //! fixed-size NDF/BDF integrator of [`crate::engine::bdf`].
 
 use crate::engine::bdf::roots::RootFinder;
-use crate::engine::bdf::{Bdf, N_MAX};
+use crate::engine::bdf::{Bdf, EXACT_MAX, N_MAX};
 
-/// The integrator's size for segments of at most 4 states (every converter segment).
-const N_SMALL: usize = 4;
 use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
 
 /// A smooth system `M ẋ = f(x, t)` with event functions, as one mode of a piecewise-smooth model.
@@ -72,15 +70,19 @@ pub fn run_segment_with_stops<S: SmoothSegment>(
         return crate::engine::bdf::crosscheck::run_segment(seg, x0, t0, t_end, times_s, o, samples, steps);
     }
     let stops = &stops[stops.partition_point(|&s| s <= t0)..];
-    if x0.len() <= N_SMALL {
-        run_segment_on::<S, N_SMALL>(seg, x0, t0, t_end, stops, times_s, o, samples, steps)
-    } else {
-        run_segment_on::<S, N_MAX>(seg, x0, t0, t_end, stops, times_s, o, samples, steps)
+    // the converter's segments (1 to 4 states) on integrators of their exact size
+    const _: () = assert!(EXACT_MAX == 4);
+    match x0.len() {
+        1 => run_segment_on::<S, 1>(seg, x0, t0, t_end, stops, times_s, o, samples, steps),
+        2 => run_segment_on::<S, 2>(seg, x0, t0, t_end, stops, times_s, o, samples, steps),
+        3 => run_segment_on::<S, 3>(seg, x0, t0, t_end, stops, times_s, o, samples, steps),
+        4 => run_segment_on::<S, 4>(seg, x0, t0, t_end, stops, times_s, o, samples, steps),
+        _ => run_segment_on::<S, N_MAX>(seg, x0, t0, t_end, stops, times_s, o, samples, steps),
     }
 }
 
-/// [`run_segment`] on an integrator of `N` states at most: its arrays are `N` long, so that the
-/// converter's segments (4 states at most) do not carry the vehicle's 12.
+/// [`run_segment`] on an integrator of `N` states: exactly `N` up to [`EXACT_MAX`] (its loops
+/// unrolled), at most `N` beyond.
 #[allow(clippy::too_many_arguments)]
 fn run_segment_on<S: SmoothSegment, const N: usize>(
     seg: &S,

@@ -1,6 +1,6 @@
 //! Dense LU factorisation with partial pivoting on fixed-size stack arrays (`n ≤ N_MAX`).
 
-use super::{Matrix, Vector};
+use super::{dim, Matrix, Vector};
 
 /// An LU factorisation `P A = L U` of the leading `n × n` block of a [`Matrix`], in place
 /// (`L` below the diagonal with a unit diagonal, `U` on and above it).
@@ -16,6 +16,12 @@ impl<const N: usize> Lu<N> {
         Self { a: [[0.0; N]; N], piv: [0; N], n }
     }
 
+    /// The size the loops run over ([`dim`]).
+    #[inline(always)]
+    fn n(&self) -> usize {
+        dim::<N>(self.n)
+    }
+
     /// Factorise `a` (its leading `n × n` block). False when a pivot is zero or not finite (a
     /// singular or NaN matrix); the factorisation is then unusable.
     pub(super) fn factor(&mut self, a: &Matrix<N>) -> bool {
@@ -24,7 +30,7 @@ impl<const N: usize> Lu<N> {
 
     /// Factorise the matrix with entries `a(i, j)` (its leading `n × n` block), as [`Lu::factor`].
     pub(super) fn factor_from(&mut self, a: impl Fn(usize, usize) -> f64) -> bool {
-        let n = self.n;
+        let n = self.n();
         for (i, row) in self.a.iter_mut().enumerate().take(n) {
             for (j, v) in row.iter_mut().enumerate().take(n) {
                 *v = a(i, j);
@@ -64,7 +70,7 @@ impl<const N: usize> Lu<N> {
 
     /// Solve `A x = b` in place (`b` becomes `x`).
     pub(super) fn solve(&self, b: &mut Vector<N>) {
-        let (n, m) = (self.n, &self.a);
+        let (n, m) = (self.n(), &self.a);
         for k in 0..n {
             b.swap(k, self.piv[k]);
         }

@@ -53,6 +53,21 @@ use lu::Lu;
 pub const N_MAX: usize = 12;
 /// The highest order.
 pub const MAX_ORDER: usize = 5;
+/// Integrators of at most this many states are instantiated for their exact size (`n = N`, every
+/// converter segment): their loops run to the constant `N`, unrolled and without bounds checks.
+/// Larger ones (the vehicle's, `N = N_MAX`) run their loops to their `n`.
+pub const EXACT_MAX: usize = 4;
+
+/// The number of states the loops of an integrator of size `N` with `n` states run over: `N` for an
+/// exact-size one ([`EXACT_MAX`]), else `n`.
+#[inline(always)]
+pub(crate) const fn dim<const N: usize>(n: usize) -> usize {
+    if N <= EXACT_MAX {
+        N
+    } else {
+        n
+    }
+}
 
 pub(crate) type Vector<const N: usize> = [f64; N];
 pub(crate) type Matrix<const N: usize> = [[f64; N]; N];
@@ -168,6 +183,9 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
         if n == 0 || n > N || x0.len() != n {
             return Err(fail(format!("{n} states ({} given): the solver takes 1 to {N}", x0.len())));
         }
+        if N <= EXACT_MAX && n != N {
+            return Err(fail(format!("{n} states on an integrator of exactly {N}")));
+        }
         let atol_v = seg.atol(o);
         let mut atol = [0.0; N];
         atol[..n].copy_from_slice(&atol_v[..n]);
@@ -210,9 +228,15 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
         Ok(b)
     }
 
+    /// The number of states the loops run over ([`dim`]).
+    #[inline(always)]
+    fn n(&self) -> usize {
+        dim::<N>(self.n)
+    }
+
     /// `D_1 = h ẋ(t0)`, from `M ẋ = f`.
     fn init_derivative(&mut self) -> Result<(), String> {
-        let n = self.n;
+        let n = self.n();
         let mut f = [0.0; N];
         self.seg.rhs(&self.d[0][..n], self.t, &mut f[..n]);
         self.stats.rhs += 1;
@@ -238,7 +262,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
 
     /// The state reached (length `n`).
     pub fn x(&self) -> &[f64] {
-        &self.d[0][..self.n]
+        &self.d[0][..self.n()]
     }
 
     /// The current order.
@@ -249,7 +273,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
     /// The state at `t` from the last step's interpolating polynomial (for `t` in that step; exact
     /// at its end), into `out[..n]`.
     pub fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let (n, h) = (self.n, self.h);
+        let (n, h) = (self.n(), self.h);
         let out = &mut out[..n];
         out.copy_from_slice(&self.d[0][..n]);
         let (s, mut p) = ((t - self.t) / h, 1.0);
@@ -268,7 +292,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
 
     /// Rescale the differences to a step `factor · h` (order `order`), and the step.
     fn rescale(&mut self, factor: f64) {
-        let (k, n) = (self.order, self.n);
+        let (k, n) = (self.order, self.n());
         let ru = rescale_matrix(k, factor);
         let mut out = [[0.0; N]; MAX_ORDER + 1];
         for (j, o) in out.iter_mut().enumerate().take(k + 1) {
@@ -328,7 +352,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
 
     /// Try the step to `t_new` with the current `h` and order.
     fn attempt(&mut self, t_new: f64) -> Attempt {
-        let (n, k) = (self.n, self.order);
+        let (n, k) = (self.n(), self.order);
         let (mut pred, mut psi) = ([0.0; N], [0.0; N]);
         for j in 0..=k {
             for (p, v) in pred[..n].iter_mut().zip(&self.d[j][..n]) {
@@ -369,7 +393,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
     /// Factorise `M − cJ`, re-evaluating `J` at `(pred, t)` first when `new_jacobian`. A Newton
     /// failure when the matrix is singular (a smaller step may help), fatal when `J` is not finite.
     fn refactor(&mut self, t: f64, pred: &Vector<N>, c: f64, new_jacobian: bool) -> Result<(), Attempt> {
-        let n = self.n;
+        let n = self.n();
         if new_jacobian {
             let (mut e, mut col) = ([0.0; N], [0.0; N]);
             for j in 0..n {
@@ -404,7 +428,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
 
     /// The corrector: `(x, d, iterations)`, or None when it does not converge.
     fn newton(&mut self, t: f64, c: f64, pred: &Vector<N>, psi: &Vector<N>) -> Option<(Vector<N>, Vector<N>, usize)> {
-        let n = self.n;
+        let n = self.n();
         // CVODE's bound, or SciPy's `max(10 ε / rtol, min(0.03, √rtol))` when tighter: a state at rest
         // is then an equilibrium to about √rtol of the tolerance
         let tol = (NEWTON_TOL / ERROR_CONST[self.order])
@@ -447,7 +471,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
 
     /// Accept the corrected step or give the factor to cut it by.
     fn error_test(&mut self, t_new: f64, x: Vector<N>, d: Vector<N>, iters: usize) -> Attempt {
-        let (n, k) = (self.n, self.order);
+        let (n, k) = (self.n(), self.order);
         for i in 0..n {
             self.weights[i] = 1.0 / (self.atol[i] + self.rtol * x[i].abs());
         }
@@ -485,7 +509,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
     /// longest next step, and that step.
     fn select_order_and_step(&mut self) {
         self.select_due = false;
-        let (n, k) = (self.n, self.order);
+        let (n, k) = (self.n(), self.order);
         if self.n_equal < k + 1 {
             return;
         }
@@ -527,7 +551,8 @@ fn rescale_matrix(k: usize, factor: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1
     let mut ru = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
     for i in 0..=k {
         for j in 0..=k {
-            ru[i][j] = (0..=k).map(|m| r[i][m] * U[m][j]).sum();
+            // U is upper triangular (its factor m = j + 1 vanishes below the diagonal)
+            ru[i][j] = (0..=j).map(|m| r[i][m] * U[m][j]).sum();
         }
     }
     ru

@@ -314,3 +314,50 @@ fn failures_are_solver_errors() {
     let (t, m) = solver_error(&Linear::new(1, identity(), a), &limited);
     assert!(m == "more than 5 steps" && t > 0.0 && t < 2.0, "{t}: {m}");
 }
+
+/// Step a segment of 3 states to `t_end` on an integrator of size `N`, recording every step's time,
+/// state and order.
+fn trace<const N: usize>(seg: &Linear, x0: &[f64], t_end: f64) -> Vec<(f64, Vec<f64>, usize)> {
+    let o = options(1e-7);
+    let mut bdf = Bdf::<_, N>::new(seg, x0, 0.0, t_end, &o).unwrap();
+    let mut out = vec![];
+    while bdf.t() < t_end {
+        bdf.step(t_end).unwrap();
+        let mut mid = [0.0; 3];
+        bdf.interpolate(bdf.t() - 1e-3, &mut mid);
+        out.push((bdf.t(), [bdf.x(), &mid[..]].concat(), bdf.order()));
+    }
+    out
+}
+
+#[test]
+fn an_exact_size_integrator_steps_bit_for_bit_like_the_general_one() {
+    // issue 16: segments of up to 4 states run on integrators of their exact size, whose loops run
+    // to the constant N; the arithmetic must be the general integrator's, bit for bit
+    let mut a = [[0.0; N_MAX]; N_MAX];
+    a[0][..3].copy_from_slice(&[-1.0, 2.0, 0.0]);
+    a[1][..3].copy_from_slice(&[-2.0, -1.0, 0.5]);
+    a[2][..3].copy_from_slice(&[0.0, 0.0, -50.0]);
+    let mut mass = identity();
+    mass[0][2] = 0.3;
+    mass[2][0] = 0.3;
+    let seg = Linear { extra: Some(|x, t, out| out[2] += (3.0 * t).sin() * x[0] * x[1]), ..Linear::new(3, mass, a) };
+    let exact = trace::<3>(&seg, &[1.0, 0.0, 2.0], 4.0);
+    let general = trace::<N_MAX>(&seg, &[1.0, 0.0, 2.0], 4.0);
+    assert!(exact.len() > 50 && exact.iter().any(|s| s.2 > 2), "a real run: {} steps", exact.len());
+    assert_eq!(exact, general);
+    // an exact-size integrator takes only its size
+    let e = Bdf::<_, 4>::new(&seg, &[1.0, 0.0, 2.0], 0.0, 1.0, &options(1e-6)).err().expect("an error");
+    assert!(e.to_string().contains("3 states on an integrator of exactly 4"), "{e}");
+}
+
+#[test]
+fn the_rescaling_matrix_u_is_upper_triangular() {
+    // `rescale_matrix` sums R U over the upper triangle of U only
+    for i in 0..=super::MAX_ORDER {
+        for j in 0..i {
+            assert_eq!(super::U[i][j], 0.0, "U[{i}][{j}]");
+        }
+        assert_ne!(super::U[i][i], 0.0, "U[{i}][{i}]");
+    }
+}
