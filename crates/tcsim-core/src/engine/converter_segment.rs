@@ -342,8 +342,12 @@ impl<'a> Segment<'a> {
     }
 
     /// Root functions, each positive while the mode holds (with the hysteresis `h`).
+    /// The rates and forces are computed only for a root that needs them (the stator's torque, a
+    /// held flow's balance, the clutch's breakaway): the stator's speed and the flow need `u` alone.
     pub(super) fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
-        let (u, ud, f) = self.kinematics(x, t);
+        let u = self.full(x, t);
+        let kinematics = std::cell::OnceCell::new();
+        let rates = || *kinematics.get_or_init(|| self.kinematics(x, t));
         let slip = u[PUMP] - u[TURBINE];
         let cap = self.drive.lockup().map_or(0.0, |c| c.capacity(t));
         for (k, root) in self.roots.iter().enumerate() {
@@ -353,8 +357,11 @@ impl<'a> Segment<'a> {
                     self.mode,
                     &u,
                     h,
-                    || self.external_torques(&ud, &f)[STATOR],
-                    || self.held_flow_balance(&u, &ud),
+                    || {
+                        let (_, ud, f) = rates();
+                        self.external_torques(&ud, &f)[STATOR]
+                    },
+                    || self.held_flow_balance(&u, &rates().1),
                 ),
                 Root::Lockup(LockupRoot::Lock) => lockup::lock_root(cap, slip),
                 Root::Lockup(LockupRoot::Arm) => match self.mode.lockup {
@@ -363,6 +370,7 @@ impl<'a> Segment<'a> {
                 },
                 Root::Lockup(LockupRoot::Breakaway) => {
                     let k_s = self.drive.lockup().map_or(1.0, |c| c.static_to_kinetic);
+                    let (_, ud, f) = rates();
                     lockup::breakaway_root(cap, k_s, self.lockup_torque(&u, &ud, &f, t))
                 }
             };
