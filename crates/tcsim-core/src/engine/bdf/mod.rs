@@ -292,22 +292,35 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
 
     /// Rescale the differences to a step `factor · h` (order `order`), and the step.
     fn rescale(&mut self, factor: f64) {
-        let (k, n) = (self.order, self.n());
-        let ru = rescale_matrix(k, factor);
+        // the order as a constant: the small matrix products unrolled (the same arithmetic)
+        match self.order {
+            1 => self.rescale_order::<1>(factor),
+            2 => self.rescale_order::<2>(factor),
+            3 => self.rescale_order::<3>(factor),
+            4 => self.rescale_order::<4>(factor),
+            _ => self.rescale_order::<MAX_ORDER>(factor),
+        }
+        self.h *= factor;
+        self.n_equal = 0;
+    }
+
+    /// [`Self::rescale`]'s differences at the order `K` (the current one).
+    fn rescale_order<const K: usize>(&mut self, factor: f64) {
+        debug_assert!(self.order == K);
+        let n = self.n();
+        let ru = rescale_matrix(K, factor);
         let mut out = [[0.0; N]; MAX_ORDER + 1];
-        for (j, o) in out.iter_mut().enumerate().take(k + 1) {
-            for i in 0..=k {
+        for (j, o) in out.iter_mut().enumerate().take(K + 1) {
+            for i in 0..=K {
                 let c = ru[i][j];
                 for (o, v) in o[..n].iter_mut().zip(&self.d[i][..n]) {
                     *o += c * v;
                 }
             }
         }
-        for (d, o) in self.d.iter_mut().zip(&out).take(k + 1) {
+        for (d, o) in self.d.iter_mut().zip(&out).take(K + 1) {
             d[..n].copy_from_slice(&o[..n]);
         }
-        self.h *= factor;
-        self.n_equal = 0;
     }
 
     /// One accepted step, ending at `t_end` at the latest.
@@ -546,6 +559,7 @@ enum Attempt {
 
 /// `R(k, r) U(k)` of Shampine & Reichelt (1997) eq. (2.6): the differences for a step `r h` are
 /// `D ← (R U)ᵀ D` (`U = R(k, 1)`; `R(k, r)_{ij} = Π_{m=1..i} (m − 1 − r j)/m`).
+#[inline(always)]
 fn rescale_matrix(k: usize, factor: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] {
     let r = r_matrix(k, factor);
     let mut ru = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
@@ -559,6 +573,7 @@ fn rescale_matrix(k: usize, factor: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1
 }
 
 /// `R(k, f)` (zero beyond row and column `k`).
+#[inline(always)]
 const fn r_matrix(k: usize, f: f64) -> [[f64; MAX_ORDER + 1]; MAX_ORDER + 1] {
     let mut r = [[0.0; MAX_ORDER + 1]; MAX_ORDER + 1];
     let mut j = 0;
