@@ -24,6 +24,7 @@ pub fn mix(y: &[f64], i: usize, w: f64) -> f64 {
 
 /// `y(t)` linear between the points `(x, y)` (x strictly increasing), end values held outside;
 /// a single point is a constant.
+#[inline]
 pub fn linear_held(x: &[f64], y: &[f64], t: f64) -> f64 {
     let n = x.len();
     if n == 1 || t <= x[0] {

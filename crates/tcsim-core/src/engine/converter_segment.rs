@@ -306,9 +306,10 @@ impl<'a> Segment<'a> {
         if self.n > 0 {
             let mut r = [0.0; 4];
             self.reduced_rhs(&u, &f, t, &mut r[..self.n]);
+            // over all 4 columns: `inv` and `r` are zero beyond the n states
             for (c, rate) in ud.iter_mut().enumerate() {
                 if let Some(i) = self.col[c] {
-                    *rate = (0..self.n).map(|k| self.inv[i][k] * r[k]).sum();
+                    *rate = (0..4).map(|k| self.inv[i][k] * r[k]).sum();
                 }
             }
         }

@@ -156,6 +156,7 @@ impl Signal {
     }
 
     /// Value at time `t` (linear interpolation, end values held).
+    #[inline]
     pub fn value(&self, t: f64) -> f64 {
         self.interpolate(&self.value, t)
     }
@@ -169,6 +170,7 @@ impl Signal {
         self.interpolate(&self.rate, t)
     }
 
+    #[inline]
     fn interpolate(&self, y: &[f64], t: f64) -> f64 {
         crate::interp::linear_held(&self.time_s, y, t)
     }
