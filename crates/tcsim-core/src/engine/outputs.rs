@@ -327,6 +327,9 @@ fn fill<const C: usize>(
     }
     if rows.iter().all(|v| v.is_finite()) {
         watch.has_number |= !rows.is_empty();
+    } else if rows.iter().all(|v| v.is_nan()) {
+        // a column the run lacks (the clutch's without a clutch): its first NaN only
+        watch.first_nan = watch.first_nan.min(first + lead);
     } else {
         rows.iter().enumerate().for_each(|(i, &v)| watch.see(first + lead + i, v));
     }
