@@ -372,3 +372,26 @@ def test_the_command_line_on_a_local_cluster(cli, tmp_path, study_path, unchunke
     assert r.code == 0, r.stderr
     assert "45 rows in 4 chunks of 4 cases (4 computed, 0 kept from an earlier run)" in r.stdout
     pd.testing.assert_frame_equal(read_shards(tmp_path / "s"), unchunked, check_exact=True)
+
+
+def test_the_summary_counts_finished_runs_without_a_value():
+    # a run that finished but never reached the speed has no time to it: the summary says how many
+    # (the "runs without outputs" line counts failed runs only; trial finding, issue 16)
+    from types import SimpleNamespace
+
+    from tcsim.cli.monte_carlo import summary_lines
+
+    df = pd.DataFrame(
+        {
+            "model": ["table"] * 4 + ["hrovat-tobler"] * 2,
+            "error": ["", "", "", "refused"] + [""] * 2,
+            "time_0_100_km_h_s": [9.0, 11.0, np.nan, np.nan, np.nan, np.nan],
+        }
+    )
+    study = SimpleNamespace(outputs=("time_0_100_km_h_s",), models=("table", "hrovat-tobler"))
+    assert summary_lines(df, study) == [
+        "  time_0_100_km_h_s: table 10 ± 1.41 (n = 2; 1 finished without a value), "
+        "hrovat-tobler - (n = 0; 2 finished without a value)"
+    ]
+    df["time_0_100_km_h_s"] = [9.0, 11.0, 10.0, np.nan, 8.0, 8.0]
+    assert summary_lines(df, study) == ["  time_0_100_km_h_s: table 10 ± 1 (n = 3), hrovat-tobler 8 ± 0 (n = 2)"]

@@ -42,14 +42,17 @@ TABLE = "monte_carlo.csv"
 
 
 def summary_lines(df: pd.DataFrame, study: MonteCarloStudy) -> list[str]:
-    """Per output one line: each model's mean and standard deviation over its finished runs."""
+    """Per output one line: each model's mean and standard deviation over its finished runs, and
+    how many finished runs have no value of it (a speed never reached)."""
     lines = []
     for output in study.outputs:
         parts = []
         for model in study.models:
-            v = df.loc[(df["model"] == model) & (df["error"] == ""), output].astype(float)
-            v = v[v.notna()]
-            parts.append(f"{model} {v.mean():.4g} ± {v.std(ddof=1):.3g} (n = {len(v)})" if len(v) else f"{model} -")
+            finished = df.loc[(df["model"] == model) & (df["error"] == ""), output].astype(float)
+            v = finished[finished.notna()]
+            part = f"{model} {v.mean():.4g} ± {v.std(ddof=1):.3g} (n = {len(v)}" if len(v) else f"{model} - (n = 0"
+            missing = len(finished) - len(v)
+            parts.append(part + (f"; {missing} finished without a value)" if missing else ")"))
         lines.append(f"  {output}: " + ", ".join(parts))
     return lines
 
