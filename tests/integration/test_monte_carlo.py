@@ -10,6 +10,7 @@ import json
 import math
 import signal
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pandas as pd
@@ -19,6 +20,7 @@ from scipy import stats
 import tcsim.analysis.monte_carlo as mc
 from interrupts import ClientStopped, interrupt, stop_after
 from tcsim.analysis.monte_carlo import draw_cases, monte_carlo_study, run_monte_carlo
+from tcsim.cli.monte_carlo import summary_lines
 from tcsim.errors import InputError
 from tcsim.io.shards import MANIFEST, SHARDS, read_shards, run_to_shards, shard_name
 from tcsim.models.converter import load_converter
@@ -377,10 +379,6 @@ def test_the_command_line_on_a_local_cluster(cli, tmp_path, study_path, unchunke
 def test_the_summary_counts_finished_runs_without_a_value():
     # a run that finished but never reached the speed has no time to it: the summary says how many
     # (the "runs without outputs" line counts failed runs only; trial finding, issue 16)
-    from types import SimpleNamespace
-
-    from tcsim.cli.monte_carlo import summary_lines
-
     df = pd.DataFrame(
         {
             "model": ["table"] * 4 + ["hrovat-tobler"] * 2,
