@@ -386,3 +386,46 @@ def test_an_implausible_grid_value_is_warned_of_once_naming_the_study_file(tmp_p
         f'{path}: distributions."{key}".values[1] = 50: [inertia].pump_kg_m2 = 50 is outside the plausible '
         "0.0001 to 10 kg·m² (pump, turbine and stator inertias with their fluid)"
     ], said
+
+
+@pytest.mark.parametrize(
+    ("models", "key", "distribution", "warned"),
+    [
+        # the H&T geometry's shape effect: no table or quasi-dynamic run sees it (a trial's sweep)
+        ('["table", "quasi-dynamic"]', "converter.geometry.pump_shape_effect_m2", "grid", True),
+        ('["table", "quasi-dynamic"]', "converter.geometry.pump_shape_effect_m2", "uniform", True),
+        ('["table", "hrovat-tobler"]', "converter.geometry.pump_shape_effect_m2", "grid", False),
+        ('["table"]', PUMP, "grid", True),
+        ('["quasi-dynamic"]', PUMP, "grid", False),
+        ('["table"]', "converter.inertia.pump_kg_m2", "uniform", False),
+        ('["table"]', MASS, "uniform", False),
+    ],
+)
+def test_a_parameter_no_model_uses_is_warned_of(tmp_path, models, key, distribution, warned):
+    """Trial finding: a swept parameter that changes none of the study's models ran every grid point
+    the same without a word."""
+    low, high = (1800.0, 2000.0) if key == MASS else (0.1, 0.12) if "inertia" in key else (0.0, 0.001)
+    dist = (
+        f'{{ kind = "grid", values = [{low}, {high}] }}'
+        if distribution == "grid"
+        else f'{{ kind = "uniform", low = {low}, high = {high} }}'
+    )
+    runs = "" if distribution == "grid" else "runs = 2\n"
+    text = f'seed = 1\n{runs}models = {models}\noutputs = ["time_0_50_km_h_s"]\n[distributions]\n"{key}" = {dist}\n'
+    path = write(tmp_path / "s.toml", text)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        monte_carlo_study(load_study_file(path))
+    said = [str(w.message) for w in caught if issubclass(w.category, TcsimWarning)]
+    unused = [m for m in said if "its values change no run" in m]
+    if warned:
+        names = ", ".join(json_list(models))
+        assert unused == [
+            f'{path}: distributions."{key}": none of the study\'s models ({names}) uses {key}; its values change no run'
+        ], said
+    else:
+        assert unused == [], said
+
+
+def json_list(text: str) -> list[str]:
+    return [s.strip().strip('"') for s in text.strip("[]").split(",")]

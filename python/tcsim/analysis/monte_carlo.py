@@ -53,6 +53,7 @@ from ..models.study_file import (
     converter_data,
     count_grid_points,
     vehicle_data,
+    warn_about_unused_parameters,
 )
 from ..models.vehicle import Vehicle
 from ..simulation.launch import launch_columns
@@ -324,6 +325,7 @@ def monte_carlo_study(file: StudyFile, threads: int = 0) -> MonteCarloStudy:
         threads=threads,
     )
     _ = study._base  # every model of the converter built (an InputError now, not in a worker)
+    warn_about_unused_parameters(file)
     return study
 
 

@@ -597,6 +597,49 @@ def _check_support(p: Parameter, path: str, converter: Converter, vehicle: Vehic
             raise InputError(path, f'distributions."{p.key}"', describe(p.distribution), expected) from None
 
 
+def _model_specs(p: Parameter, value: float, converter: Converter, models: Sequence[str]) -> list[dict] | None:
+    """The specifications of the study's models with ``p`` at ``value`` (None when refused)."""
+    from .dynamic import dynamic_model  # noqa: PLC0415  (dynamic imports this module's neighbours)
+
+    try:
+        conv = build_converter(converter_data(converter.to_toml_dict(), {(p.section, p.name): value}), converter.path)
+        return [dynamic_model(conv, m).spec for m in models]
+    except InputError:
+        return None
+
+
+def _unused(p: Parameter, converter: Converter, models: Sequence[str]) -> bool:
+    """Whether a converter parameter changes none of ``models``: their specifications compared at
+    two values of it (its grid's, or its support's ends, else its value in the file)."""
+    if p.target != "converter":
+        return False
+    candidates: list[Any] = p.distribution.points() if isinstance(p.distribution, Grid) else _probes(p.distribution)
+    candidates.append(getattr(getattr(converter, p.section, None), p.name, None))
+    specs = []
+    for value in dict.fromkeys(v for v in candidates if isinstance(v, float) and math.isfinite(v)):
+        spec = _model_specs(p, value, converter, models)
+        if spec is not None:
+            specs.append(spec)
+        if len(specs) == 2:
+            break
+    return len(specs) == 2 and specs[0] == specs[1]
+
+
+def warn_about_unused_parameters(file: StudyFile) -> None:
+    """Warn of each converter parameter that changes none of the study's models (a trial swept an
+    H&T geometry value with the table and quasi-dynamic models only: every grid point ran the
+    same, without a word). Called once the study is checked whole, so that a refused file's
+    message stays its one line."""
+    for p in file.parameters:
+        if _unused(p, file.converter, file.models):
+            warnings.warn(
+                f"{file.path}: distributions.{_quoted(p.key)}: none of the study's models "
+                f"({', '.join(file.models)}) uses {p.key}; its values change no run",
+                TcsimWarning,
+                stacklevel=3,
+            )
+
+
 def load_study_file(path: str | Path) -> StudyFile:
     """A Monte Carlo study file read and checked: its schema, the vehicle and converter it names
     (relative to the file), its models (each buildable from the converter), and each parameter
