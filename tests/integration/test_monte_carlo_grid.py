@@ -429,3 +429,19 @@ def test_a_parameter_no_model_uses_is_warned_of(tmp_path, models, key, distribut
 
 def json_list(text: str) -> list[str]:
     return [s.strip().strip('"') for s in text.strip("[]").split(",")]
+
+
+def test_grids_alone_beyond_memory_blame_the_grids_not_the_runs(cli, tmp_path):
+    # trial finding: the refusal of a 10⁷-point grid named "runs = 1"
+    values = ", ".join(str(0.001 * k) for k in range(400))
+    mass = ", ".join(str(1500.0 + k) for k in range(400))
+    text = f'{BASE}[distributions]\n"{PUMP}" = {{ kind = "grid", values = [{values}] }}\n'
+    text += f'"{MASS}" = {{ kind = "grid", values = [{mass}] }}\n'
+    r = cli("monte-carlo", write(tmp_path / "s.toml", text), "--out", tmp_path / "o")
+    lines = r.stderr.strip().splitlines()
+    assert r.code == 2 and len(lines) == 1, r.stderr
+    assert (
+        "distributions = '160000 grid points': expected at most 100000 cases without --chunk-size "
+        "(400 × 400 grid points × 1 run = 160000 cases; more: --chunk-size streams them to shards)" in lines[0]
+    ), lines[0]
+    assert not (tmp_path / "o").exists()

@@ -93,6 +93,8 @@ def monte_carlo(
         grid = sf.doc.grid_points > 1
         expected = f"at most {MAX_RUNS_UNCHUNKED}{' cases' if grid else ''} without --chunk-size ("
         expected += f"{sf.doc.cases_text()}; {more})" if grid else f"{more})"
+        if grid and sf.doc.n_runs == 1:  # the grids alone: not the runs' fault
+            raise InputError(file, "distributions", f"{sf.doc.grid_points} grid points", expected)
         raise InputError(file, "runs", sf.doc.n_runs, expected)
     study = monte_carlo_study(sf)
     inputs = [file, sf.vehicle.path, sf.converter.path]
