@@ -445,3 +445,18 @@ def test_grids_alone_beyond_memory_blame_the_grids_not_the_runs(cli, tmp_path):
         "(400 × 400 grid points × 1 run = 160000 cases; more: --chunk-size streams them to shards)" in lines[0]
     ), lines[0]
     assert not (tmp_path / "o").exists()
+
+
+@pytest.mark.parametrize(
+    ("top", "grid", "field", "shown"),
+    [
+        ("", '{ kind = "grid", start = 0.1, stop = 0.3, num = 3.0 }', f'distributions."{PUMP}".num', "3.0"),
+        ("runs = 2.0\n", '{ kind = "uniform", low = 0.1, high = 0.3 }', "runs", "2.0"),
+    ],
+)
+def test_an_integer_written_as_a_float_is_shown_as_written(tmp_path, top, grid, field, shown):
+    # trial finding: `num = 3.0` was refused as "num = 3: expected a valid integer"
+    path = write(tmp_path / "s.toml", f'{BASE}{top}[distributions]\n"{PUMP}" = {grid}\n')
+    with pytest.raises(InputError) as e:
+        load_study_file(path)
+    assert str(e.value) == f"{path}: {field} = {shown}: expected an integer, written without a decimal point"

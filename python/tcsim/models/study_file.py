@@ -43,7 +43,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .. import _core
-from ..errors import InputError, TcsimWarning, from_core
+from ..errors import CoreText, InputError, TcsimWarning, from_core
 from .converter import MODELS, Converter, bundled_names, parse_converter
 from .vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, _load_named_converter, load_vehicle
 
@@ -377,6 +377,9 @@ def _validation_error(err: ValidationError, path: str) -> InputError:
         msg = "a known key (docs/study.md lists the keys of a study file)"
     elif e["type"] == "missing":
         value, msg = "missing", "this required key"
+    elif e["type"] in ("int_type", "int_from_float") and isinstance(value, float):
+        # shown as written: `num = 3` would hide why 3.0 is refused (a trial finding)
+        value, msg = CoreText(repr(value)), "an integer, written without a decimal point"
     elif e["type"] in ("union_tag_invalid", "union_tag_not_found"):
         value = value.get("kind", "missing") if isinstance(value, dict) else value
         field, msg = f"{field}.kind", "one of " + ", ".join(f"'{k}'" for k in KINDS)
