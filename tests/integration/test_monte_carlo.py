@@ -26,6 +26,7 @@ from tcsim.io.shards import MANIFEST, SHARDS, read_shards, run_to_shards, shard_
 from tcsim.models.converter import load_converter
 from tcsim.models.study_file import Lognormal, Normal, Parameter, TruncatedNormal, Uniform, load_study_file
 from tcsim.models.vehicle import load_vehicle
+from tcsim.plots.monte_carlo import histogram_bins
 
 #: A study of converter and vehicle parameters, every kind of distribution, the three models.
 STUDY = """\
@@ -393,3 +394,19 @@ def test_the_summary_counts_finished_runs_without_a_value():
     ]
     df["time_0_100_km_h_s"] = [9.0, 11.0, 10.0, np.nan, 8.0, 8.0]
     assert summary_lines(df, study) == ["  time_0_100_km_h_s: table 10 ± 1 (n = 3), hrovat-tobler 8 ± 0 (n = 2)"]
+
+
+def test_models_far_apart_each_get_bins_of_their_own():
+    # trial finding: two models 0.05 s apart, each with a spread of 0.005 s, drew each spread as one bar
+    rng = np.random.default_rng(3)
+    near = {"table": rng.normal(2.84, 0.02, 100), "quasi-dynamic": rng.normal(2.85, 0.02, 100)}
+    bins = histogram_bins(near)
+    assert bins["table"] is bins["quasi-dynamic"]  # overlapping: the same bins, comparable bars
+    far = {"table": rng.normal(2.84, 0.0005, 100), "quasi-dynamic": rng.normal(2.89, 0.0005, 100), "x": np.empty(0)}
+    bins = histogram_bins(far)
+    assert set(bins) == {"table", "quasi-dynamic"}
+    for m in bins:
+        assert bins[m][0] == far[m].min() and bins[m][-1] == far[m].max()
+        filled = np.unique(np.digitize(far[m], bins[m][1:-1])).size
+        assert filled >= 5, (m, filled)
+    assert histogram_bins({"table": np.full(4, 2.0)})["table"].tolist() == np.linspace(2.0, 3.0, 6).tolist()
