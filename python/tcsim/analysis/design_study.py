@@ -268,6 +268,18 @@ def study_base(file: DesignFile, names: Sequence[str]) -> DesignFile:
     return file
 
 
+def _blamed_on_sweep(e: InputError, names: Sequence[str]) -> InputError:
+    """A design's refusal for a swept value, shown as the sweep's (``--sweep: squash_ratio = 1.5``)
+    rather than the design file's, which does not hold the value (a trial finding); an axial width
+    is refused through the squash ratio it gives. Any other refusal as it is."""
+    key = e.field.rpartition(".")[2]
+    if key in names:
+        return InputError("--sweep", key, e.value, e.expected)
+    if key == "squash_ratio" and AXIAL_WIDTH in names:
+        return InputError("--sweep", f"{AXIAL_WIDTH} (as squash_ratio)", e.value, e.expected)
+    return e
+
+
 def design_rows(
     file: DesignFile, names: Sequence[str], grid: Sequence[tuple[float, ...]], threads: int = 2
 ) -> pd.DataFrame:
@@ -280,7 +292,7 @@ def design_rows(
     for combo, derived in zip(grid, derive_converters(files)):
         row: dict[str, Any] = dict(zip(names, combo)) | {"error": ""}
         if isinstance(derived, InputError):
-            row["error"] = str(derived)
+            row["error"] = str(_blamed_on_sweep(derived, names))
         else:
             convs.append(derived.converter)
             row["fluid_length_m"] = derived.geometry.fluid_length_m
