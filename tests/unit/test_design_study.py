@@ -154,7 +154,8 @@ def test_an_axial_width_sweep_is_the_squash_sweep_at_each_designs_radii():
         np.testing.assert_allclose(by_width[c][:3], by_squash[c], rtol=1e-12, err_msg=c)
     assert (np.diff(by_width["turbine_shape_effect_m2"][:3]) < 0).all()
     assert (np.diff(by_width["takeoff_effective_tr_dip"][:3]) < 0).all()
-    assert "--sweep: axial_width_m (as squash_ratio) = -0.2: expected a squash ratio in [0, 1)" in by_width["error"].iloc[3]
+    refused = "--sweep: axial_width_m (as squash_ratio) = -0.2: expected a squash ratio in [0, 1)"
+    assert refused in by_width["error"].iloc[3]
     # the width of the radii swept with it: R_p 0.13 m at width 0.06 m is squash 1 − 0.06/0.07
     both = design_study(circular, {"pump_exit_radius_m": [0.13], "axial_width_m": [0.06]})
     alone = design_study(circular, {"pump_exit_radius_m": [0.13], "squash_ratio": [1.0 - 0.06 / 0.07]})
