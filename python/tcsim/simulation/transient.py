@@ -22,7 +22,7 @@ stored by the core.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -92,6 +92,8 @@ EVENT_KINDS: tuple[str, ...] = tuple(_core.transient_event_kinds())
 #: Run status codes of :attr:`BatchColumns.status`: finished; input refused; solver failed;
 #: finished, but a column overflowed (±inf, or NaN in a physical quantity).
 RUN_OK, RUN_INPUT_ERROR, RUN_SOLVER_ERROR, RUN_OVERFLOW = 0, 1, 2, 3
+#: The event arrays of :attr:`BatchColumns.events` and their keys in ``transient_batch``'s result.
+_EVENT_KEYS = tuple((k, f"event_{k}") for k in ("run", "time_s", "kind", "stator_locked", "flow_direction"))
 #: Columns the table models' extension warning reads (:meth:`DynamicModel.warn_about_run`).
 _WARNING_COLUMNS = ("pump_speed_rad_s", "turbine_speed_rad_s")
 
@@ -204,19 +206,18 @@ class BatchColumns:
         :meth:`check` (which raises the first failed run's error)."""
         self.check()
         n = len(self)
-        names = list(self.columns)
-        if n == 1:  # a single run's rows: the whole of a flat column, the one row of an (1, S) one
-            rows: Iterator[Sequence[np.ndarray]] = iter([[c if c.ndim == 1 else c[0] for c in self.columns.values()]])
-        else:
-            cols = [list(c) if c.ndim == 2 else np.split(c, self.offsets[1:-1]) for c in self.columns.values()]
-            rows = zip(*cols) if names else iter([()] * n)
         ev = self.events
-        bounds = [0, len(ev["run"])] if n == 1 else np.searchsorted(ev["run"], np.arange(n + 1)).tolist()
         fields = [ev[k].tolist() for k in ("time_s", "kind", "stator_locked", "flow_direction")]
         events = [Event(t, EVENT_KINDS[k], locked, flow) for t, k, locked, flow in zip(*fields)]
+        if n == 1:  # a single run: the whole of a flat column, the one row of an (1, S) one
+            cols = {name: c if c.ndim == 1 else c[0] for name, c in self.columns.items()}
+            return [TransientResult(self._model(0).name, cols, events)]
+        names = list(self.columns)
+        rows = [list(c) if c.ndim == 2 else np.split(c, self.offsets[1:-1]) for c in self.columns.values()]
+        bounds = np.searchsorted(ev["run"], np.arange(n + 1)).tolist()
         return [
             TransientResult(self._model(i).name, dict(zip(names, values)), events[bounds[i] : bounds[i + 1]])
-            for i, values in enumerate(rows)
+            for i, values in enumerate(zip(*rows) if names else iter([()] * n))
         ]
 
 
@@ -312,7 +313,7 @@ def _drive_specs(drives: Sequence[Drive], times_s: Sequence[float] | None) -> tu
             s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s)
         specs.append(s)
     if times_s is not None:
-        return specs, np.atleast_1d(np.asarray(times_s, dtype=float))
+        return specs, _floats_1d(times_s)
     first = np.asarray(specs[0]["time_s"], dtype=float)
     same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
     return specs, first if same else None
@@ -429,7 +430,7 @@ def _batch_columns(
         cols = {k: v.reshape(n, samples) for k, v in cols.items()}
     if shared_time is not None and not (regular and samples == len(shared_time)):
         shared_time = None
-    events = {k: raw[f"event_{k}"] for k in ("run", "time_s", "kind", "stator_locked", "flow_direction")}
+    events = {k: raw[key] for k, key in _EVENT_KEYS}
     batch = BatchColumns(models, cols, offsets, shared_time, status, events)
     for f in raw["failures"]:
         i = int(f["run"])
@@ -468,8 +469,8 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
 
 def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]) -> tuple[np.ndarray, int]:
     """:func:`output_times` with the times as a float64 array (what the runs pass to the core)."""
-    t = np.atleast_1d(np.asarray(times_s, dtype=float))
-    span = np.atleast_1d(np.asarray(drive_time_s, dtype=float))
+    t = _floats_1d(times_s)
+    span = _floats_1d(drive_time_s)
     start, end = float(span[0]), float(span[-1])
     if t.ndim != 1 or t.size < 1:
         raise InputError("simulate", "times_s", f"shape {t.shape}", "a one-dimensional sequence of output times")
@@ -491,3 +492,9 @@ def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float
             f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
         )
     return np.concatenate(([start], t)), 1
+
+
+def _floats_1d(x: Any) -> np.ndarray:
+    """``np.atleast_1d(np.asarray(x, dtype=float))``, without the call's overhead."""
+    a = np.asarray(x, dtype=float)
+    return a.reshape(1) if a.ndim == 0 else a
