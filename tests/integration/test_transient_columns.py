@@ -214,3 +214,28 @@ def test_the_table_models_extension_warning_reads_speeds_not_chosen():
     with pytest.warns(TcsimWarning, match=r"the run reached SR 3"):
         r = tr.simulate(m, overrun, columns=["pump_torque_nm"])
     assert list(r.columns) == ["pump_torque_nm"]
+
+
+def test_a_batch_of_one_run_is_its_columnar_run_with_the_same_warnings_and_errors():
+    """simulate and a batch of one run take the core's flat columns as they are (issue 16, the
+    Python path): the same numbers, events, warnings (from the same place) and errors."""
+    table, ht = (tr.dynamic_model("li-sunden-2016", name) for name in ("table", "hrovat-tobler"))
+    t = np.array([0.0, 1.0, 2.0])
+    overrun = tr.Speeds(t, np.array([100.0, 120.0, 100.0]), 300.0)  # SR 3: beyond the table's SR 1
+    b = tr.simulate_columns([table], [overrun], times_s=t)
+    places = set()
+    for models, drives in (([table], [overrun]), ([table, table], [overrun])):
+        with pytest.warns(TcsimWarning, match=r"reached SR 3") as w:
+            runs = tr.simulate_batch(models, drives, times_s=t)
+        places |= {(x.filename, x.lineno) for x in w}
+        one = runs[0]
+        assert list(one.columns) == list(tr.COLUMNS) and one.events == b.run_events(0)
+        for name in tr.COLUMNS:
+            assert one[name].shape == (3,) and np.array_equal(_bits(one[name]), _bits(b.columns[name][0])), name
+    assert len(places) == 1, "the warning comes from one place whatever the batch's size"
+    solver_fails = tr.PumpTorqueLoad(t, np.array([100.0, 100.0, 1e300]), load_inertia_kg_m2=1.0)
+    expected = tr.simulate_columns([ht], [solver_fails], times_s=t).errors[0]
+    for call in (tr.simulate_batch, lambda ms, ds, **kw: [tr.simulate(ms[0], ds[0], **kw)]):
+        with pytest.raises(tr.SolverError) as e:
+            call([ht], [solver_fails], times_s=t)
+        assert str(e.value) == str(expected)

@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Condvar, Mutex};
 use std::time::Duration;
 
-use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray1, PyReadonlyArray2};
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -785,20 +785,51 @@ fn transient_run(
 // ---------------------------------------------------------------------------------------------
 // Transient runs
 
+/// The error of a dict value `key` that does not extract: `key: <the extraction's error>`.
+fn field_error(key: &str, e: impl Into<PyErr>) -> PyErr {
+    PyValueError::new_err(format!("{key}: {}", e.into()))
+}
+
+fn present<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyAny>> {
+    d.get_item(key)?.ok_or_else(|| PyValueError::new_err(format!("missing key {key:?}")))
+}
+
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
-    d.get_item(key)?
-        .ok_or_else(|| PyValueError::new_err(format!("missing key {key:?}")))?
-        .extract::<T>()
-        .map_err(|e| PyValueError::new_err(format!("{key}: {}", Into::<PyErr>::into(e))))
+    present(d, key)?.extract::<T>().map_err(|e| field_error(key, e))
 }
 
 fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Option<T>> {
     match d.get_item(key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
-        Some(v) => {
-            v.extract::<T>().map(Some).map_err(|e| PyValueError::new_err(format!("{key}: {}", Into::<PyErr>::into(e))))
-        }
+        Some(v) => v.extract::<T>().map(Some).map_err(|e| field_error(key, e)),
+    }
+}
+
+/// The numbers of a drive's series (a signal's values, its time stamps, the output times): a 1-D
+/// float64 NumPy array is copied in one go (strided too); anything else is extracted as a sequence
+/// of floats, as before arrays were taken (a list, a tuple, an array of another dtype or order).
+fn numbers(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
+    if let Some(ro) = v.cast::<PyArray1<f64>>().ok().and_then(|a| a.try_readonly().ok()) {
+        return Ok(match ro.as_slice() {
+            Ok(s) => s.to_vec(),
+            Err(_) => ro.as_array().to_vec(),
+        });
+    }
+    v.extract::<Vec<f64>>()
+}
+
+/// [`item`] for a series ([`numbers`]), with its messages.
+fn numbers_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Vec<f64>> {
+    numbers(&present(d, key)?).map_err(|e| field_error(key, e))
+}
+
+/// [`opt_item`] for a series ([`numbers`]), with its messages.
+fn opt_numbers_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Option<Vec<f64>>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        Some(v) => numbers(&v).map(Some).map_err(|e| field_error(key, e)),
     }
 }
 
@@ -822,13 +853,15 @@ fn model_from(d: &Bound<'_, PyDict>) -> PyResult<Box<dyn ConverterDynamics + Sen
     tcsim_core::converter::spec::build_model(&DictSpec(d)).map_err(input_error)
 }
 
+/// The drive's signal `key`: a constant when a number (a float, a 0-d array), else one value per
+/// time stamp ([`numbers`]; a 1-D float64 array is a series even of one value).
 fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal> {
-    let t: Vec<f64> = item(d, "time_s")?;
+    let t = numbers_item(d, "time_s")?;
     match d.get_item(key)? {
-        Some(v) if v.extract::<f64>().is_ok() => {
+        Some(v) if v.cast::<PyArray1<f64>>().is_err() && v.extract::<f64>().is_ok() => {
             Signal::constant_named(key, v.extract::<f64>()?).map_err(|e| input_error(e.about(InputSource::Drive)))
         }
-        _ => Signal::new(key, t, item(d, key)?, window).map_err(|e| input_error(e.about(InputSource::Drive))),
+        _ => Signal::new(key, t, numbers_item(d, key)?, window).map_err(|e| input_error(e.about(InputSource::Drive))),
     }
 }
 
@@ -849,9 +882,9 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
     let kind: String = item(d, "kind")?;
     let window: f64 =
         opt_item(d, "derivative_window_s")?.unwrap_or(tcsim_core::engine::signal::DEFAULT_DERIVATIVE_WINDOW_S);
-    let out: Vec<f64> = match opt_item(d, "output_time_s")? {
+    let out = match opt_numbers_item(d, "output_time_s")? {
         Some(t) => t,
-        None => item(d, "time_s")?,
+        None => numbers_item(d, "time_s")?,
     };
     let drive = match kind.as_str() {
         "pump-torque-turbine-speed" => Drive::PumpTorqueTurbineSpeed {

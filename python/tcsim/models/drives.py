@@ -8,6 +8,7 @@ the core's default, 1.2)."""
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -28,11 +29,25 @@ def _arr(x: Any) -> list[float] | float:
     return np.asarray(x, dtype=float).tolist()
 
 
-def _lockup(capacity_nm: ArrayLike | None, static_to_kinetic: float | None) -> dict[str, Any]:
+def _series(x: Any) -> np.ndarray | list[float] | float:
+    """:func:`_arr` for the core (``Drive._core_spec``): a one-dimensional series as a float64 array,
+    which the binding copies in one go instead of a list's floats one by one; a number, a 0-d array
+    or an array of another shape as :func:`_arr` gives it (so the same constant, or the same error)."""
+    if not isinstance(x, np.ndarray) and np.isscalar(x):  # (an array is never a scalar here)
+        return float(x)  # type: ignore[arg-type]  # a real scalar; complex inputs are not drives
+    a = np.asarray(x, dtype=float)
+    return a if a.ndim == 1 else a.tolist()
+
+
+#: How a drive's series go into its spec: :func:`_arr` (lists, ``spec()``) or :func:`_series`.
+_Series = Callable[[Any], Any]
+
+
+def _lockup(capacity_nm: ArrayLike | None, static_to_kinetic: float | None, series: _Series = _arr) -> dict[str, Any]:
     """The lock-up keys of a drive's spec (none without a capacity command)."""
     spec: dict[str, Any] = {}
     if capacity_nm is not None:
-        spec["lockup_capacity_nm"] = _arr(capacity_nm)
+        spec["lockup_capacity_nm"] = series(capacity_nm)
         if static_to_kinetic is not None:
             spec["lockup_static_to_kinetic"] = float(static_to_kinetic)
     return spec
@@ -53,13 +68,21 @@ class PumpTorqueTurbineSpeed:
     lockup_static_to_kinetic: float | None = None
 
     def spec(self) -> dict[str, Any]:
+        """The drive as the core's dict (``tcsim._core.transient_batch``), its series as lists."""
+        return self._spec(_arr)
+
+    def _core_spec(self) -> dict[str, Any]:
+        """:meth:`spec` with its one-dimensional series as float64 arrays (what the runs pass)."""
+        return self._spec(_series)
+
+    def _spec(self, series: _Series) -> dict[str, Any]:
         return {
             "kind": "pump-torque-turbine-speed",
-            "time_s": _arr(self.time_s),
-            "pump_torque_nm": _arr(self.pump_torque_nm),
-            "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
+            "time_s": series(self.time_s),
+            "pump_torque_nm": series(self.pump_torque_nm),
+            "turbine_speed_rad_s": series(self.turbine_speed_rad_s),
             "derivative_window_s": self.derivative_window_s,
-            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic),
+            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic, series),
         }
 
 
@@ -76,13 +99,21 @@ class Speeds:
     lockup_static_to_kinetic: float | None = None
 
     def spec(self) -> dict[str, Any]:
+        """The drive as the core's dict (``tcsim._core.transient_batch``), its series as lists."""
+        return self._spec(_arr)
+
+    def _core_spec(self) -> dict[str, Any]:
+        """:meth:`spec` with its one-dimensional series as float64 arrays (what the runs pass)."""
+        return self._spec(_series)
+
+    def _spec(self, series: _Series) -> dict[str, Any]:
         return {
             "kind": "speeds",
-            "time_s": _arr(self.time_s),
-            "pump_speed_rad_s": _arr(self.pump_speed_rad_s),
-            "turbine_speed_rad_s": _arr(self.turbine_speed_rad_s),
+            "time_s": series(self.time_s),
+            "pump_speed_rad_s": series(self.pump_speed_rad_s),
+            "turbine_speed_rad_s": series(self.turbine_speed_rad_s),
             "derivative_window_s": self.derivative_window_s,
-            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic),
+            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic, series),
         }
 
 
@@ -101,14 +132,22 @@ class PumpTorqueLoad:
     lockup_static_to_kinetic: float | None = None
 
     def spec(self) -> dict[str, Any]:
+        """The drive as the core's dict (``tcsim._core.transient_batch``), its series as lists."""
+        return self._spec(_arr)
+
+    def _core_spec(self) -> dict[str, Any]:
+        """:meth:`spec` with its one-dimensional series as float64 arrays (what the runs pass)."""
+        return self._spec(_series)
+
+    def _spec(self, series: _Series) -> dict[str, Any]:
         return {
             "kind": "pump-torque-load",
-            "time_s": _arr(self.time_s),
-            "pump_torque_nm": _arr(self.pump_torque_nm),
-            "load_torque_nm": _arr(self.load_torque_nm),
+            "time_s": series(self.time_s),
+            "pump_torque_nm": series(self.pump_torque_nm),
+            "load_torque_nm": series(self.load_torque_nm),
             "load_inertia_kg_m2": float(self.load_inertia_kg_m2),
             "load_drag_nm_s2": float(self.load_drag_nm_s2),
-            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic),
+            **_lockup(self.lockup_capacity_nm, self.lockup_static_to_kinetic, series),
         }
 
 

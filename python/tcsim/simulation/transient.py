@@ -92,6 +92,8 @@ EVENT_KINDS: tuple[str, ...] = tuple(_core.transient_event_kinds())
 #: Run status codes of :attr:`BatchColumns.status`: finished; input refused; solver failed;
 #: finished, but a column overflowed (±inf, or NaN in a physical quantity).
 RUN_OK, RUN_INPUT_ERROR, RUN_SOLVER_ERROR, RUN_OVERFLOW = 0, 1, 2, 3
+#: The event arrays of :attr:`BatchColumns.events` and their keys in ``transient_batch``'s result.
+_EVENT_KEYS = tuple((k, f"event_{k}") for k in ("run", "time_s", "kind", "stator_locked", "flow_direction"))
 #: Columns the table models' extension warning reads (:meth:`DynamicModel.warn_about_run`).
 _WARNING_COLUMNS = ("pump_speed_rad_s", "turbine_speed_rad_s")
 
@@ -204,16 +206,18 @@ class BatchColumns:
         :meth:`check` (which raises the first failed run's error)."""
         self.check()
         n = len(self)
-        names = list(self.columns)
-        cols = [list(c) if c.ndim == 2 else np.split(c, self.offsets[1:-1]) for c in self.columns.values()]
-        rows = zip(*cols) if names else iter([()] * n)
         ev = self.events
-        bounds = np.searchsorted(ev["run"], np.arange(n + 1)).tolist()
         fields = [ev[k].tolist() for k in ("time_s", "kind", "stator_locked", "flow_direction")]
         events = [Event(t, EVENT_KINDS[k], locked, flow) for t, k, locked, flow in zip(*fields)]
+        if n == 1:  # a single run: the whole of a flat column, the one row of an (1, S) one
+            cols = {name: c if c.ndim == 1 else c[0] for name, c in self.columns.items()}
+            return [TransientResult(self._model(0).name, cols, events)]
+        names = list(self.columns)
+        rows = [list(c) if c.ndim == 2 else np.split(c, self.offsets[1:-1]) for c in self.columns.values()]
+        bounds = np.searchsorted(ev["run"], np.arange(n + 1)).tolist()
         return [
             TransientResult(self._model(i).name, dict(zip(names, values)), events[bounds[i] : bounds[i + 1]])
-            for i, values in enumerate(rows)
+            for i, values in enumerate(zip(*rows) if names else iter([()] * n))
         ]
 
 
@@ -281,7 +285,7 @@ def simulate_batch(
     ``speed_atol_rad_s``, ``flow_atol_m3_s``, ``first_step_s``, ``max_events`` and
     ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs, counting only the
     chosen columns, is refused above it before anything runs)."""
-    batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options)
+    batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options, shaped=False)
     batch.check()
     _warn_about_runs(batch)
     if columns is not None and len(batch.columns) > len(columns):
@@ -303,12 +307,13 @@ def _drive_specs(drives: Sequence[Drive], times_s: Sequence[float] | None) -> tu
     the sample times every run shares, s (None when the drives' time stamps differ)."""
     specs = []
     for d in drives:
-        s = d.spec()
+        core_spec = getattr(d, "_core_spec", None)  # the series as arrays (a stand-in drive: its spec())
+        s = core_spec() if core_spec is not None else d.spec()
         if times_s is not None:
-            s["output_time_s"], s["output_skip"] = output_times(s["time_s"], times_s)
+            s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s)
         specs.append(s)
     if times_s is not None:
-        return specs, np.atleast_1d(np.asarray(times_s, dtype=float))
+        return specs, _floats_1d(times_s)
     first = np.asarray(specs[0]["time_s"], dtype=float)
     same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
     return specs, first if same else None
@@ -366,9 +371,11 @@ def _run_batch(
     threads: int,
     files: Mapping[str, str] | None,
     solver_options: dict[str, Any],
+    shaped: bool = True,
 ) -> BatchColumns:
     """The one call of the core's ``transient_batch`` (:func:`simulate_columns`), with the columns
-    the warnings read added for table models (:func:`_core_columns`)."""
+    the warnings read added for table models (:func:`_core_columns`); ``shaped`` as in
+    :func:`_batch_columns`."""
     specs, shared_time = _drive_specs(drives, times_s)
     try:
         raw = _core.transient_batch(
@@ -385,7 +392,7 @@ def _run_batch(
         converters = {m.source for m in models}
         sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
         raise from_core(e, sources) from None
-    return _batch_columns(raw, models, shared_time, files)
+    return _batch_columns(raw, models, shared_time, files, shaped)
 
 
 def _core_columns(models: Sequence[DynamicModel], columns: Sequence[str] | None) -> list[str] | None:
@@ -401,17 +408,29 @@ def _core_columns(models: Sequence[DynamicModel], columns: Sequence[str] | None)
 
 
 def _batch_columns(
-    raw: dict[str, Any], models: Sequence[DynamicModel], shared_time: np.ndarray | None, files: Mapping[str, str] | None
+    raw: dict[str, Any],
+    models: Sequence[DynamicModel],
+    shared_time: np.ndarray | None,
+    files: Mapping[str, str] | None,
+    shaped: bool = True,
 ) -> BatchColumns:
-    """The :class:`BatchColumns` of the core's ``transient_batch`` result (reshaped views, no copy)."""
+    """The :class:`BatchColumns` of the core's ``transient_batch`` result (reshaped views, no copy).
+    Without ``shaped``, a single run keeps the core's flat columns (its rows, offsets ``[0, S]``), for
+    :meth:`BatchColumns.runs` (:func:`simulate_batch`), which takes them as they are."""
     offsets, status = raw["offsets"], raw["status"]
     n = len(status)
-    counts = np.diff(offsets)
-    regular = n > 0 and bool((counts == counts[0]).all())
-    cols = {k: v.reshape(n, int(counts[0])) if regular else v for k, v in raw["columns"].items()}
-    if shared_time is not None and not (regular and int(counts[0]) == len(shared_time)):
+    if n == 1:
+        regular, samples = True, int(offsets[1] - offsets[0])
+    else:
+        counts = np.diff(offsets)
+        regular = n > 0 and bool((counts == counts[0]).all())
+        samples = int(counts[0]) if regular else 0
+    cols = raw["columns"]
+    if regular and (shaped or n > 1):
+        cols = {k: v.reshape(n, samples) for k, v in cols.items()}
+    if shared_time is not None and not (regular and samples == len(shared_time)):
         shared_time = None
-    events = {k: raw[f"event_{k}"] for k in ("run", "time_s", "kind", "stator_locked", "flow_direction")}
+    events = {k: raw[key] for k, key in _EVENT_KEYS}
     batch = BatchColumns(models, cols, offsets, shared_time, status, events)
     for f in raw["failures"]:
         i = int(f["run"])
@@ -444,19 +463,26 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
     the drive's span, else :class:`InputError` about ``times_s[i]``; a first sample closer to the
     start than the engine's time resolution (1 µs, or 1024 ulp of the time) is refused likewise.
     """
-    t = np.atleast_1d(np.asarray(times_s, dtype=float))
-    span = np.atleast_1d(np.asarray(drive_time_s, dtype=float))
+    t, skip = _output_times(drive_time_s, times_s)
+    return t.tolist(), skip
+
+
+def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]) -> tuple[np.ndarray, int]:
+    """:func:`output_times` with the times as a float64 array (what the runs pass to the core)."""
+    t = _floats_1d(times_s)
+    span = _floats_1d(drive_time_s)
     start, end = float(span[0]), float(span[-1])
     if t.ndim != 1 or t.size < 1:
         raise InputError("simulate", "times_s", f"shape {t.shape}", "a one-dimensional sequence of output times")
-    outside = np.flatnonzero(~np.isfinite(t) | (t < start) | (t > end))
-    if outside.size:
-        i = int(outside[0])
-        raise InputError(
-            "simulate", f"times_s[{i}]", float(t[i]), f"a time within the drive's span, {start:g} to {end:g} s"
-        )
+    if not (start <= t.min() and t.max() <= end):  # a time outside the span or NaN (or a NaN span)
+        outside = np.flatnonzero(~np.isfinite(t) | (t < start) | (t > end))
+        if outside.size:
+            i = int(outside[0])
+            raise InputError(
+                "simulate", f"times_s[{i}]", float(t[i]), f"a time within the drive's span, {start:g} to {end:g} s"
+            )
     if t[0] == start:
-        return t.tolist(), 0
+        return t, 0
     resolution = _core.time_resolution_s(start)
     if t[0] - start < (1.0 - 1e-3) * resolution:
         raise InputError(
@@ -465,4 +491,10 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
             float(t[0]),
             f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
         )
-    return [start, *t.tolist()], 1
+    return np.concatenate(([start], t)), 1
+
+
+def _floats_1d(x: Any) -> np.ndarray:
+    """``np.atleast_1d(np.asarray(x, dtype=float))``, without the call's overhead."""
+    a = np.asarray(x, dtype=float)
+    return a.reshape(1) if a.ndim == 0 else a
