@@ -14,7 +14,7 @@ call counts per function come from ``callgrind_annotate``. Programs:
 
 Then, in wall time (medians of ``WALL_REPEATS`` in this process, so the machine's load enters): one
 ``tcsim.transient.simulate`` through the Python API, and inside it the core call
-(``_core.transient_runs``: the run, its 27 columns and their conversion to NumPy arrays); the rest
+(``_core.transient_batch``: the run, its columns and their hand-over to NumPy); the rest
 is Python (checking inputs, building the result).
 
 The split printed for tcsim: *integration* is ``run_segment`` less the sampling inside it; of it,
@@ -189,7 +189,7 @@ def peer_profile(samples: int) -> None:
 
 def python_split(samples: int) -> None:
     """Median wall time of ``simulate`` through the Python API and of the core call inside it."""
-    core, core_times = transient._core.transient_runs, []
+    core, core_times = transient._core.transient_batch, []
 
     def timed(*args):
         t0 = time.perf_counter()
@@ -202,7 +202,7 @@ def python_split(samples: int) -> None:
         isolated_takeoff(),
         np.linspace(0, 10, samples),
     )
-    transient._core.transient_runs = timed
+    transient._core.transient_batch = timed
     try:
         transient.simulate(model, drive, times_s=times)
         core_times.clear()
@@ -212,7 +212,7 @@ def python_split(samples: int) -> None:
             transient.simulate(model, drive, times_s=times)
             totals.append(time.perf_counter() - t0)
     finally:
-        transient._core.transient_runs = core
+        transient._core.transient_batch = core
     total, inside = statistics.median(totals), statistics.median(core_times)
     print(
         f"Python API, {samples} samples (wall, median of {WALL_REPEATS}, load {os.getloadavg()[0]:.1f}): simulate "
