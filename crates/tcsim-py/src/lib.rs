@@ -842,6 +842,11 @@ impl tcsim_core::converter::spec::ModelSpec for DictSpec<'_, '_> {
     }
     fn numbers(&self, key: &str) -> Option<Vec<f64>> {
         let v = self.0.get_item(key).ok()??;
+        if v.is_instance_of::<PyList>() {
+            // a list is never a number: read it at once, without building the error of a failed
+            // `f64` first (which was most of the cost of reading a model, once per run of a batch)
+            return v.extract::<Vec<f64>>().ok();
+        }
         v.extract::<f64>().map(|x| vec![x]).or_else(|_| v.extract::<Vec<f64>>()).ok()
     }
     fn text(&self, key: &str) -> Option<String> {
