@@ -131,3 +131,19 @@ def test_quasi_dynamic_needs_its_section():
     with pytest.raises(InputError, match=r"\[quasi_dynamic\]"):
         tr.dynamic_model(replace(conv, quasi_dynamic=None), "quasi-dynamic")
     assert tr.default_flow_time_constant_s(conv) == pytest.approx(2.93e-3, rel=1e-2)
+
+
+@pytest.mark.parametrize("model", ["table", "hrovat-tobler", "quasi-dynamic"])
+def test_sample_times_from_linspace_ending_an_ulp_after_a_drive_time_stamp(model):
+    # 37–80 % of a 3 s record: np.linspace(0.37 * 3.0, 0.8 * 3.0, 33) ends at 2.4000000000000004;
+    # with a drive time stamp at 2.4 s the run failed ("the step 4.4e-16 s fell below the smallest
+    # step"; found by a before/after comparison of the core, issue 16)
+    times = np.linspace(0.37 * 3.0, 0.8 * 3.0, 33)
+    assert times[-1] > 2.4
+    drive = tr.PumpTorqueLoad(
+        np.array([0.0, 0.1, 0.3, 2.4, 10.0]), np.array([40.0, 40.0, 250.0, 250.0, 250.0]), 1.2, 10.0, 0.002
+    )
+    r = tr.simulate("li-sunden-2016", drive, model, times_s=times)
+    at = tr.simulate("li-sunden-2016", drive, model, times_s=np.append(times[:-1], 2.4))
+    for c in ("pump_speed_rad_s", "turbine_speed_rad_s", "turbine_torque_nm"):
+        assert r[c][-1] == pytest.approx(at[c][-1], rel=1e-9), c

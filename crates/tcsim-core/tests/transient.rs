@@ -509,3 +509,34 @@ fn a_pulse_after_a_steady_phase_is_not_stepped_over() {
         assert!(traj.steps > 0);
     }
 }
+
+#[test]
+fn an_output_time_a_few_ulp_after_a_drive_time_stamp_is_reached() {
+    // Found by a before/after comparison (issue 16): `np.linspace(1.11, 2.4, 33)` ends at
+    // 2.4000000000000004; a drive with a time stamp at 2.4 s stopped the steps there and left a
+    // span of 4.4e-16 s, below the smallest step, and the run failed ("the step 4.4e-16 s fell
+    // below the smallest step"). The stop is now passed over; the last sample is the run's at 2.4 s
+    // to round-off.
+    let stamps = vec![0.0, 0.1, 0.3, 2.4, 10.0];
+    let drive = Drive::PumpTorqueLoad {
+        pump_torque_nm: Signal::new("pump_torque_nm", stamps, vec![40.0, 40.0, 250.0, 250.0, 250.0], 0.0).unwrap(),
+        load: tcsim_core::engine::isolated::TurbineLoad {
+            torque_nm: Signal::constant(10.0),
+            inertia_kg_m2: 1.2,
+            drag_nm_s2: 0.002,
+        },
+        lockup: None,
+    };
+    let models: [(&str, Box<dyn ConverterDynamics>); 2] =
+        [("hrovat-tobler", Box::new(ht_fitted(SHAPE))), ("table", Box::new(table()))];
+    for (name, model) in models {
+        let (_, at) = run(model.as_ref(), &drive, &[0.0, 1.0, 2.4], InitialState::default());
+        for end in [f64::from_bits(2.4f64.to_bits() + 1), f64::from_bits(2.4f64.to_bits() + 4), 2.4 + 1e-14] {
+            let (_, after) = run(model.as_ref(), &drive, &[0.0, 1.0, end], InitialState::default());
+            for c in ["pump_speed_rad_s", "turbine_speed_rad_s", "pump_torque_nm"] {
+                let (a, b) = (col(&at, c)[2], col(&after, c)[2]);
+                assert!((a - b).abs() <= 1e-9 * a.abs().max(1.0), "{name}, end {end:e}, {c}: {a} at 2.4 s, {b}");
+            }
+        }
+    }
+}

@@ -81,6 +81,12 @@ pub fn run_segment_with_stops<S: SmoothSegment>(
     }
 }
 
+/// Whether the span from `a` to `b` (`a ≤ b`) is shorter than twice the integrator's smallest step
+/// (16 ε of the larger time, [`Bdf::step`]): too short for a step of its own.
+fn no_step(a: f64, b: f64) -> bool {
+    b - a <= 32.0 * f64::EPSILON * a.abs().max(b.abs())
+}
+
 /// [`run_segment`] on an integrator of `N` states: exactly `N` up to [`EXACT_MAX`] (its loops
 /// unrolled), at most `N` beyond.
 #[allow(clippy::too_many_arguments)]
@@ -95,10 +101,13 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
     samples: &mut Vec<S::Sample>,
     steps: &mut usize,
 ) -> TransientResult<SegmentEnd<S::Root>> {
-    while samples.len() < times_s.len() && times_s[samples.len()] <= t0 {
+    // a span shorter than the integrator's smallest step (an event a few ulp before the end) is no
+    // step: the state at its end is the state at its start, to round-off
+    let upto = if no_step(t0, t_end) { t_end } else { t0 };
+    while samples.len() < times_s.len() && times_s[samples.len()] <= upto {
         samples.push(seg.sample(&x0, times_s[samples.len()]));
     }
-    if t0 >= t_end {
+    if t0 >= t_end || no_step(t0, t_end) {
         return Ok(None);
     }
     let mut bdf = Bdf::<S, N>::new(seg, &x0, t0, t_end, o)?;
@@ -121,7 +130,12 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
         }
         *steps += 1;
         let t_lo = bdf.t();
-        while next_stop < stops.len() && stops[next_stop] <= t_lo {
+        // a stop a few ulp after the step's start or before the end (the last output time 2.4 +
+        // 4e-16 s after a drive's time stamp at 2.4 s) would leave a span no step can take: it is
+        // passed over, the kink crossed by less than the smallest step
+        while next_stop < stops.len()
+            && (stops[next_stop] <= t_lo || no_step(t_lo, stops[next_stop]) || no_step(stops[next_stop], t_end))
+        {
             next_stop += 1;
         }
         bdf.step(stops.get(next_stop).map_or(t_end, |&s| s.min(t_end)))?;

@@ -6,7 +6,7 @@
 use super::roots::RootFinder;
 use super::{Bdf, Matrix, N_MAX};
 use crate::engine::options::{Hysteresis, SolverOptions, TransientError};
-use crate::engine::segment::{run_segment, SmoothSegment};
+use crate::engine::segment::{run_segment, run_segment_with_stops, SmoothSegment};
 
 type Fun = fn(&[f64], f64, &mut [f64]);
 
@@ -360,4 +360,27 @@ fn the_rescaling_matrix_u_is_upper_triangular() {
         }
         assert_ne!(super::U[i][i], 0.0, "U[{i}][{i}]");
     }
+}
+
+#[test]
+fn a_span_shorter_than_the_smallest_step_is_no_step() {
+    // an event a few ulp before the end leaves a segment no step can take: its samples are the
+    // state at its start (to round-off), not a solver error; a stop a few ulp after the start is
+    // passed over
+    let mut a = [[0.0; N_MAX]; N_MAX];
+    a[0][0] = -2.0;
+    let seg = Linear::new(1, identity(), a);
+    let o = options(1e-8);
+    let t0: f64 = 3.0;
+    let t_end = f64::from_bits(t0.to_bits() + 3);
+    let (mut samples, mut steps) = (vec![], 0);
+    let end = run_segment(&seg, vec![0.5], t0, t_end, &[t0, t_end], &o, &mut samples, &mut steps).unwrap();
+    assert!(end.is_none() && steps == 0);
+    assert_eq!(samples, vec![(t0, vec![0.5]), (t_end, vec![0.5])]);
+    let stop = f64::from_bits(t0.to_bits() + 2);
+    let (mut samples, mut steps) = (vec![], 0);
+    let times = [t0, 4.0];
+    let end = run_segment_with_stops(&seg, vec![0.5], t0, 4.0, &[stop, 3.5], &times, &o, &mut samples, &mut steps);
+    assert!(end.unwrap().is_none() && steps > 0);
+    assert!((samples[1].1[0] - 0.5 * (-2.0f64).exp()).abs() < 1e-6, "{samples:?}");
 }
