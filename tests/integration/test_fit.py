@@ -25,6 +25,7 @@ from tcsim.analysis.fitting import (
     fit_hrovat_tobler,
     target_table,
 )
+from tcsim.api import steady_state
 from tcsim.cli import main
 from tcsim.errors import InputError, TcsimWarning
 from tcsim.models.characteristic import Characteristic
@@ -258,6 +259,7 @@ def test_fit_runs_on_every_shared_table(path, bundled, tmp_path, cli):
     tr0, cf0, _, _ = _core.ht_ratio_gradients(bundled.core_geometry(), PUMP_SPEED_RAD_S, sr, [])
     assert e["rms_torque_ratio"] < np.sqrt(np.mean((tr0 / report["points"]["torque_ratio_table"] - 1) ** 2))
     assert e["rms_capacity_factor"] < np.sqrt(np.mean((cf0 / report["points"]["capacity_factor_table"] - 1) ** 2))
+    assert_the_report_is_the_written_converters(out)
     if resized:  # the size is the whole difference: radii and area close it (measured 0.03–0.6 %)
         assert e["rms_torque_ratio"] < 0.01 and e["rms_capacity_factor"] < 0.01
     # every free parameter at a bound or outside its measured range (thesis §4.1.1) is warned about in
@@ -284,3 +286,37 @@ def test_fit_runs_on_every_shared_table(path, bundled, tmp_path, cli):
         f"max {100 * e['max_torque_ratio']:.2f} %, {100 * e['max_capacity_factor']:.2f} %\n  angles: {angles}\n  "
         + "\n  ".join(warned)
     )
+
+
+def assert_the_report_is_the_written_converters(out: Path) -> None:
+    """The fit's reported model values and errors are those of the converter it wrote, computed
+    afresh with the steady state every command uses (the flow starting from rest), and that
+    converter flows at every fitted point."""
+    report = json.loads((out / "fit_report.json").read_text())
+    pts = report["points"]
+    sr = np.array(pts["speed_ratio"])
+    pump = report["pump_speed_rpm"] * np.pi / 30.0
+    own = steady_state(str(out / "fitted.toml"), "hrovat-tobler", pump, sr * pump)
+    assert (own["stator_mode"] != "no-flow").all(), own[["speed_ratio", "stator_mode"]]
+    np.testing.assert_allclose(own["torque_ratio"], pts["torque_ratio_model"], rtol=1e-9)
+    np.testing.assert_allclose(own["capacity_factor_nm_s2"], pts["capacity_factor_model"], rtol=1e-9)
+    tr_err = own["torque_ratio"].to_numpy() / np.array(pts["torque_ratio_table"]) - 1.0
+    assert report["errors"]["rms_torque_ratio"] == pytest.approx(np.sqrt(np.mean(tr_err**2)), rel=1e-9)
+
+
+def test_a_fit_whose_flow_cannot_start_is_not_reported_as_a_good_fit(tmp_path, cli):
+    """Fresh-eyes trial: a supplier K-factor table fitted 0.5 % on the forward-flow branch of a
+    geometry whose flow is held at rest (two steady states); the converter written transmitted no
+    torque anywhere (``characterise`` gave no flow) and a launch with it crashed in its plots."""
+    target = tmp_path / "ktab.csv"
+    target.write_text(
+        "# a supplier's K-factor table\nspeed_ratio,torque_ratio,k_factor_rpm_per_sqrt_nm\n"
+        "0.0,2.05,160\n0.2,1.80,162\n0.4,1.55,166\n0.6,1.30,175\n0.8,1.08,195\n0.87,1.00,215\n"
+        "0.95,1.00,300\n1.0,1.00,900\n",
+        encoding="utf-8",
+    )
+    out = tmp_path / "fit"
+    run = cli("fit", "li-sunden-2016", "--target", target, "--out", out, "--no-plots")
+    assert run.code == 0, run.stderr
+    assert_the_report_is_the_written_converters(out)
+    assert json.loads((out / "fit_report.json").read_text())["errors"]["rms_torque_ratio"] < 0.01

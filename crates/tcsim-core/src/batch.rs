@@ -208,8 +208,9 @@ pub fn ht_pump_speed_at_pump_torque(geometry: &HtGeometry<f64>, pump_torque_nm: 
 /// with their exact derivatives with respect to the parameters `free`.
 ///
 /// Returns `(tr, cf, d_tr, d_cf)`; the derivative matrices are row-major, `n_points × free.len()`.
-/// Points without a forward-flow drive steady state ([`drive_steady_state`]) are NaN, which a
-/// least-squares fit must treat as a failure.
+/// Points without a forward-flow drive steady state ([`drive_steady_state`]), or where the model's
+/// own steady state ([`try_steady_state`], the flow starting from rest) does not flow forwards, are
+/// NaN, which a least-squares fit must treat as a failure.
 pub fn ht_ratio_gradients(
     geometry: &HtGeometry<f64>,
     pump_speed_rad_s: f64,
@@ -223,7 +224,15 @@ pub fn ht_ratio_gradients(
     let mut dcf = vec![f64::NAN; n * k];
     let wp = Dual::cst(pump_speed_rad_s);
     let w2 = pump_speed_rad_s * pump_speed_rad_s;
+    let constants = HtConstants::new(geometry);
     for (i, &sr) in speed_ratio.iter().enumerate() {
+        // the model's own steady state (from rest, as `characterise` and every run compute it) must
+        // flow forwards here: a geometry whose flow is held at rest though a forward-flow state
+        // exists (two steady states) fitted 0.5 % while the converter it wrote transmitted nothing
+        let own = try_steady_state(&constants, pump_speed_rad_s, sr * pump_speed_rad_s);
+        if !own.is_ok_and(|s| s.mode != StatorMode::NoFlow && s.flow_m3_s > 0.0) {
+            continue;
+        }
         let wt = Dual::cst(sr * pump_speed_rad_s);
         // one forward pass per free parameter; without free parameters, one plain pass
         let seeds: Vec<HtGeometry<Dual>> =
