@@ -11,7 +11,7 @@ import pandas as pd
 
 from ..models.characteristic import Characteristic
 from ..models.steady import ratio_frame
-from .common import mpl_text, plt
+from .common import mpl_text, plt, save_figure
 from .styles import model_line
 
 QUANTITIES = {
@@ -54,7 +54,7 @@ def plot_characteristic(
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
         path = out_dir / filename
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path)
         plt.close(fig)
         paths.append(path)
     return paths

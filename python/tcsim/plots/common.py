@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -57,6 +58,27 @@ def fixed_figure(figsize: tuple[float, float], height_ratios: tuple[float, ...] 
     return fig, axes
 
 
+def _no_markers_without_points(fig) -> None:
+    """Drop the markers of every line without a finite point: matplotlib (3.10) fails to draw a
+    fractional ``markevery`` on one (an IndexError that ended a launch whose converter transmits
+    nothing, found by a fresh-eyes trial; before it ``tcsim characterise`` of a fitted converter)."""
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            try:
+                x, y = (np.asarray(v, dtype=float) for v in line.get_data())
+            except (TypeError, ValueError):  # not numbers (no such line here): matplotlib's business
+                continue
+            if not (np.isfinite(x) & np.isfinite(y)).any():
+                line.set_marker("")
+                line.set_markevery(None)
+
+
+def save_figure(fig, path: Path, dpi: int = 120) -> None:
+    """Save ``fig`` as every figure of tcsim is saved (markers only on lines that have points)."""
+    _no_markers_without_points(fig)
+    fig.savefig(path, dpi=dpi)
+
+
 def finish_figure(fig, ax, path: Path, title: str, xlabel: str = "Time [s]") -> Path:
     """Label, grid, legend (when there are labelled lines), save at 120 dpi and close."""
     ax.set_xlabel(xlabel)
@@ -64,6 +86,6 @@ def finish_figure(fig, ax, path: Path, title: str, xlabel: str = "Time [s]") -> 
     ax.grid(True, alpha=0.3)
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize="small")
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     plt.close(fig)
     return path

@@ -15,7 +15,7 @@ import pandas as pd
 
 from ..models.characteristic import Characteristic
 from .characteristic import QUANTITIES, table_columns
-from .common import mpl_text, plt
+from .common import mpl_text, plt, save_figure
 from .styles import model_line
 
 #: The speed-ratio span of the figures: the drive range the fit's model covers.
@@ -86,7 +86,7 @@ def plot_fit(
     for column, (_, filename) in QUANTITIES.items():
         fig, _ = fit_figure(column, curves, title, table, speed_ratio_max, coupling_point)
         path = out_dir / filename
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path)
         plt.close(fig)
         paths.append(path)
     return paths

@@ -36,7 +36,7 @@ from matplotlib.ticker import MaxNLocator
 from ..analysis.launch import REFERENCE_MODEL
 from ..analysis.launch_metrics import RECOVERY_BAND, deficit_series, shift_windows
 from ..units import KM_H
-from .common import finish_figure, fixed_figure, mpl_text, plt
+from .common import finish_figure, fixed_figure, mpl_text, plt, save_figure
 from .styles import MODEL_STYLES, model_line
 
 LABELS = {name: style.label for name, style in MODEL_STYLES.items()}
@@ -87,7 +87,8 @@ def plot_torque_speed_ratio(frames: Frames, release: float, out_dir: Path) -> Pa
         # of external torques would also carry the pump's and turbine's inertia torques
         ax.plot(w["time_s"], w["effective_torque_ratio"], **_style(name, i))
         ax.plot(w["time_s"], w["speed_ratio"], **model_line(name, i, label="_nolegend_"))
-        top = max(top, float(np.nanmax(w["effective_torque_ratio"], initial=0.0)) + 0.1)
+        etr = w["effective_torque_ratio"].to_numpy(dtype=float)
+        top = max(top, float(np.max(etr[np.isfinite(etr)], initial=0.0)) + 0.1)  # all NaN: no torque
     _release_line(ax, release)
     ax.text(0.01, 0.97, "upper lines: effective torque ratio", transform=ax.transAxes, va="top", fontsize="small")
     ax.text(0.01, 0.03, "lower lines: speed ratio", transform=ax.transAxes, va="bottom", fontsize="small")
@@ -135,7 +136,7 @@ def plot_effective_torque_ratio(frames: Frames, release: float, out_dir: Path, s
     if ax.get_legend_handles_labels()[0]:
         ax.legend(fontsize="small")
     path = Path(out_dir) / "effective_torque_ratio.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     plt.close(fig)
     return path
 
@@ -237,7 +238,7 @@ def _two_panels(title: str):
 def _save_panels(fig, top, path: Path) -> Path:
     if top.get_legend_handles_labels()[0]:
         top.legend(fontsize="small")
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     plt.close(fig)
     return path
 

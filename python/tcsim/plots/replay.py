@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .common import finish_figure, mpl_text, plt
+from .common import finish_figure, mpl_text, plt, save_figure
 from .styles import model_line
 
 #: Signals by name (a measurement's channels, or a run's columns), each an array over time.
@@ -50,7 +50,7 @@ def plot_inputs(time_s: np.ndarray, channels: Signals, inputs: Sequence[str], ti
     axes[0].set_title(mpl_text(title), fontsize="medium")
     axes[-1].set_xlabel("Time [s]")
     path = out_dir / "inputs.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     plt.close(fig)
     return path
 

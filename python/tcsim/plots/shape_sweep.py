@@ -7,7 +7,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from .common import mpl_text, plt
+from .common import mpl_text, plt, save_figure
 from .styles import model_line
 
 _PLOTS = (
@@ -62,7 +62,7 @@ def plot_shape_effect_sweep(
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
         path = Path(out_dir) / filename
-        fig.savefig(path, dpi=120)
+        save_figure(fig, path)
         plt.close(fig)
         paths.append(path)
     return paths

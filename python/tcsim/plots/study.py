@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from ..analysis.study import ParameterRange
-from .common import mpl_text, plt
+from .common import mpl_text, plt, save_figure
 
 _PANELS = (
     ("torque_ratio", "Torque ratio [-]"),
@@ -44,7 +44,7 @@ def plot_parameter(
         ax.grid(True, alpha=0.3)
     axes[0].legend(title=mpl_text(f"{p.label} [{p.unit}]"), fontsize="small")
     fig.suptitle(mpl_text(f"Effect of parameter '{p.label}': {title}"))
-    fig.savefig(path, dpi=dpi)
+    save_figure(fig, path, dpi)
     plt.close(fig)
     return path
 

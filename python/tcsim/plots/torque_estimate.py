@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 
 from ..analysis.torque_estimate import TorqueComparison
-from .common import mpl_text, plt
+from .common import mpl_text, plt, save_figure
 
 #: The most steps drawn in ``steps.png`` (the first ones; steps.csv lists all).
 MAX_STEP_PANELS = 12
@@ -74,7 +74,7 @@ def plot_overview(comparison: TorqueComparison, out_dir: Path) -> Path:
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize="small")
     path = Path(out_dir) / "torque_estimate.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     plt.close(fig)
     return path
 
@@ -110,7 +110,7 @@ def plot_steps(comparison: TorqueComparison, out_dir: Path) -> Path | None:
     if len(c.steps) > len(steps):
         fig.suptitle(f"The first {len(steps)} of {len(c.steps)} load steps (steps.csv lists all)", fontsize="medium")
     path = Path(out_dir) / "steps.png"
-    fig.savefig(path, dpi=120)
+    save_figure(fig, path)
     plt.close(fig)
     return path
 
