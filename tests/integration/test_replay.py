@@ -431,3 +431,14 @@ def test_ignored_initial_state_warns(cli, tmp_path, meas_csv):
     )
     assert r.code == 0, r.stderr
     assert "turbine_speed_rad_s is ignored" in r.stderr and "flow_m3_s is ignored by the table model" in r.stderr
+
+
+def test_a_window_constant_to_round_off_has_no_nrmse():
+    # fresh-eyes trial: a replayed launch's braked windows, constant to rounding (a range of 1e-13),
+    # gave NRMSE 5.7e12 next to windows of the same data with NaN
+    t = np.linspace(0.0, 3.0, 301)
+    measured = np.where(t < 2.0, 74.8 + 1e-13 * np.sin(40.0 * t), 74.8 + 10.0 * (t - 2.0))
+    df = error_metrics(t, measured, measured + 0.3, window_s=1.0)
+    assert np.isnan(df.iloc[1]["nrmse"]) and np.isnan(df.iloc[2]["nrmse"]), df
+    assert df.iloc[3]["nrmse"] == pytest.approx(0.3 / np.ptp(measured[200:]), rel=1e-12)
+    assert df.iloc[0]["nrmse"] == pytest.approx(0.3 / np.ptp(measured), rel=1e-12)

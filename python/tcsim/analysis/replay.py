@@ -88,7 +88,8 @@ Outputs (in DIR, default ``replay``; written all at once, nothing on error)
   windows without a sample are left out). An explicit ``--metrics-window`` shorter than the
   median sample spacing or longer than the record's span is refused (:func:`check_record_windows`).
   The error is simulated − measured; RMSE = √mean(error²); NRMSE = RMSE / (max − min of the
-  measured channel in the window), NaN when that range is zero; ``n`` is the number of samples.
+  measured channel in the window), NaN when that range is zero or below :data:`FLAT_RANGE` of the
+  channel's largest magnitude (constant to round-off); ``n`` is the number of samples.
 * Plots (PNG): ``inputs.png`` (the input signals, thesis figures 3.11/3.12); per reference output
   ``pump_speed.png`` and ``turbine_torque.png`` (drive (a), figures 3.14 and 3.13) or
   ``pump_torque.png`` and ``turbine_torque.png`` (drive (b)); ``effective_pump_torque.png`` (figure
@@ -311,6 +312,18 @@ def reference_channels(meas: Measurement, drive: DriveKind, effective: dict[str,
 # metrics (pure)
 
 
+#: A measured range below this fraction of the channel's largest magnitude is no range: the channel
+#: is constant to round-off there, and its NRMSE is NaN (a fresh-eyes trial found 5.7e12 where a
+#: constant channel's range was 1e-13 of rounding).
+FLAT_RANGE = 1e-9
+
+
+def _flat_below(measured: np.ndarray) -> float:
+    """The range below which ``measured`` (a channel, or a window of it) counts as constant."""
+    finite = np.abs(measured[np.isfinite(measured)])
+    return FLAT_RANGE * float(finite.max(initial=0.0))
+
+
 def _stats(time_s: np.ndarray, measured: np.ndarray, simulated: np.ndarray) -> dict[str, float]:
     err = simulated - measured
     rmse = float(np.sqrt(np.mean(err * err)))
@@ -318,7 +331,7 @@ def _stats(time_s: np.ndarray, measured: np.ndarray, simulated: np.ndarray) -> d
     j = int(np.argmax(np.abs(err)))
     return {
         "rmse": rmse,
-        "nrmse": rmse / span if span > 0 else math.nan,
+        "nrmse": rmse / span if span > _flat_below(measured) else math.nan,
         "max_abs_error": float(abs(err[j])),
         "max_abs_error_time_s": float(time_s[j]),
         "n": int(len(err)),
@@ -337,8 +350,9 @@ def _window_stats(time_s: np.ndarray, measured: np.ndarray, simulated: np.ndarra
     segment = np.repeat(np.arange(len(starts)), counts)
     hits = np.flatnonzero(key == np.maximum.reduceat(key, starts)[segment])
     first = hits[np.unique(segment[hits], return_index=True)[1]]
+    ranged = span > _flat_below(measured)  # against the whole channel's magnitude
     with np.errstate(divide="ignore", invalid="ignore"):
-        nrmse = np.where(span > 0, rmse / np.where(span > 0, span, 1.0), math.nan)
+        nrmse = np.where(ranged, rmse / np.where(ranged, span, 1.0), math.nan)
     return pd.DataFrame(
         {
             "rmse": rmse,
@@ -371,7 +385,8 @@ def error_metrics(time_s, measured, simulated, window_s: float | None = METRICS_
     """Errors of ``simulated`` against ``measured`` (same samples) over the whole record and over
     consecutive windows of ``window_s``: columns ``window, window_start_s, window_end_s, rmse,
     nrmse, max_abs_error, max_abs_error_time_s, n``. Error = simulated − measured; NRMSE = RMSE /
-    (max − min of measured in the window), NaN when that is zero."""
+    (max − min of measured in the window), NaN when that is zero or below :data:`FLAT_RANGE` of the
+    channel's largest magnitude."""
     t, m, s = (np.asarray(a, dtype=float) for a in (time_s, measured, simulated))
     if not (len(t) == len(m) == len(s)) or len(t) == 0:
         raise ValueError(f"time, measured and simulated need the same non-zero length ({len(t)}, {len(m)}, {len(s)})")
