@@ -100,3 +100,12 @@ def test_a_signal_swallowed_into_another_exception_is_still_an_interrupt(cli, tm
     assert r.code == 128 + signal.SIGTERM, r.stderr
     assert r.stdout.strip().splitlines() + r.stderr.strip().splitlines() == ["interrupted (SIGTERM): nothing written"]
     assert os.listdir(tmp_path) == []
+
+
+def test_a_study_without_any_figures_says_so(cli, tmp_path):
+    # fresh-eyes trial: every design refused, and the run read like a good one (exit 0, no warning)
+    r = cli("design-study", "li-sunden-2016-design", "--sweep", "squash_ratio=1.0:1.5:2", "--out", tmp_path / "o")
+    assert r.code == 0, r.stderr
+    assert "warning: none of the 2 designs has figures (the first: --sweep: squash_ratio = 1: " in r.stderr, r.stderr
+    ok = cli("design-study", "li-sunden-2016-design", "--sweep", "squash_ratio=0.0:1.0:2", "--out", tmp_path / "p")
+    assert ok.code == 0 and "none of the" not in ok.stderr, ok.stderr

@@ -255,3 +255,23 @@ def test_the_launch_runs_on_the_vehicle_given(tmp_path, cli):
     assert bad.stderr.strip().splitlines() == [
         "error: nope: vehicle = 'nope': expected a bundled vehicle (midsize-awd-8at) or an existing vehicle .toml file"
     ]
+
+
+def test_a_radius_in_mm_blames_the_design_not_the_bundled_vehicle(tmp_path, cli):
+    """Fresh-eyes trial: `pump_exit_radius_m = 120` (mm typed as m) ended on one line naming the
+    bundled vehicle's idle speed in site-packages, and warned of `[inertia].pump_kg_m2` and
+    `[geometry].fluid_length_m` as if the design file held them."""
+    design = tmp_path / "mm.toml"
+    design.write_text(_edit(_bundled_text(), "pump_exit_radius_m = 0.12", "pump_exit_radius_m = 120"), encoding="utf-8")
+    r = cli("design", design, "--out", tmp_path / "o")
+    assert r.code == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    errors = [line for line in lines if line.startswith("error: ")]
+    assert len(errors) == 1 and errors[0].startswith(f"error: {design}: [design] = 'the derived converter': "), r.stderr
+    assert "can hold the stalled converter" in errors[0] and "radii and their units" in errors[0]
+    warned = [line.removeprefix(f"warning: {design}: ") for line in lines if line.startswith("warning: ")]
+    assert any(w.startswith("[design].pump_exit_radius_m = 120 is outside the plausible") for w in warned), warned
+    assert any(w.startswith("the derived [inertia].pump_kg_m2 = ") for w in warned), warned
+    assert any(w.startswith("the derived [geometry].fluid_length_m = ") for w in warned), warned
+    assert not any(w.startswith(("[inertia]", "[geometry]")) for w in warned), warned
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["mm.toml"]

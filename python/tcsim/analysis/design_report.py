@@ -31,6 +31,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 import pandas as pd
 
+from ..errors import InputError
 from ..models.converter import Converter, load_converter
 from ..models.design_file import DerivedConverter, DesignFile, derive_converter
 from ..models.drives import isolated_takeoff
@@ -192,6 +193,27 @@ def summary_row(
     }
 
 
+def _design_launches(
+    file: DesignFile, converters: Sequence[Converter], labels: Sequence[str], vehicle: Vehicle | None
+) -> dict[str, LaunchRun]:
+    """:func:`launch_runs`; a refusal by the vehicle's checks (its engine cannot hold the stalled
+    converter) is the design's: the vehicle holds the reference, so the derived converter is what
+    changed (a radius typed in mm blamed the bundled vehicle's idle speed, in a file the user never
+    touched: a fresh-eyes trial)."""
+    try:
+        return launch_runs(converters, labels, vehicle)
+    except InputError as e:
+        if e.core_source != "vehicle":
+            raise
+        expected = (
+            f"a design whose converter the launch vehicle can drive; {e.source} refused it: "
+            f"{e.field} = {e.value:g}: expected {e.expected} (check the design's radii and their units)"
+            if isinstance(e.value, float)
+            else f"a design whose converter the launch vehicle can drive; {e}"
+        )
+        raise InputError(file.path, "[design]", "the derived converter", expected) from None
+
+
 def design_report(
     file: DesignFile,
     reference: str = DEFAULT_REFERENCE,
@@ -207,7 +229,7 @@ def design_report(
     pairs = ((derived.converter, "design"), (ref, "reference"))
     names = [derived.converter.name]
     names.append(ref.name if ref.name != names[0] else f"{ref.name} (reference)")
-    runs = launch_runs([c for c, _ in pairs], names, vehicle)
+    runs = _design_launches(file, [c for c, _ in pairs], names, vehicle)
     characteristics, takeoffs, launches, rows = {}, {}, {}, []
     for (conv, role), name in zip(pairs, names):
         characteristics[name] = characterise(conv, "hrovat-tobler", pump_speed_rpm)

@@ -15,6 +15,7 @@ running the same command again (:class:`tcsim.analysis.chunked.DesignSweepStudy`
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Annotated
 
@@ -55,7 +56,7 @@ def design_study(
     """The command; its help is :data:`HELP`."""
     from ..analysis.chunked import check_chunk_size, check_scheduler, design_sweep_study
     from ..analysis.design_study import check_sweep, design_study, parse_sweep
-    from ..errors import InputError
+    from ..errors import InputError, TcsimWarning
     from ..io.outputs import check_output_dir, output_dir
     from ..io.tables import write_table
     from ..models.design_file import load_design_file
@@ -90,6 +91,9 @@ def design_study(
         if plots:
             plot_design_pareto(study, stage, f"{file.name}: design study of {' × '.join(names)}")
     failed = int((study["error"] != "").sum())
+    if failed == len(study):  # a script cannot tell it from a good study by the exit code alone
+        first = study["error"].iloc[0]
+        warnings.warn(f"none of the {failed} designs has figures (the first: {first})", TcsimWarning, stacklevel=1)
     say(f"{file.name}: {len(study)} designs of {' × '.join(names)}, {failed} without figures, written to {out}")
     front = study[study["pareto_front"]]
     say(f"Pareto front: {len(front)} designs (stall TR against take-off effective-TR dip)")

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import tomllib
+import warnings
 from collections.abc import Sequence
 from dataclasses import MISSING, dataclass, fields
 from importlib import resources
@@ -27,7 +28,7 @@ from typing import TYPE_CHECKING, Any, get_type_hints
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
-from ..errors import InputError
+from ..errors import InputError, TcsimWarning
 from .converter import Converter, GeometrySection, InertiaSection, load_converter, parse_converter
 from .design import DEFAULT_POINTS, DesignGeometry, TorusDesign, design_geometry, design_table, geometry_of_row
 
@@ -254,13 +255,38 @@ def _converter_of(file: DesignFile, g: DesignGeometry) -> DerivedConverter:
         document["description"] = file.description
     document |= {"inertia": inertia, "geometry": geometry, "sources": _sources(file, defaults)}
     try:
-        converter = parse_converter(document, file.path)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", TcsimWarning)
+            converter = parse_converter(document, file.path)
     except InputError as e:
         key = e.field.removeprefix("[geometry].")
         if key in file.losses:
             raise InputError(file.path, f"[losses].{key}", e.value, e.expected) from None
         raise
+    for w in caught:
+        if issubclass(w.category, TcsimWarning):
+            warnings.warn(_as_design_field(file, str(w.message)), TcsimWarning, stacklevel=3)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return DerivedConverter(document, converter, g, defaults)
+
+
+def _as_design_field(file: DesignFile, message: str) -> str:
+    """A plausibility warning of the derived converter as the design file's: a value the file holds
+    named where it holds it (``[design].pump_exit_radius_m``, ``[losses].friction_loss``), a derived
+    one said to be derived (a trial's warnings named ``[inertia].pump_kg_m2`` in a design file that
+    has no such section)."""
+    head = f"{file.path}: "
+    rest = message.removeprefix(head)
+    field, sep, tail = rest.partition(" = ")
+    section, _, key = field.partition(".")
+    if not (sep and message.startswith(head) and section.startswith("[")):
+        return message
+    if section == "[geometry]" and key in file.losses:
+        return f"{head}[losses].{key} = {tail}"
+    if section == "[geometry]" and key in {f.name for f in fields(TorusDesign)}:
+        return f"{head}[design].{key} = {tail}"
+    return f"{head}the derived {field} = {tail}"
 
 
 __all__ = [
