@@ -14,7 +14,7 @@ import pandas as pd
 import pytest
 
 from tcsim.analysis.effective import measured_effective_torques, smoothed_rate
-from tcsim.analysis.shape_fit import fit_shape_effects, shape_effect_sweep, sweep_minima
+from tcsim.analysis.shape_fit import ShapeFitResult, fit_shape_effects, shape_effect_sweep, sweep_minima
 from tcsim.cli.fit_shapes import shape_fit_command
 from tcsim.errors import InputError
 from tcsim.models.shape_effects import THESIS_PAIR_M2, THESIS_VALUES_M2, mass_matrix_bound
@@ -273,3 +273,21 @@ def test_fit_shapes_command_line(tmp_path, drive_a, cli):
     r = cli("fit-shapes", CONVERTER, bad, "--out", tmp_path / "bad")
     assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1 and "turbine_torque_nm" in r.stderr
     assert not (tmp_path / "bad").exists()
+
+
+def test_a_shape_effect_at_a_bound_is_warned_of_like_a_fit_parameter():
+    # fresh-eyes trial: S_t ended at its lower bound −0.5 m² and only shape_fit.md said so
+    r = ShapeFitResult(
+        "quasi-dynamic", "effective_turbine_torque_nm", 0.31295, -0.5, 3.1, 3.3, 40, None,
+        pump_bounds_m2=(-0.5, 0.5), turbine_bounds_m2=(-0.5, 0.5), active={"turbine_shape_effect_m2": "lower"},
+    )  # fmt: skip
+    assert r.bound_warnings("m.csv") == [
+        "m.csv: fitted turbine_shape_effect_m2 = -0.5 m² ends at its lower bound (bounds -0.5 to 0.5 m²): "
+        "the best fit may lie beyond it"
+    ]
+    assert (
+        ShapeFitResult("quasi-dynamic", "effective_turbine_torque_nm", 0.1, 0.1, 1.0, 2.0, 9, None).bound_warnings(
+            "m.csv"
+        )
+        == []
+    )

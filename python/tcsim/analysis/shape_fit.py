@@ -137,6 +137,26 @@ class ShapeFitResult:
             },
         }
 
+    def bound_warnings(self, source: str) -> list[str]:
+        """One line per shape effect that ended at a bound of the fit, naming ``source`` (the
+        measurement), as ``tcsim fit`` warns of its parameters (a fresh-eyes trial found S_t at
+        its lower bound −0.5 m² said only in ``shape_fit.md``)."""
+        bounds = {
+            "shape_effect_m2": self.pump_bounds_m2,
+            "pump_shape_effect_m2": self.pump_bounds_m2,
+            "turbine_shape_effect_m2": self.turbine_bounds_m2,
+        }
+        value = {
+            "shape_effect_m2": self.pump_shape_effect_m2,
+            "pump_shape_effect_m2": self.pump_shape_effect_m2,
+            "turbine_shape_effect_m2": self.turbine_shape_effect_m2,
+        }
+        return [
+            f"{source}: fitted {name} = {value[name]:.5g} m² ends at its {side} bound (bounds "
+            f"{bounds[name][0]:.4g} to {bounds[name][1]:.4g} m²): the best fit may lie beyond it"
+            for name, side in self.active.items()
+        ]
+
     def one_line(self) -> str:
         return (
             f"{self.model}: S_p = {self.pump_shape_effect_m2:.5g} m², S_t = {self.turbine_shape_effect_m2:.5g} m²; "

@@ -6,6 +6,7 @@ sweep of thesis figures 4.1–4.2 (see :mod:`tcsim.analysis.shape_fit`).
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -54,6 +55,7 @@ def shape_fit_command(
     """
     from ..analysis import shape_fit as sf
     from ..analysis.effective import measured_effective_torques
+    from ..errors import TcsimWarning
     from ..io.measurement import parse_channel_map, read_measurement
     from ..io.outputs import check_output_dir, output_dir
     from ..io.results import write_frames, write_text_files
@@ -85,6 +87,8 @@ def shape_fit_command(
     effective = measured_effective_torques(meas, inertia[1], inertia[0])
     drv = sf.drive_of(meas, drive)
     result = sf.fit_shape_effects(conv, base, drv, meas.time_s, effective[target], target, equal=equal)
+    for line in result.bound_warnings(meas.source):
+        warnings.warn(line, TcsimWarning, stacklevel=1)
     fitted = (result.pump_shape_effect_m2, result.turbine_shape_effect_m2)
     sweep = sf.shape_effect_sweep(conv, base, drv, sweep_values(base), pairs=[fitted], times_s=meas.time_s)
     sweep.loc[(sweep.pump_shape_effect_m2 == fitted[0]) & (sweep.turbine_shape_effect_m2 == fitted[1]), "label"] = (
