@@ -431,6 +431,13 @@ def test_cli_export_fmu(cli, library_env, tmp_path):
     assert out.is_file() and validate_fmu(str(out)) == []
     assert json.loads(zipfile.ZipFile(out).read("resources/model.json"))["causality"] == "speeds"
     assert [p.name for p in out.parent.iterdir()] == ["ht.fmu"], "no temporary file left"
+    # the summary names every input the FMU declares (it left out turbine_accel_rad_s2: a trial)
+    declared = [
+        v.get("name")
+        for v in ElementTree.fromstring(zipfile.ZipFile(out).read("modelDescription.xml")).iter("ScalarVariable")
+        if v.get("causality") == "input"
+    ]
+    assert "turbine_accel_rad_s2" in declared and f"inputs {', '.join(declared)};" in " ".join(r.stdout.split())
 
 
 @pytest.mark.parametrize(

@@ -20,9 +20,9 @@ HELP = (
 def export_fmu_command(converter: str, model: str, out: Path, causality: str, fmi_version: str = "2") -> str:
     """Write the FMU; the line to print."""
     import json
+    import xml.etree.ElementTree as ET
     import zipfile
 
-    from ..io.fmu import CAUSALITIES, COMMON_INPUTS
     from ..io.fmu import export_fmu as write_fmu
     from ..io.fmu3 import fmi_version as version_of
 
@@ -31,7 +31,9 @@ def export_fmu_command(converter: str, model: str, out: Path, causality: str, fm
     with zipfile.ZipFile(path) as zf:
         params = json.loads(zf.read("resources/model.json"))["parameters"]
         platforms = sorted({n.split("/")[1] for n in zf.namelist() if n.startswith("binaries/")})
-    inputs = (*CAUSALITIES[causality], *COMMON_INPUTS)
+        # the inputs as the FMU declares them (a list kept here left out turbine_accel_rad_s2)
+        variables = ET.fromstring(zf.read("modelDescription.xml")).iter()
+        inputs = [v.get("name", "") for v in variables if v.get("causality") == "input"]
     return (
         f"{model} model of {converter} written to {path} (FMI {fmi.name} Model Exchange and Co-Simulation, "
         f"{', '.join(platforms)}; inputs {', '.join(inputs)}; {len(params)} tunable parameters)"
