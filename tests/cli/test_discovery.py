@@ -68,3 +68,19 @@ def test_help_shows_every_bracketed_word_of_its_options(cli, name):
         text = getattr(param, "help", None) or ""
         for word in re.findall(r"\\?\[([A-Za-z_][\w.]*)\]", text):
             assert f"[{word}]" in shown, (name, param.name, word)
+
+
+@pytest.mark.parametrize(
+    ("word", "expected"),
+    [
+        (
+            "lauch",
+            "command line: command = 'lauch': expected a command of tcsim (did you mean 'launch'? see 'tcsim --help')",
+        ),
+        ("xyzzy", "command line: command = 'xyzzy': expected a command of tcsim (see 'tcsim --help')"),
+    ],
+)
+def test_a_mistyped_command_is_one_line_naming_it(cli, word, expected):
+    # fresh-eyes trial: "No such command 'lauch'. Did you mean 'launch'?: expected the usage of ..."
+    r = cli(word)
+    assert r.code == 2 and r.stderr.strip() == f"error: {expected}", r.stderr

@@ -9,6 +9,7 @@ one line ``interrupted (SIGINT): nothing written`` and nothing written (docs/gua
 from __future__ import annotations
 
 import contextlib
+import re
 import signal
 import sys
 import warnings
@@ -252,6 +253,12 @@ def usage_error_line(e: Exception, argv: list[str]) -> str:
         value = _option_value(argv, opts)
         detail = reason.split(": ", 1)[-1]
         return f"command line: {opts[0]} = {value!r}: expected a valid value ({detail}; see '{command} --help')"
+    unknown = re.fullmatch(r"No such command '(.*)'(?:\. Did you mean '(.*)'\?)?", reason)
+    if unknown:  # "No such command 'lauch'. Did you mean 'launch'?: expected the usage" read badly
+        hint = f"did you mean '{unknown.group(2)}'? " if unknown.group(2) else ""
+        return (
+            f"command line: command = {unknown.group(1)!r}: expected a command of tcsim ({hint}see '{command} --help')"
+        )
     return f"command line: {reason}: expected the usage of '{command} --help'"
 
 
