@@ -301,7 +301,7 @@ def test_the_vehicle_and_converter_files_are_relative_to_the_study_file(tmp_path
     assert Path(study.vehicle_path) == tmp_path / "files" / "v.toml"
     r = cli("monte-carlo", "files/s.toml", "--out", "o", "--no-plots", cwd=tmp_path)
     assert r.code == 0, r.stderr
-    assert "2 cases × 1 models (table), 0 of 2 runs without outputs" in r.stdout
+    assert "2 cases × 1 model (table), 0 of 2 runs without outputs" in r.stdout
 
 
 def test_more_runs_than_fit_in_memory_need_chunks(cli, tmp_path):
@@ -375,6 +375,15 @@ def test_the_command_line_on_a_local_cluster(cli, tmp_path, study_path, unchunke
     assert r.code == 0, r.stderr
     assert "45 rows in 4 chunks of 4 cases (4 computed, 0 kept from an earlier run)" in r.stdout
     pd.testing.assert_frame_equal(read_shards(tmp_path / "s"), unchunked, check_exact=True)
+    # the shards' statistics are one call away, and the command says which (fresh-eyes trial)
+    said = " ".join(r.stdout.split())
+    columns = ["model", "error", *study_outputs(study_path)]
+    assert f"statistics: tcsim.io.shards.read_shards({str(tmp_path / 's')!r}, {columns!r})" in said, said
+    assert list(read_shards(tmp_path / "s", columns).columns) == columns
+
+
+def study_outputs(path) -> list[str]:
+    return list(dict.fromkeys(load_study_file(path).doc.outputs))
 
 
 def test_the_summary_counts_finished_runs_without_a_value():

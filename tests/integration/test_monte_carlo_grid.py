@@ -148,7 +148,7 @@ def test_a_grid_alone_may_omit_runs_one_case_per_point(cli, tmp_path):
         {"parameter": PUMP, "kind": "grid", "start": 0.0, "stop": 0.003, "num": 4}
     ]
     r = cli("monte-carlo", path, "--out", tmp_path / "o", "--no-plots", "--no-progress")
-    assert r.code == 0 and "g: 4 cases (4 grid points) × 1 models (table), 0 of 4 runs without outputs" in r.stdout
+    assert r.code == 0 and "g: 4 cases (4 grid points) × 1 model (table), 0 of 4 runs without outputs" in r.stdout
 
 
 # --------------------------------------------------------------------------------------------

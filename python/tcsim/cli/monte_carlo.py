@@ -101,10 +101,16 @@ def monte_carlo(
     cases = f"{study.n_cases} cases"
     if sf.doc.grid_points > 1:
         cases += f" ({sf.doc.grid_points} grid points" + (f" × {sf.doc.n_runs} runs)" if sf.doc.n_runs > 1 else ")")
-    head = f"{sf.name}: {cases} × {len(study.models)} models ({', '.join(study.models)})"
+    models = f"{len(study.models)} model{'s' if len(study.models) != 1 else ''}"
+    head = f"{sf.name}: {cases} × {models} ({', '.join(study.models)})"
     if chunk_size is not None:
         run = run_sharded(study, out, chunk_size, tf.speed_unit, scheduler, workers, inputs, not no_progress)
         say(f"{head}, {run.rows} rows in {shards_line(run)}")
+        outputs = ", ".join(repr(o) for o in study.outputs)
+        say(
+            f"  statistics: tcsim.io.shards.read_shards({str(out)!r}, ['model', 'error', {outputs}]) reads "
+            "the rows for them (a run without --chunk-size prints them and draws the histograms)"
+        )
         return
     check_output_dir(out, inputs)
     with progress_display(not no_progress) as display:

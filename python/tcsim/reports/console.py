@@ -81,7 +81,7 @@ def launch_report(result: Launch, out: Path, ext: str = "csv", plots: bool = Tru
     with the suffix ``ext``; and plots if ``plots``)."""
     lines = [
         "–: not reached or nothing to compare with; times are from the brake release",
-        f"compute {result.compute_s * 1e3:.0f} ms for {len(result.runs)} models"
+        f"compute {result.compute_s * 1e3:.0f} ms for {len(result.runs)} model{'s' if len(result.runs) != 1 else ''}"
         + (f", sweep {result.sweep_compute_s * 1e3:.0f} ms" if result.sweep is not None else ""),
         rich_text(
             f"written to {out}/: summary.{ext}, {', '.join(f'{m}.{ext}' for m in result.runs)}, timeseries.{ext}, "
