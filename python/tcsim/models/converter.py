@@ -302,6 +302,13 @@ def _characteristic(doc: ConverterFile, tables: list[CharacteristicSection] | No
     return Characteristic.torque_dependent(out, path, prefixes)
 
 
+def _unknown_beside(err: ValidationError, loc: tuple[Any, ...]) -> str:
+    """For a missing key, the unknown keys beside it (a misspelt key was reported as missing
+    without naming what was typed: a fresh-eyes trial)."""
+    typed = [x["loc"][-1] for x in err.errors() if x["type"] == "extra_forbidden" and x["loc"][:-1] == loc[:-1]]
+    return f" (the section has the unknown key {', '.join(map(repr, typed))}: misspelt?)" if typed else ""
+
+
 def _pydantic_to_input_error(err: ValidationError, path: str, prefix: tuple[Any, ...] = ()) -> InputError:
     e = err.errors()[0]
     loc = [str(x) for x in (*prefix, *e["loc"])]
@@ -317,7 +324,7 @@ def _pydantic_to_input_error(err: ValidationError, path: str, prefix: tuple[Any,
         section = f"[{loc[0]}]" if len(loc) > 1 else "the top level"
         msg = f"a known key of {section} (this key is unknown; conventions.md lists the keys)"
     elif e["type"] == "missing":
-        value, msg = "missing", "this required key"
+        value, msg = "missing", "this required key" + _unknown_beside(err, e["loc"])
     elif e["type"] == "value_error":
         msg = msg.removeprefix("Value error, ")
         value = "" if isinstance(value, dict) else value
