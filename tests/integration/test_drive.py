@@ -166,3 +166,27 @@ def test_unknown_cycle_name_is_refused(cli, tmp_path):
         r.stderr.strip()
         == "error: command line: --cycle = 'wltc_3b': expected one of us06, udds, hwfet, wltc-3b or a trace file"
     )
+
+
+def test_a_trace_in_km_h_is_read_as_its_m_s_twin(tmp_path, cli):
+    # fresh-eyes trial: drive cycles are published in km/h and a trace file took m/s only
+    t = np.arange(0.0, 31.0)
+    kmh = np.concatenate([np.linspace(0.0, 45.0, 16), np.linspace(45.0, 0.0, 15)])
+    pd.DataFrame({"time_s": t, "vehicle_speed_km_h": kmh}).to_csv(tmp_path / "kmh.csv", index=False)
+    pd.DataFrame({"time_s": t, "vehicle_speed_m_s": kmh / 3.6}).to_csv(tmp_path / "ms.csv", index=False)
+    a, b = read_cycle(tmp_path / "kmh.csv"), read_cycle(tmp_path / "ms.csv")
+    assert a.speed_column == "vehicle_speed_km_h" and b.speed_column == "vehicle_speed_m_s"
+    np.testing.assert_array_equal(a.vehicle_speed_m_s, b.vehicle_speed_m_s)
+    # a speed beyond the range is named in the file's column and unit
+    fast = pd.DataFrame({"time_s": t, "vehicle_speed_km_h": kmh * 7.0})
+    fast.to_csv(tmp_path / "fast.csv", index=False)
+    r = cli("drive", "--cycle", tmp_path / "fast.csv", "--out", tmp_path / "o")
+    lines = r.stderr.strip().splitlines()
+    assert r.code == 2 and len(lines) == 1, r.stderr
+    assert lines[0].startswith(f"error: {tmp_path / 'fast.csv'}: vehicle_speed_km_h = '252 at row 13 (time_s 12)': ")
+    assert lines[0].endswith("(in m/s: the file's km/h ÷ 3.6)")
+    pd.DataFrame({"time_s": t, "vehicle_speed_m_s": kmh / 3.6, "vehicle_speed_km_h": kmh}).to_csv(
+        tmp_path / "both.csv", index=False
+    )
+    r = cli("drive", "--cycle", tmp_path / "both.csv", "--out", tmp_path / "o")
+    assert r.code == 2 and "vehicle_speed_km_h = 'given too': expected one speed column" in r.stderr

@@ -77,6 +77,9 @@ class Cycle:
     grade_percent: np.ndarray | None = None
     #: The file's first time stamp, s (``time_s`` starts at 0): errors name the file's own times.
     start_time_s: float = 0.0
+    #: The file's speed column: ``vehicle_speed_m_s``, or ``vehicle_speed_km_h`` (read ÷ 3.6), which
+    #: errors about the speed name with the file's value.
+    speed_column: str = "vehicle_speed_m_s"
 
     def core_spec(self) -> dict[str, Any]:
         """The trace as ``tcsim._core.drive_runs`` takes it."""
@@ -137,9 +140,13 @@ def located(error: InputError, cycle: Cycle) -> InputError:
     if error.core_source != "scenario" or match is None or int(match[2]) >= len(cycle.time_s):
         return error
     i = int(match[2])
-    value = f"{error.value:g}" if isinstance(error.value, float) else error.value
-    where = f"{value} at row {i + 1} (time_s {cycle.time_s[i] + cycle.start_time_s:g})"
-    return InputError(error.source, match[1], where, error.expected, core_source=error.core_source)
+    column, value, expected = match[1], error.value, error.expected
+    if column == "vehicle_speed_m_s" and cycle.speed_column != column:  # the file's km/h
+        column, expected = cycle.speed_column, f"{expected} (in m/s: the file's km/h ÷ 3.6)"
+        value = value * 3.6 if isinstance(value, float) else value
+    shown = f"{value:g}" if isinstance(value, float) else value
+    where = f"{shown} at row {i + 1} (time_s {cycle.time_s[i] + cycle.start_time_s:g})"
+    return InputError(error.source, column, where, expected, core_source=error.core_source)
 
 
 def run_drive(

@@ -3,10 +3,11 @@
 files of a drive.
 
 A trace file has ``time_s`` (s, strictly increasing; shifted so that the first sample is time 0),
-``vehicle_speed_m_s`` (m/s, starting at rest) and optionally ``grade_percent`` (%, positive
-uphill); linear between samples. The core checks the ranges (speed 0–250 km/h, grade ±30 %, the
-first speed at rest); :func:`tcsim.analysis.drive.located` names the file, the column, the value,
-its data row and time stamp, as for the other problems of the file.
+``vehicle_speed_m_s`` (m/s, starting at rest) or ``vehicle_speed_km_h`` (km/h, as cycles are
+published; not both) and optionally ``grade_percent`` (%, positive uphill); linear between samples.
+The core checks the ranges (speed 0–250 km/h, grade ±30 %, the first speed at rest);
+:func:`tcsim.analysis.drive.located` names the file, the column, the value, its data row and time
+stamp, as for the other problems of the file.
 """
 
 from __future__ import annotations
@@ -26,11 +27,14 @@ from .tables import CSV, TableFormat
 
 _REQUIRED = ("time_s", "vehicle_speed_m_s")
 _OPTIONAL = ("grade_percent",)
+#: The speed in km/h, as drive cycles are published (a trial had only m/s): read and divided by 3.6.
+_SPEED_KM_H = "vehicle_speed_km_h"
 #: The unit each column's name states, as a file's unit metadata (MDF4 channels) may spell it
 #: (lower case, no spaces); any other unit there is refused, no unit is the name's.
 _UNITS: dict[str, tuple[str, ...]] = {
     "time_s": ("s",),
     "vehicle_speed_m_s": ("m/s",),
+    _SPEED_KM_H: ("km/h", "kph"),
     "grade_percent": ("%", "percent"),
 }
 
@@ -48,13 +52,16 @@ class _CyclePicker:
         self.found: list[str] = []
 
     def __call__(self, names: Sequence[str]) -> list[str]:
-        for column in _REQUIRED:
+        speed = _SPEED_KM_H if _SPEED_KM_H in names and "vehicle_speed_m_s" not in names else "vehicle_speed_m_s"
+        if _SPEED_KM_H in names and "vehicle_speed_m_s" in names:
+            raise InputError(str(self.path), _SPEED_KM_H, "given too", "one speed column: vehicle_speed_m_s or km/h")
+        for column in ("time_s", speed):
             if column not in names:
                 shown = ", ".join(list(names)[:12]) + (" ..." if len(names) > 12 else "")
-                raise InputError(
-                    str(self.path), column, "missing", f"a column named {column}; columns found: {shown or '(none)'}"
-                )
-        self.found = [c for c in (*_REQUIRED, *_OPTIONAL) if c in names]
+                also = f" (or {_SPEED_KM_H})" if column == "vehicle_speed_m_s" else ""
+                expected = f"a column named {column}{also}; columns found: {shown or '(none)'}"
+                raise InputError(str(self.path), column, "missing", expected)
+        self.found = [c for c in ("time_s", speed, *_OPTIONAL) if c in names]
         refuse_duplicates(self.path, names, self.found)
         return self.found
 
@@ -87,13 +94,15 @@ def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
         if column == "time_s":
             time_s = values
         out[column] = values
+    speed = out["vehicle_speed_m_s"] if "vehicle_speed_m_s" in out else out[_SPEED_KM_H] / 3.6
     return Cycle(
         name or path.stem,
         str(path),
         out["time_s"] - out["time_s"][0],
-        out["vehicle_speed_m_s"],
+        speed,
         out.get("grade_percent"),
         float(out["time_s"][0]),
+        picker.found[1],
     )
 
 
