@@ -61,7 +61,10 @@ AllowImplausibleOpt = Annotated[
     bool,
     typer.Option(
         "--allow-implausible",
-        help="run values outside the plausibility ranges (docs/guarantees.md) with a warning instead of refusing them",
+        help=(
+            "run measured and command-line values outside the plausibility ranges (docs/guarantees.md) with a "
+            "warning instead of refusing them (a converter file's design values are only warned of)"
+        ),
     ),
 ]
 ChannelOpt = Annotated[list[str] | None, typer.Option("--channel", help="TARGET=COLUMN channel mapping, repeatable")]
