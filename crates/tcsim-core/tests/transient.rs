@@ -540,3 +540,22 @@ fn an_output_time_a_few_ulp_after_a_drive_time_stamp_is_reached() {
         }
     }
 }
+
+#[test]
+fn a_solver_error_names_the_coordinates_the_model_has() {
+    // the before/after comparison (issue 16) found a table model's solver errors showing
+    // `ω_s = 0, Q = 0`, coordinates it lacks, and a lagged table's lag torque (N·m) as `Q`
+    use tcsim_core::converter::dynamics::TorqueLag;
+    use tcsim_core::engine::options::named_state;
+    let names = |m: &dyn ConverterDynamics, n: usize| -> Vec<&str> {
+        let values: Vec<f64> = (0..n).map(|i| i as f64).collect();
+        named_state(Some(m), &values).into_iter().map(|(name, _)| name).collect()
+    };
+    let lagged = tcsim_core::converter::dynamics::TableDynamics { lag: Some(TorqueLag::new(0.05).unwrap()), ..table() };
+    assert_eq!(names(&table(), 4), ["ω_p", "ω_t"]);
+    assert_eq!(names(&lagged, 4), ["ω_p", "ω_t", "T_lag"]);
+    assert_eq!(names(&ht_fitted(SHAPE), 4), ["ω_p", "ω_t", "ω_s", "Q"]);
+    assert_eq!(names(&table(), 6), ["ω_p", "ω_t", "ω_o", "ω_f"]); // the vehicle's coordinates follow
+    let values: Vec<f64> = named_state(Some(&table()), &[3.0, 4.0, 0.0, 0.0]).into_iter().map(|(_, v)| v).collect();
+    assert_eq!(values, [3.0, 4.0]);
+}

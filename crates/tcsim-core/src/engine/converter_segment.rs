@@ -13,7 +13,7 @@ use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STAT
 use crate::engine::converter_events::{self, ConverterRoot, EventKind, LockupSample, Mode, Sample, SampleConstants};
 use crate::engine::drive::{Drive, TurbineLoad};
 use crate::engine::lockup::{self, ClutchMode, LockupCommand, LockupRoot};
-use crate::engine::options::{Hysteresis, SolverOptions};
+use crate::engine::options::{named_state, Hysteresis, NamedState, SolverOptions};
 use crate::engine::segment::SmoothSegment;
 use crate::engine::signal::Signal;
 
@@ -519,7 +519,7 @@ impl SmoothSegment for Segment<'_> {
     fn sample(&self, x: &[f64], t: f64) -> Sample {
         Segment::sample(self, x, t)
     }
-    fn coordinates(&self, x: &[f64], t: f64) -> Vec<f64> {
-        self.full(x, t).to_vec()
+    fn coordinates(&self, x: &[f64], t: f64) -> NamedState {
+        named_state(Some(self.model), &self.full(x, t))
     }
 }

@@ -42,7 +42,7 @@ use crate::converter::dynamics::{ConverterDynamics, SteadyPoint, Vec4, FLOW, PUM
 use crate::engine::converter_events::{EventKind, Mode, Sample};
 use crate::engine::converter_segment::{flow_sign_at_zero, lock_energies, switch, Root, Segment};
 use crate::engine::lockup;
-use crate::engine::options::{SolverOptions, TransientError, TransientResult};
+use crate::engine::options::{named_state, SolverOptions, TransientError, TransientResult};
 use crate::error::{sig, CoreError, CoreResult, InputSource};
 
 pub use crate::engine::drive::{Drive, TurbineLoad};
@@ -460,7 +460,7 @@ pub fn simulate_from(
                     let t_last = traj.samples.last().map_or(times_s[0], |s| s.time_s);
                     return Err(TransientError::Solver {
                         time_s: t_last,
-                        state: u.to_vec(),
+                        state: named_state(Some(model), &u),
                         message: format!(
                             "the solver stopped before the last output time ({} of {} samples)",
                             traj.samples.len(),
@@ -488,7 +488,7 @@ pub fn simulate_from(
                 if traj.events.len() > options.max_events {
                     return Err(TransientError::Solver {
                         time_s: t_root,
-                        state: next.to_vec(),
+                        state: named_state(Some(model), &next),
                         message: format!("more than {} events: the clutch or flow events chatter", options.max_events),
                     });
                 }

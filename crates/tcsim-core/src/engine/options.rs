@@ -1,5 +1,6 @@
 //! Solver options and the error type of the transient engines (isolated converter and vehicle).
 
+use crate::converter::dynamics::ConverterDynamics;
 use crate::error::{sig, CoreError, CoreResult, InputSource};
 
 /// Tolerances and limits of the BDF solver.
@@ -109,8 +110,8 @@ impl Default for SolverOptions {
 pub enum TransientError {
     /// The user's input (exit code 2).
     Input(CoreError),
-    /// The solver failed (exit code 1): time, state and message.
-    Solver { time_s: f64, state: Vec<f64>, message: String },
+    /// The solver failed (exit code 1): time, state (each coordinate's name and value) and message.
+    Solver { time_s: f64, state: NamedState, message: String },
 }
 
 impl From<CoreError> for TransientError {
@@ -124,12 +125,7 @@ impl std::fmt::Display for TransientError {
         match self {
             TransientError::Input(e) => write!(f, "{e}"),
             TransientError::Solver { time_s, state, message } => {
-                let names = ["ω_p", "ω_t", "ω_s", "Q", "ω_o", "ω_f", "ω_r", "v", "θ_f", "θ_r", "T_fast", "T_boost"];
-                let shown: Vec<String> = state
-                    .iter()
-                    .enumerate()
-                    .map(|(i, v)| format!("{} = {}", names.get(i).copied().unwrap_or("x"), sig(*v)))
-                    .collect();
+                let shown: Vec<String> = state.iter().map(|(name, v)| format!("{name} = {}", sig(*v))).collect();
                 write!(f, "solver failed at t = {} s ({}): {message}", sig(*time_s), shown.join(", "))
             }
         }
@@ -137,6 +133,27 @@ impl std::fmt::Display for TransientError {
 }
 
 pub type TransientResult<T> = Result<T, TransientError>;
+
+/// A state as a solver error shows it: each coordinate's name and value.
+pub type NamedState = Vec<(&'static str, f64)>;
+
+/// The names of the converter's coordinates and then the vehicle's, in their order.
+const COORDINATE_NAMES: [&str; 12] =
+    ["ω_p", "ω_t", "ω_s", "Q", "ω_o", "ω_f", "ω_r", "v", "θ_f", "θ_r", "T_fast", "T_boost"];
+
+/// `values` named by position ([`COORDINATE_NAMES`], `x` beyond them): the converter's four
+/// coordinates then the vehicle's. With `model`, the converter's coordinates the model lacks are left
+/// out and a table model's lag state is named `T_lag` (a table model's error showed `ω_s = 0, Q = 0`,
+/// and a lagged table's lag torque as `Q`).
+pub fn named_state(model: Option<&dyn ConverterDynamics>, values: &[f64]) -> NamedState {
+    let (present, lag) = model.map_or(([true; 4], false), |m| (m.coordinates(), m.lag_state()));
+    values
+        .iter()
+        .enumerate()
+        .filter(|&(i, _)| i >= 4 || present[i])
+        .map(|(i, &v)| (if i == 3 && lag { "T_lag" } else { COORDINATE_NAMES.get(i).copied().unwrap_or("x") }, v))
+        .collect()
+}
 
 #[cfg(test)]
 mod tests {
@@ -176,8 +193,8 @@ mod tests {
 
     #[test]
     fn solver_messages_print_six_digits() {
-        let e =
-            TransientError::Solver { time_s: 1e5 + 1e-9, state: vec![1e300, 50.0, 0.0, 0.0745], message: "m".into() };
+        let state = named_state(None, &[1e300, 50.0, 0.0, 0.0745]);
+        let e = TransientError::Solver { time_s: 1e5 + 1e-9, state, message: "m".into() };
         assert_eq!(e.to_string(), "solver failed at t = 100000 s (ω_p = 1e300, ω_t = 50, ω_s = 0, Q = 0.0745): m");
     }
 }

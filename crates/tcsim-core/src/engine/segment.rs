@@ -5,7 +5,7 @@
 use crate::engine::bdf::roots::RootFinder;
 use crate::engine::bdf::{Bdf, EXACT_MAX, N_MAX};
 
-use crate::engine::options::{Hysteresis, SolverOptions, TransientError, TransientResult};
+use crate::engine::options::{Hysteresis, NamedState, SolverOptions, TransientError, TransientResult};
 
 /// A smooth system `M ẋ = f(x, t)` with event functions, as one mode of a piecewise-smooth model.
 pub trait SmoothSegment {
@@ -22,8 +22,8 @@ pub trait SmoothSegment {
     /// Event functions, positive while the mode holds.
     fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]);
     fn sample(&self, x: &[f64], t: f64) -> Self::Sample;
-    /// The physical coordinates at (x, t), for error messages.
-    fn coordinates(&self, x: &[f64], t: f64) -> Vec<f64>;
+    /// The physical coordinates at (x, t), named, for error messages.
+    fn coordinates(&self, x: &[f64], t: f64) -> NamedState;
 }
 
 /// How a segment ended: the root that fired, its time and the state there (None at the end time).

@@ -399,7 +399,7 @@ fn run_step(
         if events_in_step > options.max_events.min(MAX_EVENTS_PER_STEP) {
             return Err(TransientError::Solver {
                 time_s: t_root,
-                state: next.to_vec(),
+                state: crate::engine::options::named_state(Some(plant.model), &next),
                 message: format!("more than {} events in one control step: events chatter", events_in_step - 1),
             });
         }

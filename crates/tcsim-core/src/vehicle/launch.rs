@@ -341,7 +341,7 @@ pub fn simulate_launch(
                 if traj.events.len() > options.max_events {
                     return Err(TransientError::Solver {
                         time_s: t_root,
-                        state: next.to_vec(),
+                        state: crate::engine::options::named_state(Some(plant.model), &next),
                         message: format!("more than {} events: events chatter", options.max_events),
                     });
                 }

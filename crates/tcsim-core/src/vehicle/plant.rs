@@ -630,8 +630,8 @@ impl SmoothSegment for Plant<'_> {
             tyre_force_n: tyre,
         }
     }
-    fn coordinates(&self, x: &[f64], _t: f64) -> Vec<f64> {
-        self.full(x).to_vec()
+    fn coordinates(&self, x: &[f64], _t: f64) -> crate::engine::options::NamedState {
+        crate::engine::options::named_state(Some(self.model), &self.full(x))
     }
 }
 

@@ -5,7 +5,7 @@
 
 use super::roots::RootFinder;
 use super::{Bdf, Matrix, N_MAX};
-use crate::engine::options::{Hysteresis, SolverOptions, TransientError};
+use crate::engine::options::{named_state, Hysteresis, NamedState, SolverOptions, TransientError};
 use crate::engine::segment::{run_segment, run_segment_with_stops, SmoothSegment};
 
 type Fun = fn(&[f64], f64, &mut [f64]);
@@ -72,8 +72,8 @@ impl SmoothSegment for Linear {
     fn sample(&self, x: &[f64], t: f64) -> (f64, Vec<f64>) {
         (t, x.to_vec())
     }
-    fn coordinates(&self, x: &[f64], _t: f64) -> Vec<f64> {
-        x.to_vec()
+    fn coordinates(&self, x: &[f64], _t: f64) -> NamedState {
+        named_state(None, x)
     }
 }
 
