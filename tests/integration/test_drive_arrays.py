@@ -193,3 +193,14 @@ def test_a_drive_whose_start_is_nan_is_refused_by_the_core_as_before():
     with pytest.raises(InputError) as e:
         tr.simulate(m, d, times_s=[0.5, 1.0])
     assert e.value.core_source == "drive" and "time_s[0]" in e.value.field
+
+
+@pytest.mark.parametrize("skip", [2, 3])
+def test_a_skip_of_every_output_time_is_an_input_error_naming_it(skip):
+    # raw tier: it was a plain ValueError (the before/after comparison of the core, issue 16)
+    spec = tr.isolated_takeoff().spec()
+    spec["output_time_s"], spec["output_skip"] = [0.0, 1.0], skip
+    with pytest.raises(_core.CoreInputError) as e:
+        _core.transient_batch([tr.dynamic_model("li-sunden-2016", "hrovat-tobler").spec], [spec], None, {}, 1, None)
+    assert e.value.args[1:] == ("output_skip", str(skip), e.value.args[3], "drive")
+    assert e.value.args[3] == "fewer leading output times to drop than the 2 output times"

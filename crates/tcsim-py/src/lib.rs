@@ -1121,7 +1121,10 @@ fn transient_jobs(
         let (drive, times) = drive_from(d)?;
         let skip: usize = opt_item(d, "output_skip")?.unwrap_or(0);
         if skip > 0 && skip >= times.len() {
-            return Err(PyValueError::new_err(format!("output_skip {skip} of {} output times", times.len())));
+            // an input error naming the field, as every other bad value of a drive dict (it was a
+            // plain ValueError: the before/after comparison of issue 16)
+            let expected = format!("fewer leading output times to drop than the {} output times", times.len());
+            return Err(input_error(CoreError::of(InputSource::Drive, "output_skip", skip, expected)));
         }
         parsed.push((drive, times));
         skips.push(skip);
