@@ -50,6 +50,7 @@ class _CyclePicker:
     def __init__(self, path: Path):
         self.path = path
         self.found: list[str] = []
+        self.speed = "vehicle_speed_m_s"  # or _SPEED_KM_H, as the file gives it
 
     def __call__(self, names: Sequence[str]) -> list[str]:
         speed = _SPEED_KM_H if _SPEED_KM_H in names and "vehicle_speed_m_s" not in names else "vehicle_speed_m_s"
@@ -62,6 +63,7 @@ class _CyclePicker:
                 expected = f"a column named {column}{also}; columns found: {shown or '(none)'}"
                 raise InputError(str(self.path), column, "missing", expected)
         self.found = [c for c in ("time_s", speed, *_OPTIONAL) if c in names]
+        self.speed = speed
         refuse_duplicates(self.path, names, self.found)
         return self.found
 
@@ -94,7 +96,7 @@ def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
         if column == "time_s":
             time_s = values
         out[column] = values
-    speed = out["vehicle_speed_m_s"] if "vehicle_speed_m_s" in out else out[_SPEED_KM_H] / 3.6
+    speed = out[picker.speed] / 3.6 if picker.speed == _SPEED_KM_H else out[picker.speed]
     return Cycle(
         name or path.stem,
         str(path),
@@ -102,7 +104,7 @@ def read_cycle(path: str | Path, name: str | None = None) -> Cycle:
         speed,
         out.get("grade_percent"),
         float(out["time_s"][0]),
-        picker.found[1],
+        picker.speed,
     )
 
 

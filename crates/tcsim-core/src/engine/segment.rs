@@ -4,7 +4,6 @@
 
 use crate::engine::bdf::roots::RootFinder;
 use crate::engine::bdf::{Bdf, EXACT_MAX, N_MAX};
-
 use crate::engine::options::{Hysteresis, NamedState, SolverOptions, TransientError, TransientResult};
 
 /// A smooth system `M ẋ = f(x, t)` with event functions, as one mode of a piecewise-smooth model.
@@ -103,11 +102,12 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
 ) -> TransientResult<SegmentEnd<S::Root>> {
     // a span shorter than the integrator's smallest step (an event a few ulp before the end) is no
     // step: the state at its end is the state at its start, to round-off
-    let upto = if no_step(t0, t_end) { t_end } else { t0 };
+    let reached = no_step(t0, t_end); // also at or past the end
+    let upto = if reached { t0.max(t_end) } else { t0 };
     while samples.len() < times_s.len() && times_s[samples.len()] <= upto {
         samples.push(seg.sample(&x0, times_s[samples.len()]));
     }
-    if t0 >= t_end || no_step(t0, t_end) {
+    if reached {
         return Ok(None);
     }
     let mut bdf = Bdf::<S, N>::new(seg, &x0, t0, t_end, o)?;
