@@ -11,15 +11,17 @@
 //! `... --example takeoff_profile -- batch RUNS SAMPLES THREADS...` runs RUNS take-offs as one batch
 //! ([`run_transient_jobs`], the core of `simulate_batch` without Python) with each thread count and
 //! prints the wall time and the process's CPU time (user + system, from `/proc/self/stat`) per run,
-//! and the speed-up over the first thread count.
+//! and the speed-up over the first thread count. `... -- columns RUNS SAMPLES THREADS...` does the
+//! same through [`run_transient_columns`] with all 33 columns (the columnar batch of
+//! `simulate_columns`: one buffer per column for all runs, written by the workers).
 use std::time::Instant;
 
-use tcsim_core::batch::{run_transient_jobs, TransientJob};
+use tcsim_core::batch::{run_transient_columns, run_transient_jobs, TransientJob};
 use tcsim_core::converter::dynamics::{HtDynamics, Inertias};
 use tcsim_core::converter::hrovat_tobler::HtGeometry;
 use tcsim_core::engine::isolated::{simulate, Drive, InitialState, TurbineLoad};
 use tcsim_core::engine::options::SolverOptions;
-use tcsim_core::engine::outputs::columns;
+use tcsim_core::engine::outputs::{columns, Selection};
 use tcsim_core::engine::signal::Signal;
 
 fn median(v: &mut [f64]) -> f64 {
@@ -54,7 +56,7 @@ fn cpu_time_s() -> f64 {
     tick(14) + tick(15)
 }
 
-fn batch(runs: usize, samples: usize, threads: &[usize]) {
+fn batch(runs: usize, samples: usize, threads: &[usize], columnar: bool) {
     let (model, drive) = takeoff();
     let t: Vec<f64> = (0..samples).map(|i| 10.0 * i as f64 / (samples - 1) as f64).collect();
     let jobs: Vec<TransientJob> = (0..runs)
@@ -69,10 +71,15 @@ fn batch(runs: usize, samples: usize, threads: &[usize]) {
     let mut first = None;
     for &n in threads {
         let (cpu0, start) = (cpu_time_s(), Instant::now());
-        let out = run_transient_jobs(&jobs, n);
+        if columnar {
+            let never = std::sync::atomic::AtomicBool::new(false);
+            let out = run_transient_columns(&jobs, &[0], &Selection::all(), n, &never);
+            assert!(out.is_ok_and(|o| o.is_some_and(|o| o.failures.is_empty())));
+        } else {
+            let out = run_transient_jobs(&jobs, n);
+            assert!(out.iter().all(Result::is_ok));
+        }
         let (wall, cpu) = (start.elapsed().as_secs_f64(), cpu_time_s() - cpu0);
-        assert!(out.iter().all(Result::is_ok));
-        drop(out);
         let base = *first.get_or_insert(wall);
         println!(
             "{runs} runs, {samples} samples, {n} threads: {:.1} µs/run wall, {:.1} µs/run CPU, speed-up {:.2}",
@@ -85,7 +92,8 @@ fn batch(runs: usize, samples: usize, threads: &[usize]) {
 
 fn main() {
     let words: Vec<String> = std::env::args().skip(1).collect();
-    let is_batch = words.first().is_some_and(|w| w == "batch");
+    let columnar = words.first().is_some_and(|w| w == "columns");
+    let is_batch = columnar || words.first().is_some_and(|w| w == "batch");
     let args: Vec<usize> = words
         .iter()
         .skip(usize::from(is_batch))
@@ -95,7 +103,7 @@ fn main() {
     let samples = args.get(1).copied().unwrap_or(1001).max(2);
     if is_batch {
         let threads = if args.len() > 2 { args[2..].to_vec() } else { vec![1, 2] };
-        return batch(runs, samples, &threads);
+        return batch(runs, samples, &threads, columnar);
     }
     let (model, drive) = takeoff();
     let t: Vec<f64> = (0..samples).map(|i| 10.0 * i as f64 / (samples - 1) as f64).collect();

@@ -3,6 +3,7 @@
 //! These loops are what the Python API calls (with the GIL released) for characteristics, the
 //! parameter study and the fit.
 
+use std::mem::MaybeUninit;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::converter::hrovat_tobler::{
@@ -10,7 +11,7 @@ use crate::converter::hrovat_tobler::{
 };
 use crate::engine::isolated::{simulate, Event};
 use crate::engine::options::{try_reserve, TransientError, TransientResult};
-use crate::engine::outputs::{write_columns, Overflow, Selection};
+use crate::engine::outputs::{write_columns, OutputRow, Overflow, Selection};
 use crate::error::CoreError;
 use crate::scalar::{Dual, Scalar};
 
@@ -396,7 +397,7 @@ pub struct BatchColumns {
 /// selected column, which one worker fills.
 struct RunRows<'a> {
     first: usize,
-    columns: Vec<&'a mut [f64]>,
+    columns: Vec<&'a mut [MaybeUninit<f64>]>,
     status: &'a mut [u8],
 }
 
@@ -434,14 +435,13 @@ pub fn run_transient_columns(
         offsets.push(offsets[i] + j.times_s.len().saturating_sub(skip(i)));
     }
     let rows = offsets[n];
-    let mut columns = Vec::with_capacity(selection.len());
+    // the buffers are not zeroed: each row is written once, by the worker of its run, so that
+    // the workers share the first touch of the memory (zeroing it is a serial pass over all of it)
+    let mut columns: Vec<Vec<f64>> = Vec::with_capacity(selection.len());
     for _ in 0..selection.len() {
-        // zeroed memory is mapped lazily: the workers touch their own rows (the probe turns a
-        // lack of memory into an error instead of an abort)
-        let mut probe: Vec<f64> = Vec::new();
-        try_reserve(&mut probe, rows)?;
-        drop(probe);
-        columns.push(vec![0.0; rows]);
+        let mut c = Vec::new();
+        try_reserve(&mut c, rows)?;
+        columns.push(c);
     }
     let mut status = vec![RUN_OK; n];
     let cores = if threads == 0 { std::thread::available_parallelism().map_or(1, |c| c.get()) } else { threads };
@@ -483,6 +483,11 @@ pub fn run_transient_columns(
         result.events.extend(d.events);
         result.failures.extend(d.failures);
     }
+    for c in &mut result.columns {
+        // SAFETY: every run ran (no piece was left incomplete), and fill_run_rows wrote every row
+        // of each run: write_columns writes all of its rows, a failed run's rows are filled with NaN
+        unsafe { c.set_len(rows) };
+    }
     Ok(Some(result))
 }
 
@@ -494,7 +499,9 @@ fn run_rows<'a>(
     per_piece: usize,
 ) -> Vec<RunRows<'a>> {
     let n = status.len();
-    let mut rest: Vec<&'a mut [f64]> = columns.iter_mut().map(|c| c.as_mut_slice()).collect();
+    let rows = offsets[n];
+    let mut rest: Vec<&'a mut [MaybeUninit<f64>]> =
+        columns.iter_mut().map(|c| &mut c.spare_capacity_mut()[..rows]).collect();
     let mut status_rest = status;
     let mut out = Vec::with_capacity(n.div_ceil(per_piece));
     let mut first = 0;
@@ -533,7 +540,7 @@ fn fill_run_rows(
         }
         let i = rows.first + k;
         let (a, b) = (offsets[i] - base, offsets[i + 1] - base);
-        let mut out: Vec<&mut [f64]> = rows.columns.iter_mut().map(|c| &mut c[a..b]).collect();
+        let mut out: Vec<&mut [MaybeUninit<f64>]> = rows.columns.iter_mut().map(|c| &mut c[a..b]).collect();
         let job = &jobs[i];
         let run = catch_panic(|| {
             let traj = simulate(job.model.as_ref(), &job.drive, &job.times_s, &job.init, &job.options)?;
@@ -549,7 +556,7 @@ fn fill_run_rows(
                 }
             }
             Err(e) => {
-                out.iter_mut().for_each(|c| c.fill(f64::NAN));
+                out.iter_mut().for_each(|c| c.iter_mut().for_each(|v| v.put(f64::NAN)));
                 rows.status[k] = if matches!(e, TransientError::Input(_)) { RUN_INPUT_ERROR } else { RUN_SOLVER_ERROR };
                 done.failures.push((i, RunFailure::Error(e)));
             }

@@ -299,17 +299,38 @@ impl Watch {
     }
 }
 
+/// A row of an output column: a plain `f64`, or memory not yet written (`MaybeUninit<f64>`: the
+/// batch's buffers, written once by [`write_columns`] instead of zeroed first and then written).
+pub trait OutputRow {
+    fn put(&mut self, v: f64);
+}
+
+impl OutputRow for f64 {
+    #[inline(always)]
+    fn put(&mut self, v: f64) {
+        *self = v;
+    }
+}
+
+impl OutputRow for std::mem::MaybeUninit<f64> {
+    #[inline(always)]
+    fn put(&mut self, v: f64) {
+        self.write(v);
+    }
+}
+
 /// Column `C` of the samples `block` (global indices `first..`) into its rows of `out` (the whole
 /// column; sample `i` goes to row `i − skip`, the first `skip` samples are only looked at), the
 /// values of all of them shown to `watch`. A loop per column, with the column's formula
 /// ([`RunConstants::value`]) specialised by the constant `C`: no dispatch per value, contiguous
-/// writes; the check scans the written values and looks closer only when one is not finite.
-fn fill<const C: usize>(
+/// writes; the loop notes whether the values are all finite or all NaN, and the check looks closer
+/// only when they are neither. Every row of the block's samples past `skip` is written.
+fn fill<const C: usize, R: OutputRow>(
     k: &RunConstants,
     block: &[Sample],
     first: usize,
     skip: usize,
-    out: Option<&mut [f64]>,
+    out: Option<&mut [R]>,
     watch: &mut Watch,
 ) {
     let Some(out) = out else {
@@ -322,16 +343,20 @@ fn fill<const C: usize>(
         return; // a block of skipped samples
     }
     let rows = &mut out[first + lead - skip..first + block.len() - skip];
+    let (mut finite, mut nan) = (true, true);
     for (o, s) in rows.iter_mut().zip(&block[lead..]) {
-        *o = k.value(C, s);
+        let v = k.value(C, s);
+        finite &= v.is_finite();
+        nan &= v.is_nan();
+        o.put(v);
     }
-    if rows.iter().all(|v| v.is_finite()) {
+    if finite {
         watch.has_number |= !rows.is_empty();
-    } else if rows.iter().all(|v| v.is_nan()) {
+    } else if nan {
         // a column the run lacks (the clutch's without a clutch): its first NaN only
         watch.first_nan = watch.first_nan.min(first + lead);
     } else {
-        rows.iter().enumerate().for_each(|(i, &v)| watch.see(first + lead + i, v));
+        block[lead..].iter().enumerate().for_each(|(i, s)| watch.see(first + lead + i, k.value(C, s)));
     }
 }
 
@@ -346,7 +371,7 @@ const _: () = assert!(COLUMNS.len() == 33);
 macro_rules! fill_column {
     ($c:expr, $k:expr, $block:expr, $first:expr, $skip:expr, $out:expr, $watch:expr; $($n:literal)*) => {
         match $c {
-            $($n => fill::<$n>($k, $block, $first, $skip, $out, $watch),)*
+            $($n => fill::<$n, _>($k, $block, $first, $skip, $out, $watch),)*
             c => panic!("output column {c} of {}", COLUMNS.len()),
         }
     };
@@ -357,18 +382,19 @@ macro_rules! fill_column {
 /// computed and checked, not stored; every slice is `samples.len() - skip` long). The run's
 /// constants are taken once; each column is one tight loop over the samples ([`fill`]). Returns the
 /// run's [`Overflow`], if any: the check covers the selected columns and the state, at every sample.
-pub fn write_columns(
+/// Every row of every slice is written ([`OutputRow`]: the slices may be memory not yet written).
+pub fn write_columns<R: OutputRow>(
     model: &dyn ConverterDynamics,
     samples: &[Sample],
     selection: &Selection,
     skip: usize,
-    out: &mut [&mut [f64]],
+    out: &mut [&mut [R]],
 ) -> Option<Overflow> {
     assert!(out.len() == selection.len(), "one output slice per selected column");
     assert!(out.iter().all(|c| c.len() + skip == samples.len()), "output slices fit the samples");
     let k = RunConstants::new(model);
     let state_only = STATE_COLUMNS.filter(|c| !selection.indices.contains(c));
-    let mut columns: Vec<(usize, Option<&mut [f64]>)> =
+    let mut columns: Vec<(usize, Option<&mut [R]>)> =
         selection.indices.iter().copied().zip(out.iter_mut().map(|c| Some(&mut **c))).collect();
     columns.extend(state_only.map(|c| (c, None)));
     let mut watch: Vec<Watch> = columns.iter().map(|&(c, _)| Watch::new(c)).collect();
@@ -409,11 +435,14 @@ pub fn columns(model: &dyn ConverterDynamics, traj: &Trajectory) -> TransientRes
     for _ in 0..COLUMNS.len() {
         let mut c = Vec::new();
         try_reserve(&mut c, n)?;
-        c.resize(n, 0.0);
         cols.push(c);
     }
-    let mut out: Vec<&mut [f64]> = cols.iter_mut().map(|c| c.as_mut_slice()).collect();
+    let mut out: Vec<_> = cols.iter_mut().map(|c| &mut c.spare_capacity_mut()[..n]).collect();
     write_columns(model, &traj.samples, &Selection::all(), 0, &mut out);
+    for c in &mut cols {
+        // SAFETY: write_columns wrote every row of every slice, the first n of each column
+        unsafe { c.set_len(n) };
+    }
     Ok(cols)
 }
 
@@ -543,6 +572,33 @@ mod tests {
             }
             for s in &traj.samples[..5] {
                 assert_eq!(bits(&row(&model, s)), bits(&reference_row(&model, s)));
+            }
+        }
+    }
+
+    /// The batch's buffers are written once, never zeroed ([`OutputRow`]): every row of every
+    /// slice is written, whatever the skip, so a poisoned row never survives, and the values are
+    /// those written into plain `f64`s.
+    #[test]
+    fn every_row_of_a_buffer_not_yet_written_is_written() {
+        let (model, drive) = takeoff(true);
+        let times: Vec<f64> = (0..3 * BLOCK + 7).map(|i| i as f64 * 0.02).collect();
+        let traj = simulate(&model, &drive, &times, &InitialState::default(), &SolverOptions::default()).unwrap();
+        let sel = Selection::from_names(&["lockup_torque_nm", "time_s", "stator_torque_nm", "flow_m3_s"]).unwrap();
+        let poison = f64::from_bits(0x7ff8_dead_beef_0001);
+        for skip in [0, 1, BLOCK - 1, BLOCK, 2 * BLOCK + 5, times.len() - 1, times.len()] {
+            let rows = times.len() - skip;
+            let mut plain = vec![vec![0.0; rows]; sel.len()];
+            let mut out: Vec<&mut [f64]> = plain.iter_mut().map(|b| b.as_mut_slice()).collect();
+            let want = write_columns(&model, &traj.samples, &sel, skip, &mut out);
+            let mut fresh = vec![vec![std::mem::MaybeUninit::new(poison); rows]; sel.len()];
+            let mut out: Vec<&mut [std::mem::MaybeUninit<f64>]> = fresh.iter_mut().map(|b| b.as_mut_slice()).collect();
+            assert_eq!(write_columns(&model, &traj.samples, &sel, skip, &mut out), want, "skip {skip}");
+            for (f, p) in fresh.iter().zip(&plain) {
+                // SAFETY: initialised with the poison above, and only ever written since
+                let got: Vec<f64> = f.iter().map(|v| unsafe { v.assume_init() }).collect();
+                assert!(got.iter().all(|v| v.to_bits() != poison.to_bits()), "skip {skip}: a row left unwritten");
+                assert_eq!(bits(&got), bits(p), "skip {skip}");
             }
         }
     }
