@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from tcsim import transient
+from tcsim.models.converter import bundled_converters
 
 MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
 HANG_GUARD_S = 600  # a hang guard only; nothing is asserted about durations
@@ -57,3 +58,14 @@ def test_the_replay_table_fits_80_columns_with_a_unit_on_every_number(tmp_path):
     f[["time_s", "pump_torque_nm", "turbine_speed_rad_s", "turbine_torque_nm"]].to_csv(tmp_path / "m.csv", index=False)
     out = run_80("replay", "li-sunden-2016", "m.csv", "--out", "o", cwd=tmp_path)
     assert_reads_well(out, ("RMSE", "[N·m]", "NRMSE [-]"))
+
+
+@pytest.mark.subprocess
+def test_converters_shows_each_source_whole(tmp_path):
+    # fresh-eyes trial: a source holding a long path ended in "tests/data/converters/l…"
+    stdout = run_80("converters", cwd=tmp_path)
+    assert "…" not in stdout and all(len(line) <= 80 for line in stdout.splitlines())
+    source_cells = [line.split("│")[3] for line in stdout.splitlines() if line.count("│") == 4]
+    shown = "".join("".join(source_cells).split())
+    for conv in bundled_converters():
+        assert conv.name in stdout and "".join(conv.source.split()) in shown, conv.name

@@ -11,7 +11,6 @@ from ..units import DEFAULT_PUMP_SPEED_RPM
 from .app import (
     AllowImplausibleOpt,
     FormatOpt,
-    ModelOpt,
     OutOpt,
     PlotsOpt,
     SpeedUnitOpt,
@@ -20,12 +19,22 @@ from .app import (
     table_format,
 )
 
+CharacteriseModelOpt = Annotated[
+    str,
+    typer.Option(
+        "--model",
+        "-m",
+        help="table | hrovat-tobler | quasi-dynamic (default: hrovat-tobler when the converter has its geometry, "
+        "else table)",
+    ),
+]
+
 
 def characterise(
     converter: Annotated[str, typer.Argument(help="bundled name, converter .toml, or table .csv/.vtcc")],
-    model: ModelOpt = "",
+    model: CharacteriseModelOpt = "",
     pump_speed_rpm: Annotated[
-        float | None, typer.Option(help=f"fixed pump speed of the sweep [default: {DEFAULT_PUMP_SPEED_RPM:g}]")
+        float | None, typer.Option(help=f"fixed pump speed of the sweep, rpm (default: {DEFAULT_PUMP_SPEED_RPM:g})")
     ] = None,
     input_torque_nm: Annotated[
         float | None,

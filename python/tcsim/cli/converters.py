@@ -13,8 +13,10 @@ def converters() -> None:
     from ..reports.format import rich_text
 
     table = Table(title="Bundled converters")
-    for col in ("name", "models", "source"):
-        table.add_column(col)
+    table.add_column("name", no_wrap=True)
+    table.add_column("models")
+    # a source may hold a path longer than the column: folded, never cut
+    table.add_column("source", overflow="fold")
     for conv in bundled_converters():
         table.add_row(rich_text(conv.name), ", ".join(conv.models), rich_text(conv.source))
     stdout.print(table)

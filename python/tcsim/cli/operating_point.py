@@ -29,7 +29,7 @@ def operating_point(
         float | None,
         typer.Option(
             "--pump-speed-limit-rpm",
-            help="highest pump speed, rpm: points that need more are flagged above-pump-speed-limit [default: none]",
+            help="highest pump speed, rpm: points that need more are flagged above-pump-speed-limit (default: none)",
         ),
     ] = None,
     out: OutOpt = Path("operating_points"),

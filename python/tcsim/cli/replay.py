@@ -105,7 +105,7 @@ def replay(
         typer.Option(
             "--window",
             help="derivative smoothing window S, s: local least-squares slope over ±S/2, at most the record's span "
-            "[default: 0.04]",
+            "(default: 0.04)",
         ),
     ] = None,
     metrics_window: Annotated[
