@@ -30,7 +30,7 @@ import pandas as pd
 
 from .. import _core
 from ..errors import InputError, TcsimWarning, core_input_error, from_core
-from ..models.dynamic import DynamicModel, select_models
+from ..models.dynamic import DynamicModel, select_models, warn_about_runs
 from ..models.vehicle import Vehicle
 from ..simulation.transient import SolverError
 from ..units import KM_H
@@ -174,8 +174,9 @@ def run_drive(
         result = _unpack(run, model.name, files)
         if not isinstance(result, DriveRun):
             raise result
-        model.warn_about_run({str(k): v for k, v in result.frame.items()}, f"the drive run {model.name!r}")
         out[model.name] = result
+    frames = [(m.name, m, {str(k): v for k, v in out[m.name].frame.items()}) for m in models]
+    warn_about_runs("drive", frames)
     return out
 
 

@@ -223,6 +223,37 @@ class Characteristic:
         return self.speed_ratio, self.torque_ratio, self.capacity_factor_nm_s2
 
 
+def extension_reached(table: dict[str, Any], pump_speed_rad_s, turbine_speed_rad_s) -> float | None:
+    """The largest |SR| at which the core's overrun rule extended the table ``table``
+    (:meth:`Characteristic.core_table`) beyond its rows at the points (rad/s; the core says where, by
+    the ``extension`` flag of ``tcsim._core.table_steady_states``), or None where it extended it at
+    none of them."""
+    wp = np.asarray(pump_speed_rad_s, dtype=float).reshape(-1)
+    wt = np.asarray(turbine_speed_rad_s, dtype=float).reshape(-1)
+    ok = np.isfinite(wp) & np.isfinite(wt)
+    if not ok.any():
+        return None
+    wp, wt = np.ascontiguousarray(wp[ok]), np.ascontiguousarray(wt[ok])
+    try:
+        ext = np.asarray(_core.table_steady_states(**table, pump_speed_rad_s=wp, turbine_speed_rad_s=wt)["extension"])
+    except _core.CoreInputError:  # speeds whose torques overflow: the run itself says so
+        return None
+    if not ext.any():
+        return None
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return float(np.max(np.abs(wt[ext] / wp[ext])))
+
+
+def extension_message(source: str, table: dict[str, Any], what: str, reached: str) -> str:
+    """The warning that ``what`` (one run, or several) reached SR ``reached`` (as written) beyond the
+    rows of the table ``table`` of ``source``, where the overrun rule mirrors the characteristic."""
+    end = float(np.asarray(table["speed_ratio"], dtype=float)[-1])
+    return (
+        f'{source}: overrun = "mirror": the table ends at SR {end:g}; {what} reached SR {reached}, '
+        "where tcsim mirrors the characteristic (the turbine drives the pump; see docs/models.md)"
+    )
+
+
 def warn_if_extended(
     source: str,
     table: dict[str, Any],
@@ -231,27 +262,8 @@ def warn_if_extended(
     what: str = "the run",
 ) -> None:
     """One :class:`~tcsim.errors.TcsimWarning` when the core's overrun rule extended the table
-    ``table`` (:meth:`Characteristic.core_table`) beyond its rows at any of the points
-    (rad/s; the core says where, by the ``extension`` flag of ``tcsim._core.table_steady_states``):
-    the results there rest on the extension rule, not on data (docs/models.md)."""
-    wp = np.asarray(pump_speed_rad_s, dtype=float).reshape(-1)
-    wt = np.asarray(turbine_speed_rad_s, dtype=float).reshape(-1)
-    ok = np.isfinite(wp) & np.isfinite(wt)
-    if not ok.any():
-        return
-    wp, wt = np.ascontiguousarray(wp[ok]), np.ascontiguousarray(wt[ok])
-    sr = np.asarray(table["speed_ratio"], dtype=float)
-    try:
-        ext = np.asarray(_core.table_steady_states(**table, pump_speed_rad_s=wp, turbine_speed_rad_s=wt)["extension"])
-    except _core.CoreInputError:  # speeds whose torques overflow: the run itself says so
-        return
-    if not ext.any():
-        return
-    with np.errstate(divide="ignore", invalid="ignore"):
-        reached = float(np.max(np.abs(wt[ext] / wp[ext])))
-    warnings.warn(
-        f'{source}: overrun = "mirror": the table ends at SR {sr[-1]:g}; {what} reached SR {reached:.3g}, '
-        "where tcsim mirrors the characteristic (the turbine drives the pump; see docs/models.md)",
-        TcsimWarning,
-        stacklevel=3,
-    )
+    ``table`` beyond its rows at any of the points (:func:`extension_reached`): the results there
+    rest on the extension rule, not on data (docs/models.md)."""
+    reached = extension_reached(table, pump_speed_rad_s, turbine_speed_rad_s)
+    if reached is not None:
+        warnings.warn(extension_message(source, table, what, f"{reached:.3g}"), TcsimWarning, stacklevel=3)

@@ -14,7 +14,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError, TcsimWarning, from_core
 from ..units import DEFAULT_PUMP_SPEED_RAD_S
-from .characteristic import warn_if_extended
+from .characteristic import extension_message, extension_reached, warn_if_extended
 from .converter import MODELS, Converter, load_converter
 
 #: Pump speed at which the default quasi-dynamic flow time constant is evaluated (stall), rad/s:
@@ -46,12 +46,6 @@ class DynamicModel:
         """The shape effects (pump, turbine[, stator]); empty for the table model."""
         return tuple(self.spec.get("shape_effect_m2", ()))
 
-    def warn_about_run(self, columns: Mapping[str, Any], what: str = "the run") -> None:
-        """The warnings about a finished run of this model: :meth:`warn_if_extended` and
-        :meth:`warn_if_fragile_near_coupling`."""
-        self.warn_if_fragile_near_coupling()
-        self.warn_if_extended(columns, what)
-
     def warn_if_fragile_near_coupling(self) -> None:
         """For the quasi-dynamic model, one warning when its flow time constant is below
         :data:`COUPLING_MARGIN` times the turbine's stability bound for its shape effects
@@ -72,11 +66,11 @@ class DynamicModel:
                 stacklevel=3,
             )
 
-    def warn_if_extended(self, columns: Mapping[str, Any], what: str = "the run") -> None:
-        """For the table models, one warning when the run's pump and turbine speeds (``columns``)
-        reached the overrun rule's extension of the table (:func:`~.characteristic.warn_if_extended`)."""
+    def table(self) -> dict[str, Any] | None:
+        """The characteristic of the table models as the core's table functions take it; None for
+        Hrovat & Tobler."""
         if self.name not in ("table", "quasi-dynamic"):
-            return
+            return None
         keys = (*TABLE_SPEC_KEYS, "overrun", "interpolation")
         table: dict[str, Any] = {}
         for k, v in self.spec.items():
@@ -84,7 +78,14 @@ class DynamicModel:
                 table[k] = [float(x) for x in v]
             elif k in keys:
                 table[k] = v if isinstance(v, str) else np.asarray(v, dtype=float)
-        warn_if_extended(self.source, table, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"], what)
+        return table
+
+    def warn_if_extended(self, columns: Mapping[str, Any], what: str = "the run") -> None:
+        """For the table models, one warning when the run's pump and turbine speeds (``columns``)
+        reached the overrun rule's extension of the table (:func:`~.characteristic.warn_if_extended`)."""
+        table = self.table()
+        if table is not None:
+            warn_if_extended(self.source, table, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"], what)
 
     def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:
         """The same model with other shape effects (eqs 2.16–2.18 sign convention)."""
@@ -94,6 +95,32 @@ class DynamicModel:
         if self.name == "hrovat-tobler":
             shape.append(self.shape_effect_m2[2] if stator_m2 is None else stator_m2)
         return replace(self, spec={**self.spec, "shape_effect_m2": [float(s) for s in shape]})
+
+
+def _and_list(words: Sequence[str]) -> str:
+    """``a``, ``a and b``, ``a, b and c``."""
+    return words[0] if len(words) == 1 else ", ".join(words[:-1]) + " and " + words[-1]
+
+
+def warn_about_runs(kind: str, runs: Sequence[tuple[str, DynamicModel, Mapping[str, Any]]]) -> None:
+    """The warnings about finished runs (``kind``: "drive", "launch"; ``runs``: label, model and
+    columns of each): each model's :meth:`DynamicModel.warn_if_fragile_near_coupling`, and per
+    converter one warning that names every run whose speeds reached the overrun rule's extension
+    of its table (:func:`~.characteristic.extension_reached`), rather than one per run."""
+    reached: dict[str, list[tuple[str, float, dict[str, Any]]]] = {}
+    for label, model, columns in runs:
+        model.warn_if_fragile_near_coupling()
+        table = model.table()
+        if table is None:
+            continue
+        sr = extension_reached(table, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"])
+        if sr is not None:
+            reached.setdefault(model.source, []).append((label, sr, table))
+    for source, found in reached.items():
+        plural = "s" if len(found) > 1 else ""
+        what = f"the {kind} run{plural} " + _and_list([repr(label) for label, _, _ in found])
+        message = extension_message(source, found[0][2], what, _and_list([f"{sr:.3g}" for _, sr, _ in found]))
+        warnings.warn(message, TcsimWarning, stacklevel=3)
 
 
 def _require(conv: Converter, section: str, model: str) -> Any:

@@ -22,7 +22,7 @@ import pandas as pd
 
 from .. import _core
 from ..errors import TcsimWarning, core_input_error, from_core
-from ..models.dynamic import DynamicModel
+from ..models.dynamic import DynamicModel, warn_about_runs
 from ..models.dynamic import select_models as select_converter_models
 from ..models.shape_effects import THESIS_PAIR_M2, mass_matrix_bound, sweep_values
 from ..models.vehicle import Vehicle
@@ -145,13 +145,15 @@ def run_launch(
     if on_error == "raise" and failed is not None:
         raise failed  # before any run's warning: a failure is one line
     out: dict[str, LaunchRun] = {}
+    finished = []
     for name, model, run, result in zip(names, models, raw, results):
         if isinstance(result, LaunchRun):
-            model.warn_about_run({str(k): v for k, v in result.frame.items()}, f"the launch run {name!r}")
+            finished.append((name, model, {str(k): v for k, v in result.frame.items()}))
             out[name] = result
             continue
         text = f"solver: {run.error.message}" if isinstance(result, SolverError) and run.error else str(result)
         warnings.warn(f"{name} left out ({text})", TcsimWarning, stacklevel=2)
+    warn_about_runs("launch", finished)
     return out
 
 

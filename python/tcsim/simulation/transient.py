@@ -94,7 +94,7 @@ EVENT_KINDS: tuple[str, ...] = tuple(_core.transient_event_kinds())
 RUN_OK, RUN_INPUT_ERROR, RUN_SOLVER_ERROR, RUN_OVERFLOW = 0, 1, 2, 3
 #: The event arrays of :attr:`BatchColumns.events` and their keys in ``transient_batch``'s result.
 _EVENT_KEYS = tuple((k, f"event_{k}") for k in ("run", "time_s", "kind", "stator_locked", "flow_direction"))
-#: Columns the table models' extension warning reads (:meth:`DynamicModel.warn_about_run`).
+#: Columns the table models' extension warning reads (:meth:`DynamicModel.warn_if_extended`).
 _WARNING_COLUMNS = ("pump_speed_rad_s", "turbine_speed_rad_s")
 
 
@@ -439,7 +439,8 @@ def _batch_columns(
 
 
 def _warn_about_runs(batch: BatchColumns) -> None:
-    """The warnings about the finished runs (:meth:`DynamicModel.warn_about_run`): only the table
+    """The warnings about the finished runs (:meth:`DynamicModel.warn_if_fragile_near_coupling` and
+    :meth:`DynamicModel.warn_if_extended`): only the table
     models have any about a run's values, so only their runs are looked at."""
     n = len(batch)
     for m in {id(m): m for m in batch.models if m.name == "quasi-dynamic"}.values():
