@@ -154,6 +154,23 @@ def test_an_earlier_output_is_replaced_whole(cli, tmp_path):
     no_staging_left(tmp_path)
 
 
+def test_replacing_the_output_of_another_command_warns_and_of_the_same_command_does_not(cli, tmp_path):
+    # fresh-eyes trial: a launch into a drive's folder replaced it without a word
+    out = tmp_path / "o"
+    assert cli("characterise", "li-sunden-2016", "--out", out, "--no-plots").code == 0
+    again = cli("characterise", "li-sunden-2016", "--out", out, "--no-plots")
+    assert again.code == 0 and "holds the output" not in again.stderr, again.stderr
+    other = cli("design", "li-sunden-2016-design", "--out", out, "--no-plots")
+    assert other.code == 0, other.stderr
+    warned = [line for line in other.stderr.splitlines() if "holds the output" in line]
+    earlier = f"tcsim characterise li-sunden-2016 --out {out} --no-plots"
+    assert warned == [f"warning: {out}/: holds the output of an earlier `{earlier}`, which this design replaces whole"]
+    assert json.loads((out / MANIFEST).read_text())["command"][1] == "design"
+    with output_dir(out) as stage:  # the Python API: no command line, no warning (pytest's argv)
+        (stage / "a.csv").write_text("a\n")
+    assert (out / "a.csv").is_file()
+
+
 def test_an_earlier_output_with_a_changed_file_is_refused(cli, tmp_path):
     out = tmp_path / "o"
     assert cli("characterise", "li-sunden-2016", "--out", out).code == 0
