@@ -8,6 +8,7 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import re
 import signal
 from pathlib import Path
 from types import SimpleNamespace
@@ -18,7 +19,9 @@ import pytest
 from scipy import stats
 
 import tcsim.analysis.monte_carlo as mc
+import tcsim.plots.monte_carlo as plots_mc
 from interrupts import ClientStopped, interrupt, stop_after
+from tcsim.analysis.launch import SUMMARY_COLUMNS, SUMMARY_LABELS
 from tcsim.analysis.monte_carlo import draw_cases, monte_carlo_study, run_monte_carlo
 from tcsim.cli.monte_carlo import summary_lines
 from tcsim.errors import InputError
@@ -200,6 +203,22 @@ def test_the_figures_are_one_histogram_per_output(cli, tmp_path):
     pngs = sorted(p.name for p in (tmp_path / "o").glob("*.png"))
     outputs = ["effective_torque_ratio_dip_first_0_5_s", "shift_count", "time_0_100_km_h_s", "time_0_50_km_h_s"]
     assert pngs == [f"monte_carlo_{o}.png" for o in outputs]
+
+
+def test_each_summary_metric_has_an_axis_label_with_its_documented_unit(monkeypatch, tmp_path):
+    # fresh-eyes trial: the histograms' x axes read raw column names ("time_0_50_km_h_s")
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "launch_summary.md").read_text(encoding="utf-8")
+    units = dict(re.findall(r"^\| `(\w+)` \| ([^|]+?) \|", doc, flags=re.M))
+    brackets = {"s": ("[s]", "[s after release]"), "m/s²": ("[m/s²]",), "–": ("[-]",)}
+    assert set(SUMMARY_LABELS) == set(SUMMARY_COLUMNS) - {"model"}
+    for column, label in SUMMARY_LABELS.items():
+        assert label.endswith(brackets[units[column]]), (column, units[column], label)
+    shown = []
+    monkeypatch.setattr(plots_mc, "finish_figure", lambda fig, ax, path, title, xlabel: shown.append(xlabel) or path)
+    df = pd.DataFrame({"model": ["table"] * 3, "time_0_50_km_h_s": [4.0, 4.1, 4.3], "other_s": [1.0, 2.0, 3.0]})
+    plots_mc.plot_histogram(df, "time_0_50_km_h_s", ["table"], tmp_path / "a.png", "t")
+    plots_mc.plot_histogram(df, "other_s", ["table"], tmp_path / "b.png", "t")
+    assert shown == ["Time 0–50 km/h [s]", "other_s"]
 
 
 # --------------------------------------------------------------------------------------------

@@ -48,6 +48,24 @@ SUMMARY_COLUMNS: tuple[str, ...] = (
     "mean_effective_torque_ratio_deficit_first_0_5_s",
     "effective_torque_ratio_recovery_time_s",
 )
+#: An axis label with its unit for each summary metric (docs/launch_summary.md; times from the brake
+#: release ``t_r``): the histograms of a Monte Carlo study.
+SUMMARY_LABELS: dict[str, str] = {
+    "time_0_100_km_h_s": "Time 0–100 km/h [s]",
+    "time_0_50_km_h_s": "Time 0–50 km/h [s]",
+    "peak_accel_m_s2": "Peak acceleration, whole run [m/s²]",
+    "mean_accel_first_0_5_s_m_s2": "Mean acceleration, first 0.5 s [m/s²]",
+    "min_effective_torque_ratio_first_0_5_s": "Min. effective TR, first 0.5 s [-]",
+    "launch_peak_accel_m_s2": "Peak acceleration before the first shift [m/s²]",
+    "launch_peak_accel_time_s": "Time of the launch peak acceleration [s after release]",
+    "shift_count": "Shifts [-]",
+    "shift_peak_accel_m_s2": "Peak acceleration in a shift [m/s²]",
+    "max_shift_accel_ratio": "Shift peak ÷ acceleration before the shift [-]",
+    "effective_torque_ratio_dip_first_0_5_s": "Effective TR dip vs the table model, first 0.5 s [-]",
+    "effective_torque_ratio_dip_time_s": "Time of the effective TR dip [s after release]",
+    "mean_effective_torque_ratio_deficit_first_0_5_s": "Mean effective TR deficit vs the table model, first 0.5 s [-]",
+    "effective_torque_ratio_recovery_time_s": "Effective TR recovery (±0.05) [s after release]",
+}
 #: The model whose effective TR the dip and recovery columns compare with.
 REFERENCE_MODEL = "table"
 EVENT_COLUMNS: tuple[str, ...] = ("model", "time_s", "kind", "detail")

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ..analysis.launch import SUMMARY_LABELS
 from .common import finish_figure, mpl_text, plt
 from .styles import model_style
 
@@ -65,7 +66,7 @@ def plot_histogram(df: pd.DataFrame, output: str, models: Sequence[str], path: P
     if not bins:
         ax.text(0.5, 0.5, "no finished run has a value", transform=ax.transAxes, ha="center")
     ax.set_ylabel("Cases [-]")
-    return finish_figure(fig, ax, path, title, xlabel=mpl_text(output))
+    return finish_figure(fig, ax, path, title, xlabel=mpl_text(SUMMARY_LABELS.get(output, output)))
 
 
 def plot_monte_carlo(
