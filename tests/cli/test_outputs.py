@@ -159,12 +159,12 @@ def test_replacing_the_output_of_another_command_warns_and_of_the_same_command_d
     out = tmp_path / "o"
     assert cli("characterise", "li-sunden-2016", "--out", out, "--no-plots").code == 0
     again = cli("characterise", "li-sunden-2016", "--out", out, "--no-plots")
-    assert again.code == 0 and "holds the output" not in again.stderr, again.stderr
+    assert again.code == 0 and "the output of an earlier" not in again.stderr, again.stderr
     other = cli("design", "li-sunden-2016-design", "--out", out, "--no-plots")
     assert other.code == 0, other.stderr
-    warned = [line for line in other.stderr.splitlines() if "holds the output" in line]
+    warned = [line for line in other.stderr.splitlines() if "the output of an earlier" in line]
     earlier = f"tcsim characterise li-sunden-2016 --out {out} --no-plots"
-    assert warned == [f"warning: {out}/: holds the output of an earlier `{earlier}`, which this design replaces whole"]
+    assert warned == [f"warning: {out}/: replaced the output of an earlier `{earlier}`"]
     assert json.loads((out / MANIFEST).read_text())["command"][1] == "design"
     with output_dir(out) as stage:  # the Python API: no command line, no warning (pytest's argv)
         (stage / "a.csv").write_text("a\n")

@@ -14,6 +14,7 @@ import pandas as pd
 import pytest
 
 from tcsim.analysis.drive import BUNDLED_CYCLES, SUMMARY_COLUMNS, Cycle, drive
+from tcsim.errors import TcsimWarning
 from tcsim.io.cycle import bundled_cycle_path, read_cycle
 from tcsim.models.vehicle import load_vehicle
 
@@ -67,6 +68,15 @@ def test_whole_wltc_is_followed_and_the_energy_balances(wltc):
 def coasting(f: pd.DataFrame) -> pd.DataFrame:
     """Samples with the accelerator released, rolling faster than 5 m/s, not shifting."""
     return f[(f.accelerator_pedal == 0.0) & (f.vehicle_speed_m_s > 5.0) & (f.shifting == 0)]
+
+
+def test_the_table_models_reaching_the_overrun_extension_share_one_warning(vehicle):
+    # fresh-eyes trial: `tcsim drive` on the bundled defaults printed the same warning once per model
+    with pytest.warns(TcsimWarning) as caught:
+        drive(vehicle, read_cycle(bundled_cycle_path("us06"), "us06"), ["table", "quasi-dynamic"])
+    overrun = [str(w.message) for w in caught if "overrun" in str(w.message)]
+    assert len(overrun) == 1, overrun
+    assert "the drive runs 'table' and 'quasi-dynamic' reached SR 1." in overrun[0], overrun[0]
 
 
 def test_coasting_brakes_the_engine_through_the_converter_and_the_lockup(wltc, segment_runs):

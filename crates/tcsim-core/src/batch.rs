@@ -448,6 +448,7 @@ pub fn run_transient_columns(
     let workers = cores.min(n).max(1);
     let per_piece = (n / (16 * workers)).clamp(1, MAX_RUNS_PER_PIECE);
     let pieces = run_rows(&mut columns, &mut status, &offsets, per_piece);
+    let piece_count = pieces.len();
     let work = |rows: RunRows<'_>| fill_run_rows(jobs, &skip, &offsets, selection, cancel, rows);
     let done: Vec<RowsDone> = if workers == 1 {
         pieces.into_iter().map(work).collect()
@@ -462,8 +463,11 @@ pub fn run_transient_columns(
                         let mut mine = Vec::new();
                         loop {
                             let k = next.fetch_add(1, Ordering::Relaxed);
-                            let Some(piece) = queue.get(k).and_then(|m| m.lock().ok()?.take()) else { break };
-                            mine.push((k, work(piece)));
+                            let Some(slot) = queue.get(k) else { break };
+                            // each piece is taken once, by the worker that drew its index (a
+                            // poisoned lock still holds it: nothing panics while it is held)
+                            let piece = slot.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take();
+                            mine.push((k, work(piece.expect("each piece is drawn once"))));
                         }
                         mine
                     })
@@ -476,6 +480,7 @@ pub fn run_transient_columns(
     };
     let mut result =
         BatchColumns { selection: selection.clone(), offsets, columns, status, events: vec![], failures: vec![] };
+    let result_pieces = done.len();
     for d in done {
         if !d.complete {
             return Ok(None);
@@ -483,8 +488,10 @@ pub fn run_transient_columns(
         result.events.extend(d.events);
         result.failures.extend(d.failures);
     }
+    // every piece reported back (the rows of a piece that did not are not written)
+    assert_eq!(result_pieces, piece_count, "every piece of the batch ran");
     for c in &mut result.columns {
-        // SAFETY: every run ran (no piece was left incomplete), and fill_run_rows wrote every row
+        // SAFETY: every run ran (every piece reported back, none incomplete), and fill_run_rows wrote every row
         // of each run: write_columns writes all of its rows, a failed run's rows are filled with NaN
         unsafe { c.set_len(rows) };
     }

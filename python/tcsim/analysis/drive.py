@@ -169,15 +169,14 @@ def run_drive(
         raw = _core.drive_runs([m.spec for m in models], vehicle.core, cycle.core_spec(), options, threads)
     except _core.CoreInputError as e:
         raise located(from_core(e, files), cycle) from None
-    out: dict[str, DriveRun] = {}
+    finished: list[tuple[DynamicModel, DriveRun]] = []
     for model, run in zip(models, raw):
         result = _unpack(run, model.name, files)
         if not isinstance(result, DriveRun):
             raise result
-        out[model.name] = result
-    frames = [(m.name, m, {str(k): v for k, v in out[m.name].frame.items()}) for m in models]
-    warn_about_runs("drive", frames)
-    return out
+        finished.append((model, result))
+    warn_about_runs("drive", [(m.name, m, {str(k): v for k, v in r.frame.items()}) for m, r in finished])
+    return {m.name: r for m, r in finished}
 
 
 def _trapezoid(y: np.ndarray, t: np.ndarray) -> float:

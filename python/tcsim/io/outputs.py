@@ -9,7 +9,7 @@ Output directories (``--out DIR``)
 * ``DIR`` may be missing (it is created, with its parents), an empty directory, or a previous tcsim
   output: a directory holding exactly the files its manifest lists, each with the listed size and
   SHA-256. Such a directory is replaced whole (old renamed aside, new renamed in, old removed);
-  nothing of the old run is kept. The command line warns when it replaces another command's output.
+  nothing of the old run is kept. The command line warns when it replaced another command's output.
 * Anything else is refused (:class:`~tcsim.errors.InputError`, exit 2): a path that is a file, a
   directory holding other files (also a previous output with a file added or changed), and a
   ``DIR`` that contains an input file of the same run.
@@ -231,7 +231,7 @@ def output_dir(out: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[P
     directory this call created."""
     shown = Path(out)
     check_output_dir(shown, inputs)
-    _warn_if_another_command(shown)
+    earlier = _another_command(shown)
     target = Path(os.path.abspath(shown))
     target = target.resolve() if target.is_symlink() else target
     created: list[Path] = []
@@ -251,25 +251,24 @@ def output_dir(out: str | Path, inputs: Sequence[str | Path] = ()) -> Iterator[P
     finally:
         if not done:
             _held_back(lambda: _discard(stage, created))
+    if earlier is not None:  # once it is done (a warning raised as an error loses nothing)
+        warnings.warn(f"{shown}/: replaced the output of an earlier `{earlier}`", TcsimWarning, stacklevel=3)
 
 
-def _warn_if_another_command(out: Path) -> None:
-    """A :class:`~tcsim.errors.TcsimWarning` when the command line replaces the output of another
-    command (a launch into a drive's folder): by the rule it goes whole, which a user reusing a name
-    may not expect. Not for the same command run again, nor outside the command line."""
+def _another_command(out: Path) -> str | None:
+    """The command line of the earlier output in ``out`` when this command line is another command
+    (a launch into a drive's folder): by the rule it is replaced whole, which a user reusing a name
+    may not expect, so :func:`output_dir` says so once it is done. None for the same command run
+    again, outside the command line, and without an earlier output."""
     try:
         earlier = json.loads((out / MANIFEST).read_text(encoding="utf-8"))["command"]
     except (OSError, ValueError, KeyError, TypeError):
-        return
+        return None
     if not (command_line[:1] == ["tcsim"] and isinstance(earlier, list) and earlier[:1] == ["tcsim"]):
-        return
+        return None
     if len(earlier) > 1 and len(command_line) > 1 and earlier[1] != command_line[1]:
-        shown = " ".join(str(w) for w in earlier)
-        warnings.warn(
-            f"{out}/: holds the output of an earlier `{shown}`, which this {command_line[1]} replaces whole",
-            TcsimWarning,
-            stacklevel=3,
-        )
+        return " ".join(str(w) for w in earlier)
+    return None
 
 
 def _discard(staged: Path | None, created: Sequence[Path]) -> None:

@@ -107,7 +107,7 @@ def warn_about_runs(kind: str, runs: Sequence[tuple[str, DynamicModel, Mapping[s
     columns of each): each model's :meth:`DynamicModel.warn_if_fragile_near_coupling`, and per
     converter one warning that names every run whose speeds reached the overrun rule's extension
     of its table (:func:`~.characteristic.extension_reached`), rather than one per run."""
-    reached: dict[str, list[tuple[str, float, dict[str, Any]]]] = {}
+    reached: dict[tuple[str, tuple[float, ...]], list[tuple[str, float, dict[str, Any]]]] = {}
     for label, model, columns in runs:
         model.warn_if_fragile_near_coupling()
         table = model.table()
@@ -115,8 +115,10 @@ def warn_about_runs(kind: str, runs: Sequence[tuple[str, DynamicModel, Mapping[s
             continue
         sr = extension_reached(table, columns["pump_speed_rad_s"], columns["turbine_speed_rad_s"])
         if sr is not None:
-            reached.setdefault(model.source, []).append((label, sr, table))
-    for source, found in reached.items():
+            # one line per converter: its file and its table (two tables of one path stay apart)
+            key = (model.source, tuple(np.asarray(table["speed_ratio"], dtype=float).tolist()))
+            reached.setdefault(key, []).append((label, sr, table))
+    for (source, _), found in reached.items():
         plural = "s" if len(found) > 1 else ""
         what = f"the {kind} run{plural} " + _and_list([repr(label) for label, _, _ in found])
         message = extension_message(source, found[0][2], what, _and_list([f"{sr:.3g}" for _, sr, _ in found]))

@@ -382,7 +382,10 @@ macro_rules! fill_column {
 /// computed and checked, not stored; every slice is `samples.len() - skip` long). The run's
 /// constants are taken once; each column is one tight loop over the samples ([`fill`]). Returns the
 /// run's [`Overflow`], if any: the check covers the selected columns and the state, at every sample.
-/// Every row of every slice is written ([`OutputRow`]: the slices may be memory not yet written).
+/// Every row of every slice is written ([`OutputRow`]: the slices may be memory not yet written):
+/// the batch's buffers (`batch::run_transient_columns`) and [`columns`] rely on it to set their
+/// length, unsafely, after it; a change here must keep it (the test
+/// `every_row_of_a_buffer_not_yet_written_is_written` checks it).
 pub fn write_columns<R: OutputRow>(
     model: &dyn ConverterDynamics,
     samples: &[Sample],
