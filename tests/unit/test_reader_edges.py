@@ -338,3 +338,15 @@ def test_csv_columns_without_a_name_are_not_duplicates(tmp_path):
     rows = "\n".join(f"{t},{p},{w},," for t, p, w in zip(TIME_S, *CHANNELS.values(), strict=True))
     path.write_text("time_s,pump_torque_nm,turbine_speed_rad_s,,\n" + rows + "\n")
     assert len(read_measurement(path).time_s) == N
+
+
+def test_a_comma_at_the_end_of_every_row_reads_as_the_rows_without_it(tmp_path):
+    # fresh-eyes trial: pandas took the first value of such rows as their index and shifted the
+    # others ("time_s = '170 at row 52 after 170'", a pump torque read as a time)
+    rows = ["time_s,pump_torque_nm,turbine_speed_rad_s"] + [f"{0.1 * i:.1f},{40 + i},{2 * i}" for i in range(5)]
+    plain, trailing = tmp_path / "plain.csv", tmp_path / "trailing.csv"
+    plain.write_text("\n".join(rows) + "\n")
+    trailing.write_text("\n".join(r + "," for r in rows[:1]) + "\n" + "\n".join(r + "," for r in rows[1:]) + "\n")
+    a, b = read_measurement(plain).to_frame(), read_measurement(trailing).to_frame()
+    pd.testing.assert_frame_equal(a, b)
+    assert list(b.time_s) == [0.0, 0.1, 0.2, 0.3, 0.4] and list(b.pump_torque_nm) == [40, 41, 42, 43, 44]

@@ -28,6 +28,7 @@ import contextlib
 import gc
 import math
 import sys
+import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -266,24 +267,62 @@ def refuse_duplicates(path: Path, names: Sequence[str], columns: Sequence[str] |
 
 
 def read_csv_frame(path: Path, what: str = "CSV") -> pd.DataFrame:
-    """A CSV file as a DataFrame: ``#`` comments, a UTF-8 byte-order mark and blanks after the
-    commas allowed, the header's names stripped; an InputError for an empty or unreadable file and
-    for a column name that appears twice (pandas would rename the second one silently)."""
+    """A CSV file as a DataFrame: ``#`` comments, a UTF-8 byte-order mark, blanks after the commas
+    and a comma at the end of the rows allowed, the header's names stripped; an InputError for an
+    empty or unreadable file, a file that is not UTF-8, a header separated by ``;`` or tabs, a row
+    with more values than the header has columns (pandas would take the first as the row's index and
+    shift the others, silently), and a column name that appears twice (pandas would rename the second
+    one silently)."""
     options: dict = {"comment": "#", "skipinitialspace": True, "encoding": "utf-8-sig"}
 
     def read() -> tuple[pd.DataFrame, pd.DataFrame]:
         try:
             header = pd.read_csv(path, header=None, nrows=1, dtype=str, keep_default_na=False, **options)
-            return pd.read_csv(path, **options), header
+            with warnings.catch_warnings():
+                # index_col=False: never a first column as the index; a longer row warns, refused below
+                warnings.simplefilter("error", pd.errors.ParserWarning)
+                return pd.read_csv(path, index_col=False, **options), header
         except pd.errors.EmptyDataError:
             raise InputError(str(path), "(file)", "empty", "a header line and at least two data rows") from None
+        except pd.errors.ParserWarning:
+            raise _longer_row(path) from None
+        except UnicodeDecodeError as e:
+            raise _not_utf8(path, e) from None
 
     frame, header = _guarded(path, what, read)
     # an empty name gets pandas' own (``Unnamed: 3``), which --channel can map
     names = [str(c).strip() or f"Unnamed: {i}" for i, c in enumerate(header.iloc[0])]
+    if len(names) == 1 and (";" in names[0] or "\t" in names[0]):
+        sep = "';'" if ";" in names[0] else "tabs"
+        expected = f"columns separated by commas (this header is separated by {sep}: save the file as comma-separated)"
+        raise InputError(str(path), "(header)", names[0], expected)
     refuse_duplicates(path, names)
     frame.columns = names
     return frame
+
+
+def _longer_row(path: Path) -> InputError:
+    """The refusal of the first line of ``path`` with more values than its header has columns (an
+    empty value after a last comma is no value)."""
+    import csv  # noqa: PLC0415  lazy: only on this error
+
+    with open(path, encoding="utf-8-sig", newline="") as f:
+        rows = [(n, r) for n, r in enumerate(csv.reader(f), start=1) if r and not r[0].lstrip().startswith("#")]
+    width = len(rows[0][1])
+    for n, row in rows[1:]:
+        values = row[:-1] if row and not row[-1].strip() else row
+        if len(values) > width:
+            expected = f"at most {width} values, one per column of the header ({', '.join(rows[0][1])})"
+            return InputError(str(path), f"line {n}", f"{len(values)} values", expected)
+    return InputError(str(path), "(file)", "a row longer than the header", f"at most {width} values a row")
+
+
+def _not_utf8(path: Path, e: UnicodeDecodeError) -> InputError:
+    """The refusal of a file that is not UTF-8 text (UTF-16 by its byte-order mark, or a byte that
+    no UTF-8 text holds, as Latin-1 or Windows-1252 files do)."""
+    raw = bytes(e.object[:2])
+    what = "UTF-16 text" if raw in (b"\xff\xfe", b"\xfe\xff") else f"byte 0x{e.object[e.start]:02x} at offset {e.start}"
+    return InputError(str(path), "(file)", what, "UTF-8 text (save the file as UTF-8)")
 
 
 def _read_csv(path: Path, pick: _Chooser) -> _Loaded:
