@@ -26,7 +26,17 @@ CASE_KEYS = {
     *("writes", "warning"),
 }
 FILE_KEYS = {"text", "hex", "base", "replace", "prepend", "append", "make", "args", "dir"}
-COMMANDS = ("converters", "characterise", "fit", "study", "replay", "fit-shapes", "launch", "export-fmu", "operating-point")
+COMMANDS = (
+    "converters",
+    "characterise",
+    "fit",
+    "study",
+    "replay",
+    "fit-shapes",
+    "launch",
+    "export-fmu",
+    "operating-point",
+)
 
 
 def _load() -> list[dict[str, Any]]:
