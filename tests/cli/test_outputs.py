@@ -314,3 +314,18 @@ def test_export_fmu_replaces_only_an_fmu(cli, fmu_library, monkeypatch, tmp_path
         with zipfile.ZipFile(out) as zf:
             assert "modelDescription.xml" in zf.namelist()
     assert sorted(p.name for p in tmp_path.iterdir()) == ["c.fmu", "dir.fmu", "mine.fmu"]
+
+
+@pytest.mark.subprocess
+def test_a_reader_that_closes_stdout_ends_what_is_shown_not_the_run(tmp_path):
+    # fresh-eyes trial: `tcsim … | true` exited 1 without a word (click's EPIPE exit) after writing
+    # the whole output, against "a run that exits with anything but 0 has written nothing"
+    out = tmp_path / "o"
+    command = [sys.executable, "-m", "tcsim", "characterise", "li-sunden-2016", "--out", str(out)]
+    p = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path)
+    assert p.stdout is not None
+    p.stdout.close()  # the reader leaves before the first line
+    _, err = p.communicate(timeout=600)  # a hang guard only
+    assert p.returncode == 0, err.decode()
+    assert b"Traceback" not in err and b"failed" not in err and b"Exception ignored" not in err, err.decode()
+    assert_manifest_consistent(out)

@@ -9,6 +9,7 @@ one line ``interrupted (SIGINT): nothing written`` and nothing written (docs/gua
 from __future__ import annotations
 
 import contextlib
+import os
 import re
 import signal
 import sys
@@ -196,8 +197,55 @@ def interrupt_line(e: KeyboardInterrupt) -> tuple[str, int]:
     return f"interrupted ({name}): nothing written", 128 + signum
 
 
+class _ReaderMayLeave:
+    """``sys.stdout`` while a command runs: a reader that closes the pipe (``tcsim … | head``) ends
+    what is shown, not the run. Click exited 1 at the first write after it, silently, with the
+    outputs written in full; now the rest of the output goes to ``/dev/null`` (the descriptor too,
+    so that the interpreter's last flush finds no broken pipe) and the run completes."""
+
+    def __init__(self, stream: Any) -> None:
+        self._stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self._stream.write(text)
+        except BrokenPipeError:
+            self._to_devnull()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self._stream.flush()
+        except BrokenPipeError:
+            self._to_devnull()
+
+    def _to_devnull(self) -> None:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(devnull, self._stream.fileno())
+        finally:
+            os.close(devnull)
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._stream, name)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point: runs the app and maps errors to exit codes (see the module's docstring)."""
+    """Entry point: runs the app and maps errors to exit codes (see the module's docstring), with
+    stdout kept from failing when its reader leaves (:class:`_ReaderMayLeave`)."""
+    shown = sys.stdout
+    with contextlib.suppress(AttributeError, OSError, ValueError):  # a stream without a descriptor stays
+        shown.fileno()
+        sys.stdout = _ReaderMayLeave(shown)
+    try:
+        return _main(argv)
+    finally:
+        if isinstance(sys.stdout, _ReaderMayLeave):
+            sys.stdout.flush()
+            sys.stdout = shown
+
+
+def _main(argv: list[str] | None) -> int:
     from ..io import outputs
 
     warnings.showwarning = _show_warning
