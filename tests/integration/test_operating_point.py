@@ -175,7 +175,7 @@ def test_flagged_points_are_written_without_an_overflow_warning(cli, tmp_path):
     """A flagged point's empty values are explained by its reason; a valid point with a non-finite
     value would still be warned about (the writer's check, io.results.non_finite_columns)."""
     points = _points(tmp_path, "turbine_speed_rad_s,turbine_torque_nm\n100,50\n1e200,1e300\n")
-    r = cli("operating-point", "li-sunden-2016", points, "--out", tmp_path / "o")
+    r = cli("operating-point", "li-sunden-2016", points, "--out", tmp_path / "o", "--allow-implausible")
     assert r.code == 0, r.stderr
     df = pd.read_csv(tmp_path / "o" / "operating_points.csv")
     assert df["reason"].tolist() == ["ok", "overflow"] and df["pump_speed_rad_s"].isna().tolist() == [False, True]
@@ -195,8 +195,28 @@ def test_cli_reads_powers_from_parquet_and_other_models(cli, tmp_path):
     assert "1 flagged (1 power-at-standstill)" in r.stdout + r.stderr
 
 
+def test_cli_reads_speeds_in_rpm_and_runs_implausible_values_only_when_allowed(cli, tmp_path):
+    rad_s = _points(tmp_path, "turbine_speed_rad_s,turbine_torque_nm\n100,172\n150,-20\n", "rad_s.csv")
+    rpm = _points(
+        tmp_path,
+        f"turbine_speed_rpm,turbine_torque_nm\n{100 * 30 / math.pi!r},172\n{150 * 30 / math.pi!r},-20\n",
+        "rpm.csv",
+    )
+    for p, out in ((rad_s, "a"), (rpm, "b")):
+        assert cli("operating-point", "li-sunden-2016", p, "--out", tmp_path / out).code == 0
+    a, b = (pd.read_csv(tmp_path / o / "operating_points.csv") for o in "ab")
+    np.testing.assert_allclose(b["pump_speed_rad_s"], a["pump_speed_rad_s"], rtol=1e-12)
+    wrong = _points(tmp_path, "turbine_speed_rad_s,turbine_torque_nm\n1500,200\n", "wrong.csv")
+    r = cli("operating-point", "li-sunden-2016", wrong, "--out", tmp_path / "c", "--allow-implausible")
+    assert r.code == 0 and "turbine_speed_rad_s = 1500 is outside the plausible" in r.stderr, r.stderr
+
+
 BAD = [
-    ("turbine_torque_nm\n1\n", "points.csv", [], "turbine_speed_rad_s = 'missing'"),
+    ("turbine_torque_nm\n1\n", "points.csv", [], "turbine_speed_rad_s / turbine_speed_rpm = 'missing'"),
+    ("turbine_speed_rad_s,turbine_speed_rpm,turbine_torque_nm\n1,2,3\n", "points.csv", [], "_rpm = 'both'"),
+    # rpm under a rad/s name, a torque in N·mm: refused by the plausibility ranges (trial: "ok" points)
+    ("turbine_speed_rad_s,turbine_torque_nm\n100,200\n1500,200\n", "points.csv", [], "1500 rad/s at row 2"),
+    ("turbine_speed_rad_s,turbine_torque_nm\n100,2e5\n", "points.csv", [], "turbine_torque_nm = 200000 N·m at row 1"),
     ("turbine_speed_rad_s\n1\n", "points.csv", [], "turbine_torque_nm / turbine_power_w = 'missing'"),
     ("turbine_speed_rad_s,turbine_torque_nm,turbine_power_w\n1,2,3\n", "points.csv", [], "= 'both'"),
     ("turbine_speed_rad_s,turbine_torque_nm\n1,abc\n", "points.csv", [], "turbine_torque_nm = \"'abc' at row 1\""),

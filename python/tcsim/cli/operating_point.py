@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from .app import FormatOpt, ModelOpt, OutOpt, SpeedUnitOpt, say, table_format
+from .app import AllowImplausibleOpt, FormatOpt, ModelOpt, OutOpt, SpeedUnitOpt, say, table_format
 
 HELP = (
     "Backward operating points: from turbine speed and torque (or power) to pump speed and torque. "
@@ -20,8 +20,8 @@ def operating_point(
     points: Annotated[
         str,
         typer.Argument(
-            help="CSV or Parquet with turbine_speed_rad_s and turbine_torque_nm (N·m, negative in coast) "
-            "or turbine_power_w (W)"
+            help="CSV or Parquet with turbine_speed_rad_s (or turbine_speed_rpm) and turbine_torque_nm (N·m, "
+            "negative in coast) or turbine_power_w (W)"
         ),
     ],
     model: ModelOpt = "table",
@@ -35,6 +35,7 @@ def operating_point(
     out: OutOpt = Path("operating_points"),
     file_format: FormatOpt = "csv",
     speed_unit: SpeedUnitOpt = "rad/s",
+    allow_implausible: AllowImplausibleOpt = False,
 ) -> None:
     """Backward operating points of one model: DIR/operating_points.csv with valid and reason per point."""
     from ..io.outputs import check_output_dir, output_dir
@@ -50,7 +51,7 @@ def operating_point(
     conv = load_converter(converter)
     if model not in conv.models:
         conv.require(model)  # names the missing section (or the unknown --model)
-    data = read_points(points)
+    data = read_points(points, allow_implausible)
     inputs = [converter, conv.path, points]
     check_output_dir(out, inputs)
     torque, power = (data.values, None) if data.load == "turbine_torque_nm" else (None, data.values)
