@@ -6,6 +6,7 @@ levels and times to 90 % torque equal the ones computed here from their definiti
 from __future__ import annotations
 
 import math
+import re
 import warnings
 
 import numpy as np
@@ -138,6 +139,25 @@ def test_a_delay_beyond_the_searched_range_warns():
     with pytest.warns(TcsimWarning, match="edge of the searched range"):
         r = compare_torques(estimate(0.02, 0.5), measured(), max_delay_s=0.2)
     assert r.delay_s == pytest.approx(0.2, abs=1e-3)
+
+
+def test_an_estimate_of_the_opposite_sign_or_of_another_torque_warns():
+    # fresh-eyes trial: a negated estimate gave "delay -1 s (correlation -0.40)" with only the advice
+    # to raise --max-delay, and then -3.2 s at 0.73 without a word
+    est, meas = estimate(0.02, 0.2), measured()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", TcsimWarning)
+        assert compare_torques(est, meas).correlation > 0.99  # a good estimate: no warning
+    negated = TorqueSignal(est.source, est.time_s, -est.torque_nm)
+    with pytest.warns(TcsimWarning) as caught:
+        compare_torques(negated, meas)
+    messages = [str(w.message) for w in caught]
+    assert any(re.search(r"better negated \(correlation (1|0\.99\d*) at a delay of 0\.2 s.*sign", m) for m in messages)
+    assert not any("raise --max-delay" in m for m in messages), messages  # no range helps a wrong sign
+    rng = np.random.default_rng(3)
+    other = TorqueSignal(est.source, est.time_s, rng.normal(100.0, 30.0, est.time_s.size))
+    with pytest.warns(TcsimWarning, match=r"barely follows the measured torque \(correlation"):
+        compare_torques(other, meas)
 
 
 def test_steps_are_rises_through_the_hysteresis_band():

@@ -438,7 +438,8 @@ def compare_torques(
     result = TorqueComparison(
         estimate, measured, t, measured_nm, estimate_nm, aligned, max_delay_s, delay, correlation, steps
     )
-    if at_edge:
+    weak, negated = _weakness(t, estimate_nm, measured_nm, max_delay_s, correlation)
+    if at_edge and not negated:  # a negated estimate's best delay is anywhere: no range helps
         warnings.warn(
             f"{estimate.source}: the best delay, {delay:g} s, lies at the edge of the searched range "
             f"(±{max_delay_s:g} s, or half the common time): the true delay may be larger; raise --max-delay",
@@ -446,7 +447,31 @@ def compare_torques(
             stacklevel=2,
         )
     _warn_coarse(result)
+    if weak:
+        warnings.warn(f"{estimate.source}: the estimate {weak}", TcsimWarning, stacklevel=2)
     return result
+
+
+#: The correlation at the best delay below which the two torques are said not to follow each other.
+WEAK_CORRELATION = 0.8
+
+
+def _weakness(t, estimate_nm, measured_nm, max_delay_s: float, correlation: float) -> tuple[str | None, bool]:
+    """What is wrong when the torques barely follow each other at the best delay, and whether the
+    estimate negated follows better (its sign convention opposite to the measurement's); a
+    correlation below :data:`WEAK_CORRELATION` otherwise (the delay and the errors then mean little)."""
+    delay_negated, negated, _ = best_delay(t, -estimate_nm, measured_nm, max_delay_s)
+    if negated > correlation:
+        return (
+            f"follows the measured torque better negated (correlation {negated:.3g} at a delay of "
+            f"{delay_negated:.4g} s, against {correlation:.3g}): check the estimate's sign convention"
+        ), True
+    if correlation < WEAK_CORRELATION:
+        return (
+            f"barely follows the measured torque (correlation {correlation:.3g} at the best delay, below "
+            f"{WEAK_CORRELATION:g}): the delay and the errors mean little; check that both are the same torque"
+        ), False
+    return None, False
 
 
 def _warn_coarse(result: TorqueComparison) -> None:
