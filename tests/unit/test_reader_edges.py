@@ -350,3 +350,18 @@ def test_a_comma_at_the_end_of_every_row_reads_as_the_rows_without_it(tmp_path):
     a, b = read_measurement(plain).to_frame(), read_measurement(trailing).to_frame()
     pd.testing.assert_frame_equal(a, b)
     assert list(b.time_s) == [0.0, 0.1, 0.2, 0.3, 0.4] and list(b.pump_torque_nm) == [40, 41, 42, 43, 44]
+
+
+def test_seconds_under_a_milliseconds_name_are_refused_or_warned_of(tmp_path):
+    # fresh-eyes trial: a 3 s log under time_ms became 3 ms long and replayed with exit 0
+    p = tmp_path / "m.csv"
+    rows = [f"{0.01 * i:.2f},{40 + i},{i}" for i in range(300)]
+    p.write_text("time_ms,pump_torque_nm,turbine_speed_rad_s\n" + "\n".join(rows) + "\n")
+    with pytest.raises(InputError) as e:
+        read_measurement(p)
+    assert (e.value.field, e.value.value) == ("time_ms", "a record of 2.99 ms"), str(e.value)
+    with pytest.warns(TcsimWarning, match="time_ms = a record of 2.99 ms: expected a record of at least 100 ms"):
+        m = read_measurement(p, allow_implausible=True)
+    assert m.time_s[-1] == pytest.approx(2.99e-3)
+    p.write_text("time_ms,pump_torque_nm,turbine_speed_rad_s\n0,40,0\n50,41,1\n100,42,2\n")
+    assert read_measurement(p).time_s[-1] == pytest.approx(0.1)  # 100 ms: no refusal

@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError
+from ..errors import InputError, TcsimWarning
 from ..models.measurement import Measurement
 from ..models.plausibility import check_plausible
 from ..units import LBF_FT_IN_NM, RAD_S_PER_RPM
@@ -593,6 +593,23 @@ def check_increasing(path: Path, column: str, time: np.ndarray) -> None:
         )
 
 
+#: The shortest record under a milliseconds name that is not taken for seconds under it, s.
+MIN_MS_RECORD_S = 0.1
+
+
+def _short_ms_record(path: Path, column: str, span_s: float, allow: bool) -> None:
+    """Refuse (or with ``allow`` warn of) a record under a milliseconds name shorter than
+    :data:`MIN_MS_RECORD_S`: seconds written under ``time_ms`` make a 3 s log 3 ms long, its
+    accelerations a thousand times too large (a fresh-eyes trial's replay ran with exit 0)."""
+    shown = f"a record of {span_s * 1e3:g} ms"
+    expected = (
+        f"a record of at least {MIN_MS_RECORD_S * 1e3:g} ms (seconds under a milliseconds name? name the column time_s)"
+    )
+    if not allow:
+        raise InputError(str(path), column, shown, f"{expected}; --allow-implausible runs it anyway")
+    warnings.warn(f"{path}: {column} = {shown}: expected {expected}", TcsimWarning, stacklevel=4)
+
+
 def _plausible(
     path: Path,
     column: str,
@@ -618,6 +635,8 @@ def _plausible(
             )
         step = float(np.median(np.diff(values_si)))
         check_plausible("sample_spacing_s", step, str(path), f"{column} (median time step, s)", allow_implausible)
+        if column.endswith("_ms") and span < MIN_MS_RECORD_S:
+            _short_ms_record(path, column, span, allow_implausible)
         return
     if quantity not in _RANGE_OF:
         return
