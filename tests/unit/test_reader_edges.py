@@ -365,3 +365,14 @@ def test_seconds_under_a_milliseconds_name_are_refused_or_warned_of(tmp_path):
     assert m.time_s[-1] == pytest.approx(2.99e-3)
     p.write_text("time_ms,pump_torque_nm,turbine_speed_rad_s\n0,40,0\n50,41,1\n100,42,2\n")
     assert read_measurement(p).time_s[-1] == pytest.approx(0.1)  # 100 ms: no refusal
+
+
+def test_a_mapped_column_with_its_unit_in_brackets_is_converted_by_it(tmp_path):
+    # fresh-eyes trial: "turbine speed [rpm]" mapped with --channel was read as rad/s
+    p = tmp_path / "m.csv"
+    p.write_text("time [ms],EngTrq (Nm),turbine speed [rpm]\n0,40,0\n100,41,600\n200,42,1200\n")
+    channels = {"time_s": "time [ms]", "pump_torque_nm": "EngTrq (Nm)", "turbine_speed_rad_s": "turbine speed [rpm]"}
+    m = read_measurement(p, channels).to_frame()
+    assert list(m.time_s) == pytest.approx([0.0, 0.1, 0.2])
+    assert list(m.pump_torque_nm) == [40.0, 41.0, 42.0]
+    assert list(m.turbine_speed_rad_s) == pytest.approx([0.0, 20 * math.pi, 40 * math.pi])

@@ -27,6 +27,7 @@ from __future__ import annotations
 import contextlib
 import gc
 import math
+import re
 import sys
 import warnings
 from collections.abc import Callable, Iterator, Mapping, Sequence
@@ -106,7 +107,14 @@ def _candidates(canonical: str) -> list[tuple[str, float]]:
 
 
 def _suffix_factor(column: str, quantity: str) -> float:
-    """The factor to SI implied by a column name's unit suffix; 1 if it has none of ``quantity``."""
+    """The factor to SI implied by a column name's unit: a unit of ``quantity`` in brackets at its end
+    (``turbine speed [rpm]``, ``EngTrq (Nm)``, as loggers write them), else its unit suffix
+    (``GbxInSpd_rpm``); 1 if it has none of ``quantity``."""
+    bracketed = re.search(r"[\[(]\s*([^\[\]()]+?)\s*[\])]\s*$", column)
+    if bracketed is not None:
+        factor = _UNITS[quantity].get(_normalise_unit(bracketed.group(1)))
+        if factor is not None:
+            return factor
     lower = column.lower()
     for suffix, factor in _SUFFIXES[quantity].items():
         if lower.endswith("_" + suffix):
