@@ -180,6 +180,10 @@ def test_an_earlier_output_with_a_changed_file_is_refused(cli, tmp_path):
     r = cli("characterise", "li-sunden-2016", "--out", out)
     assert_refused(r, "an earlier tcsim output with 1 file changed since", "'characteristic.csv' (changed)")
     assert snapshot(tmp_path) == before
+    # a file added and a file changed: both counted (the trial saw only the added one named)
+    (out / "x.fmu").write_bytes(b"PK")
+    r = cli("characterise", "li-sunden-2016", "--out", out)
+    assert_refused(r, "2 files changed since", "'characteristic.csv' (changed)", "'x.fmu' (not in the manifest)")
 
 
 def test_the_rule_is_checked_again_after_the_compute(cli, tmp_path, monkeypatch):

@@ -13,6 +13,7 @@ import pytest
 
 from tcsim import _core
 from tcsim.io import fmu as tfmu
+from tcsim.io import fmu3
 from tcsim.models.dynamic import dynamic_model
 
 REFERENCE = Path(__file__).resolve().parents[1] / "data" / "fmu"
@@ -32,6 +33,18 @@ def test_model_description_is_the_reference(model, causality):
     xml = tfmu.model_description_xml(dynamic_model(CONVERTER, model), causality)
     reference = (REFERENCE / f"{model}-{causality}.xml").read_text(encoding="utf-8")
     assert _normalised(xml) == _normalised(reference)
+
+
+@pytest.mark.parametrize("causality", CAUSALITIES)
+@pytest.mark.parametrize("model", MODELS)
+def test_the_description_lists_the_inputs_the_fmu_declares(model, causality):
+    # fresh-eyes trial: the description left out turbine_accel_rad_s2 (the export line listed it)
+    dyn = dynamic_model(CONVERTER, model)
+    declared = [v["name"] for v in tfmu.fmu_variables(dyn, causality) if v["causality"] == "input"]
+    for xml in (tfmu.model_description_xml(dyn, causality), fmu3.model_description_xml(dyn, causality)):
+        description = ElementTree.fromstring(xml).attrib["description"]
+        listed = re.search(r"Inputs ([^;.]*)[;.]", description)
+        assert listed is not None and listed.group(1).split(", ") == declared, description
 
 
 @pytest.mark.parametrize("causality", CAUSALITIES)

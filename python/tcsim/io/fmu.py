@@ -196,11 +196,10 @@ def _header(
 ) -> list[str]:
     """``<fmiModelDescription ...>`` with the Model Exchange and Co-Simulation capabilities."""
     a, version, stem = xml_attr, _version(), Path(model.source).stem
-    outputs = ", ".join(v["name"] for v in variables if v["causality"] == "output")
+    inputs, outputs = (", ".join(v["name"] for v in variables if v["causality"] == c) for c in ("input", "output"))
     description = (
-        f"Torque converter {stem}, {model.name} model (tcsim {version}). Inputs "
-        f"{', '.join((*CAUSALITIES[causality], *COMMON_INPUTS))}; outputs {outputs}. Starts from the steady "
-        "state consistent with the inputs."
+        f"Torque converter {stem}, {model.name} model (tcsim {version}). Inputs {inputs}; outputs {outputs}. "
+        "Starts from the steady state consistent with the inputs."
     )
     return [
         '<?xml version="1.0" encoding="UTF-8"?>',

@@ -31,7 +31,7 @@ from ..errors import InputError
 from ..models.converter import Converter
 from ..models.dynamic import DynamicModel
 from . import fmu
-from .fmu import CAUSALITIES, MODEL_IDENTIFIER, FmiVersion, fmu_variables, xml_attr
+from .fmu import MODEL_IDENTIFIER, FmiVersion, fmu_variables, xml_attr
 
 #: Value reference of ``time``, the independent variable (the variable table's).
 TIME_VR: int = _core.FMU_TIME_VR
@@ -96,12 +96,13 @@ def _float64(v: dict[str, Any]) -> str:
     return f"    <Float64 {attrs}/>"
 
 
-def _header(model: DynamicModel, causality: str, name: str, token: str, stamp: str) -> list[str]:
+def _header(model: DynamicModel, variables: list[dict[str, Any]], name: str, token: str, stamp: str) -> list[str]:
     """``<fmiModelDescription ...>`` with the Model Exchange and Co-Simulation capabilities."""
     a, version, stem = xml_attr, fmu._version(), Path(model.source).stem
+    inputs = ", ".join(v["name"] for v in variables if v["causality"] == "input")
     description = (
-        f"Torque converter {stem}, {model.name} model (tcsim {version}), FMI 3.0. Inputs "
-        f"{', '.join(CAUSALITIES[causality])}. Starts from the steady state consistent with the inputs."
+        f"Torque converter {stem}, {model.name} model (tcsim {version}), FMI 3.0. Inputs {inputs}. Starts from "
+        "the steady state consistent with the inputs."
     )
     caps = 'canGetAndSetFMUState="true" canSerializeFMUState="true" providesDirectionalDerivatives="false"'
     return [
@@ -155,7 +156,7 @@ def model_description_xml(
     )
     return "\n".join(
         [
-            *_header(model, causality, name, token, stamp),
+            *_header(model, variables, name, token, stamp),
             *fmu._unit_definitions(),
             *_type_definitions(variables + indicators),
             "  <LogCategories>",

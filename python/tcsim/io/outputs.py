@@ -98,7 +98,7 @@ def _foreign_files(out: Path) -> list[str]:
     bad += [f"{n!r} (missing)" for n in listed if n not in files]
     for name, entry in listed.items():
         path = files.get(name)
-        if path is None or bad:
+        if path is None:
             continue
         if path.is_symlink() or path.stat().st_size != entry.get("size") or _sha256(path) != entry.get("sha256"):
             bad.append(f"{name!r} (changed)")
