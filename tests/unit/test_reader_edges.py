@@ -376,3 +376,17 @@ def test_a_mapped_column_with_its_unit_in_brackets_is_converted_by_it(tmp_path):
     assert list(m.time_s) == pytest.approx([0.0, 0.1, 0.2])
     assert list(m.pump_torque_nm) == [40.0, 41.0, 42.0]
     assert list(m.turbine_speed_rad_s) == pytest.approx([0.0, 20 * math.pi, 40 * math.pi])
+
+
+def test_a_gap_in_a_record_is_warned_of_once(tmp_path):
+    # fresh-eyes trial: a second of dropped rows was bridged linearly without a word
+    p = tmp_path / "m.csv"
+    t = np.r_[np.arange(0.0, 2.0, 0.01), np.arange(3.0, 5.0, 0.01)]
+    rows = "\n".join(f"{x:.2f},{40 + x:.3f},{x:.3f}" for x in t)
+    p.write_text("time_s,pump_torque_nm,turbine_speed_rad_s\n" + rows + "\n")
+    with pytest.warns(TcsimWarning, match=r"time_s: 1\.01 s between rows 200 and 201, 101 times the median step"):
+        read_measurement(p)
+    p.write_text("time_s,pump_torque_nm,turbine_speed_rad_s\n" + "\n".join(rows.splitlines()[:200]) + "\n")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", TcsimWarning)
+        read_measurement(p)  # no gap, no warning

@@ -291,7 +291,7 @@ def read_csv_frame(path: Path, what: str = "CSV") -> pd.DataFrame:
                 warnings.simplefilter("error", pd.errors.ParserWarning)
                 return pd.read_csv(path, index_col=False, **options), header
         except pd.errors.EmptyDataError:
-            raise InputError(str(path), "(file)", "empty", "a header line and at least two data rows") from None
+            raise InputError(str(path), "(file)", "empty", "a header line and data rows") from None
         except pd.errors.ParserWarning:
             raise _longer_row(path) from None
         except UnicodeDecodeError as e:
@@ -601,6 +601,25 @@ def check_increasing(path: Path, column: str, time: np.ndarray) -> None:
         )
 
 
+#: A time step this many times the median one is a gap in the record, warned of.
+GAP_STEPS = 20.0
+
+
+def _warn_of_a_gap(path: Path, column: str, steps: np.ndarray, median_step_s: float) -> None:
+    """One warning for the longest time step when it is over :data:`GAP_STEPS` times the median one
+    (rows lost by the logger): every channel is taken as linear across it, a guess, not data."""
+    worst = int(np.argmax(steps))
+    if not steps[worst] > GAP_STEPS * median_step_s:
+        return
+    warnings.warn(
+        f"{path}: {column}: {steps[worst]:.4g} s between rows {worst + 1} and {worst + 2}, "
+        f"{steps[worst] / median_step_s:.0f} times the median step ({median_step_s:.3g} s): rows missing? "
+        "The record is taken as linear across the gap",
+        TcsimWarning,
+        stacklevel=4,
+    )
+
+
 #: The shortest record under a milliseconds name that is not taken for seconds under it, s.
 MIN_MS_RECORD_S = 0.1
 
@@ -641,8 +660,10 @@ def _plausible(
                 f"time in seconds (a span under {MAX_TIME_SPAN_S:g} s; name the column time_ms "
                 "or map it with --channel)",
             )
-        step = float(np.median(np.diff(values_si)))
+        steps = np.diff(values_si)
+        step = float(np.median(steps))
         check_plausible("sample_spacing_s", step, str(path), f"{column} (median time step, s)", allow_implausible)
+        _warn_of_a_gap(path, column, steps, step)
         if column.endswith("_ms") and span < MIN_MS_RECORD_S:
             _short_ms_record(path, column, span, allow_implausible)
         return
