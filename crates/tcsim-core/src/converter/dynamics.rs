@@ -423,6 +423,19 @@ impl HtDynamics {
         if !(bound.is_finite() && b.inertance_kg_m4.is_finite() && terms.iter().all(|t| t.is_finite())) {
             return Err(self.overflowing_parameter());
         }
+        let (inertance, shape_terms) = (sig(b.inertance_kg_m4), sig(terms.iter().sum::<f64>()));
+        if bound == 0.0 {
+            // the other shape effects alone use up ρL_f/A: no value of this one helps, a longer fluid path does
+            let shortest = terms.iter().sum::<f64>() * self.geometry.get(HtParam::FlowArea) / b.density_kg_m3;
+            return Err(CoreError::new(
+                "geometry.fluid_length_m",
+                self.fluid_length_m,
+                format!(
+                    "a fluid length over {} m with these shape effects and inertias, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {inertance} and Σρ²S²/I = {shape_terms} (docs/physics.md §4)",
+                    sig(shortest)
+                ),
+            ));
+        }
         let s = self.shape_effect_m2[i].abs();
         // at the bound six digits show the same number twice: say which side the value is on
         let shown =
@@ -431,9 +444,7 @@ impl HtDynamics {
             SHAPE_KEYS[i],
             self.shape_effect_m2[i],
             format!(
-                "|S| < {shown} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {} and Σρ²S²/I = {} (docs/physics.md §4)",
-                sig(b.inertance_kg_m4),
-                sig(terms.iter().sum::<f64>())
+                "|S| < {shown} m² with the other parameters as given, so that the mass matrix is positive definite: ρL_f/A must exceed Σρ²S²/I, but ρL_f/A = {inertance} and Σρ²S²/I = {shape_terms} (docs/physics.md §4)"
             ),
         ))
     }
@@ -1226,6 +1237,19 @@ pub(crate) mod tests {
         // with S_t alone past its bound there is no room left for S_p
         let err = HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.01, 0.2, 0.0]).unwrap_err();
         assert_eq!(err.field, "geometry.turbine_shape_effect_m2");
+        // a fluid path too short for the shape effects: no shape effect's value helps, its length does
+        let err =
+            HtDynamics::new(HtGeometry::appendix_d(), inertia(), 1e-9, [0.00131, 0.002324, 0.001723]).unwrap_err();
+        assert_eq!((err.field.as_str(), err.value.as_str()), ("geometry.fluid_length_m", "0.000000001"), "{err}");
+        let i = inertia();
+        let terms = 840.0
+            * (0.00131f64.powi(2) / i.pump_kg_m2
+                + 0.002324f64.powi(2) / i.turbine_kg_m2
+                + 0.001723f64.powi(2) / i.stator_kg_m2);
+        assert!(err.expected.starts_with(&format!("a fluid length over {} m", sig(terms * 0.01))), "{}", err.expected);
+        assert!(
+            HtDynamics::new(HtGeometry::appendix_d(), i, 1.001 * terms * 0.01, [0.00131, 0.002324, 0.001723]).is_ok()
+        );
         // the bound is sharp: just below it is admitted, at it refused
         let b = ht([0.0; 3]).shape_effect_bounds()[1];
         assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, [0.0, 0.999 * b, 0.0]).is_ok());
