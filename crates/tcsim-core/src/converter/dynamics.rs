@@ -424,8 +424,11 @@ impl HtDynamics {
             return Err(self.overflowing_parameter());
         }
         let (inertance, shape_terms) = (sig(b.inertance_kg_m4), sig(terms.iter().sum::<f64>()));
-        if bound == 0.0 {
-            // the other shape effects alone use up ρL_f/A: no value of this one helps, a longer fluid path does
+        let implausible_length =
+            crate::plausibility::range("fluid_length_m").is_some_and(|r| !r.contains(self.fluid_length_m));
+        if bound == 0.0 && implausible_length {
+            // the other shape effects alone use up the ρL_f/A of an implausibly short fluid path (a
+            // length in km typed as m): no value of this shape effect helps, a longer path does
             let shortest = terms.iter().sum::<f64>() * self.geometry.get(HtParam::FlowArea) / b.density_kg_m3;
             return Err(CoreError::new(
                 "geometry.fluid_length_m",
