@@ -10,6 +10,7 @@ from __future__ import annotations
 import signal
 import unicodedata
 from collections.abc import Mapping
+from pathlib import Path
 from typing import Any
 
 
@@ -62,6 +63,35 @@ class CoreText(str):
 
 #: Escapes of the control characters that have a short one; the others are shown as ``\\xNN``/``\\uNNNN``.
 _SHORT_ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
+
+
+def read_user_text(path: str | Path, expected: str = "a readable UTF-8 text file") -> str:
+    """The text of a user's file (UTF-8, a byte-order mark skipped); a file that cannot be read, or
+    is not UTF-8, is an :class:`InputError` naming the file and why (not the exception's name)."""
+    try:
+        return Path(path).read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise not_utf8(path, e) from None
+    except OSError as e:
+        raise InputError(str(path), "(file)", e.strerror or type(e).__name__, expected) from None
+
+
+def not_utf8(path: str | Path, e: UnicodeDecodeError) -> InputError:
+    """The refusal of a file that is not UTF-8 text (UTF-16 by its byte-order mark, or a byte that
+    no UTF-8 text holds, as Latin-1 or Windows-1252 files do), naming the byte's line."""
+    data = bytes(e.object)
+    try:  # a reader's error may concern a chunk of the file (pandas): find the first bad byte of all of it
+        Path(path).read_bytes().decode("utf-8")
+    except UnicodeDecodeError as whole:
+        data, e = bytes(whole.object), whole
+    except OSError:
+        pass
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        what = "UTF-16 text"
+    else:
+        line = data[: e.start].count(b"\n") + 1
+        what = f"byte 0x{data[e.start]:02x} on line {line} (offset {e.start})"
+    return InputError(str(path), "(file)", what, "UTF-8 text (save the file as UTF-8)")
 
 
 def escape_controls(text: str) -> str:

@@ -390,3 +390,17 @@ def test_a_gap_in_a_record_is_warned_of_once(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", TcsimWarning)
         read_measurement(p)  # no gap, no warning
+
+
+def test_a_byte_that_is_not_utf8_far_into_a_csv_is_placed_in_the_whole_file(tmp_path):
+    """pandas decodes a CSV in chunks and reports the offset within the chunk: the message gives
+    the byte's line and offset in the file (it said offset 76 886 for a byte at 339 030)."""
+    rows = ["time_s,pump_torque_nm,turbine_speed_rad_s"]
+    rows += [f"{i / 1000:.3f},40.0000,{i / 100:.4f}" for i in range(20000)]
+    rows[15000] = rows[15000].replace("40.0000", "40.00\xb0")
+    data = "\n".join(rows).encode("latin-1")
+    path = tmp_path / "m.csv"
+    path.write_bytes(data)
+    offset = data.index(b"\xb0")
+    assert offset > 262144  # beyond pandas' first chunk
+    refused(lambda: read_measurement(path), "(file)", f"byte 0xb0 on line 15001 (offset {offset})")

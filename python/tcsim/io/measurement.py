@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError, TcsimWarning
+from ..errors import InputError, TcsimWarning, not_utf8
 from ..models.measurement import Measurement
 from ..models.plausibility import check_plausible
 from ..units import LBF_FT_IN_NM, RAD_S_PER_RPM
@@ -295,7 +295,7 @@ def read_csv_frame(path: Path, what: str = "CSV") -> pd.DataFrame:
         except pd.errors.ParserWarning:
             raise _longer_row(path) from None
         except UnicodeDecodeError as e:
-            raise _not_utf8(path, e) from None
+            raise not_utf8(path, e) from None
 
     frame, header = _guarded(path, what, read)
     # an empty name gets pandas' own (``Unnamed: 3``), which --channel can map
@@ -323,14 +323,6 @@ def _longer_row(path: Path) -> InputError:
             expected = f"at most {width} values, one per column of the header ({', '.join(rows[0][1])})"
             return InputError(str(path), f"line {n}", f"{len(values)} values", expected)
     return InputError(str(path), "(file)", "a row longer than the header", f"at most {width} values a row")
-
-
-def _not_utf8(path: Path, e: UnicodeDecodeError) -> InputError:
-    """The refusal of a file that is not UTF-8 text (UTF-16 by its byte-order mark, or a byte that
-    no UTF-8 text holds, as Latin-1 or Windows-1252 files do)."""
-    raw = bytes(e.object[:2])
-    what = "UTF-16 text" if raw in (b"\xff\xfe", b"\xfe\xff") else f"byte 0x{e.object[e.start]:02x} at offset {e.start}"
-    return InputError(str(path), "(file)", what, "UTF-8 text (save the file as UTF-8)")
 
 
 def _read_csv(path: Path, pick: _Chooser) -> _Loaded:

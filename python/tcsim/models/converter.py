@@ -18,7 +18,7 @@ import numpy as np
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .. import _core
-from ..errors import InputError, from_core
+from ..errors import InputError, from_core, read_user_text
 from .characteristic import CAPACITY_KEYS, Characteristic
 from .plausibility import warn_implausible
 from .tables import read_table
@@ -406,10 +406,7 @@ def parse_converter(data: dict[str, Any], path: str) -> Converter:
 
 
 def read_converter_toml(path: Path) -> Converter:
-    try:
-        text = path.read_text(encoding="utf-8-sig")  # a byte-order mark is skipped, as in the CSV readers
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
+    text = read_user_text(path, "a readable UTF-8 TOML file")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:

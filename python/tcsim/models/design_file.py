@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any, get_type_hints
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
-from ..errors import InputError, TcsimWarning
+from ..errors import InputError, TcsimWarning, read_user_text
 from .converter import Converter, GeometrySection, InertiaSection, load_converter, parse_converter
 from .design import DEFAULT_POINTS, DesignGeometry, TorusDesign, design_geometry, design_table, geometry_of_row
 
@@ -125,9 +125,7 @@ def read_design_file(path: str | Path) -> DesignFile:
     computed (:func:`derive_converter`). Raises :class:`~tcsim.errors.InputError` naming the file."""
     p = Path(path)
     try:
-        data = tomllib.loads(p.read_text(encoding="utf-8-sig"))
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(str(p), "(file)", type(e).__name__, f"a readable UTF-8 TOML design file ({e})") from None
+        data = tomllib.loads(read_user_text(p, "a readable UTF-8 TOML design file"))
     except tomllib.TOMLDecodeError as e:
         raise InputError(str(p), "(syntax)", str(e), "valid TOML") from None
     try:

@@ -43,7 +43,7 @@ import tomli_w
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .. import _core
-from ..errors import CoreText, InputError, TcsimWarning, from_core
+from ..errors import CoreText, InputError, TcsimWarning, from_core, read_user_text
 from .converter import MODELS, Converter, bundled_names, parse_converter
 from .vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, _load_named_converter, load_vehicle
 
@@ -394,9 +394,7 @@ def read_monte_carlo_file(path: str | Path) -> MonteCarloFile:
     if path.suffix.lower() != ".toml" or not path.is_file():
         raise InputError(str(path), "study file", str(path), "an existing Monte Carlo study .toml file")
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8-sig"))
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
+        data = tomllib.loads(read_user_text(path, "a readable UTF-8 TOML file"))
     except tomllib.TOMLDecodeError as e:
         raise InputError(str(path), "(syntax)", str(e), "valid TOML") from None
     if isinstance(data.get("distributions"), dict):

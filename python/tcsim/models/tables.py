@@ -18,16 +18,13 @@ import csv
 import math
 from pathlib import Path
 
-from ..errors import InputError
+from ..errors import InputError, read_user_text
 from .characteristic import CAPACITY_KEYS, Characteristic
 
 
 def _rows(path: Path) -> list[tuple[int, list[str]]]:
     """Non-empty, non-comment rows with their 1-based line numbers."""
-    try:
-        text = path.read_text(encoding="utf-8-sig")
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 text file ({e})") from None
+    text = read_user_text(path)
     out = []
     for lineno, line in enumerate(text.splitlines(), start=1):
         stripped = line.strip()

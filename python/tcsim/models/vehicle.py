@@ -25,7 +25,7 @@ from typing import Any
 import tomli_w
 
 from .. import _core
-from ..errors import InputError, from_core
+from ..errors import InputError, from_core, read_user_text
 from .converter import Converter, load_converter
 from .converter import bundled_names as bundled_converter_names
 
@@ -163,11 +163,7 @@ def parse_vehicle(data: dict[str, Any], path: str) -> Vehicle:
 
 
 def read_vehicle_toml(path: Path) -> Vehicle:
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as e:
-        raise InputError(str(path), "(file)", type(e).__name__, f"a readable UTF-8 TOML file ({e})") from None
-    return read_vehicle_text(text, str(path))
+    return read_vehicle_text(read_user_text(path, "a readable UTF-8 TOML file"), str(path))
 
 
 def _bundled_dir():
