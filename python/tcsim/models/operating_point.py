@@ -129,10 +129,11 @@ def operating_point(
         ``pump_speed_rad_s`` (rad/s), ``pump_torque_nm`` (N·m, positive in drive), ``speed_ratio``
         (ω_t/ω_p), ``torque_ratio`` (the forward model's TR), ``efficiency`` (SR·TR), ``valid`` and
         ``reason`` (categorical: ``ok``, ``at-rest``, ``non-finite-input``, ``above-pump-speed-limit``,
-        ``pump-against-turbine``, ``no-steady-state``, ``overflow``, ``power-at-standstill``;
+        ``pump-backwards``, ``no-steady-state``, ``overflow``, ``power-at-standstill``;
         docs/operating_point.md). Where several pump speeds give the torque: the lowest one turning
-        with the turbine. A NaN value always comes with a reason other than ``ok`` (or ``at-rest``,
-        where the ratios are undefined).
+        forwards (the engine's way, also while the vehicle rolls back: ω_t < 0, ω_p > 0). A NaN
+        value always comes with a reason other than ``ok`` (or ``at-rest``, where the ratios are
+        undefined).
 
     Raises
     ------

@@ -22,10 +22,12 @@
 //! each solved by Brent's method on [`steady_state`]; a piece across which the steady state jumps
 //! (a change of flow direction or stator mode) holds no root and is skipped.
 //!
-//! **Which root.** Where several pump speeds give the torque, the one with the pump turning with
-//! the turbine (`ω_p·ω_t ≥ 0`) and the smallest |ω_p| (VECTO: the lowest pump speed). If only a
-//! pump turning against the turbine gives it (coast torques beyond what the converter takes with
-//! the pump at rest), that root is returned, flagged [`Reason::PumpAgainstTurbine`].
+//! **Which root.** The pump is the engine's: it turns forwards (`ω_p ≥ 0`) whichever way the
+//! turbine turns (a vehicle rolling back in drive has ω_t < 0 and ω_p > 0). Where several pump
+//! speeds give the torque, the forward one with the smallest ω_p (VECTO: the lowest pump speed). If
+//! only a pump turned backwards gives it (coast torques beyond what the converter takes with the
+//! pump at rest, a negative torque at standstill or while rolling back), the backward root with the
+//! smallest |ω_p| is returned, flagged [`Reason::PumpBackwards`].
 
 use std::sync::atomic::AtomicBool;
 
@@ -37,7 +39,7 @@ use crate::error::{CoreError, CoreResult, InputSource};
 /// Why a backward operating point is what it is.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Reason {
-    /// A steady state with the pump turning with the turbine, within the pump speed limit.
+    /// A steady state with the pump turning forwards, within the pump speed limit.
     Ok = 0,
     /// Both speeds and the torque are zero: the converter at rest (SR, TR, efficiency NaN).
     AtRest = 1,
@@ -45,8 +47,8 @@ pub enum Reason {
     NonFiniteInput = 2,
     /// The steady state needs a pump speed above the limit (values given).
     AbovePumpSpeedLimit = 3,
-    /// Only a pump turning against the turbine gives this torque (values given).
-    PumpAgainstTurbine = 4,
+    /// Only a pump turning backwards, against the engine, gives this torque (values given).
+    PumpBackwards = 4,
     /// The model has no steady state with this torque at this turbine speed: every value NaN.
     NoSteadyState = 5,
     /// The steady state's speeds or torques overflow: every value NaN.
@@ -61,7 +63,7 @@ impl Reason {
         Self::AtRest,
         Self::NonFiniteInput,
         Self::AbovePumpSpeedLimit,
-        Self::PumpAgainstTurbine,
+        Self::PumpBackwards,
         Self::NoSteadyState,
         Self::Overflow,
         Self::PowerAtStandstill,
@@ -77,7 +79,7 @@ impl Reason {
             Self::AtRest => "at-rest",
             Self::NonFiniteInput => "non-finite-input",
             Self::AbovePumpSpeedLimit => "above-pump-speed-limit",
-            Self::PumpAgainstTurbine => "pump-against-turbine",
+            Self::PumpBackwards => "pump-backwards",
             Self::NoSteadyState => "no-steady-state",
             Self::Overflow => "overflow",
             Self::PowerAtStandstill => "power-at-standstill",
@@ -243,8 +245,8 @@ impl Backward {
         if !(wp.is_finite() && fw.pump_nm.is_finite() && fw.delivered_nm.is_finite()) {
             return BackwardPoint::empty(Reason::Overflow);
         }
-        let reason = if wp * wt < 0.0 || (wt == 0.0 && wp * t < 0.0) {
-            Reason::PumpAgainstTurbine
+        let reason = if wp < 0.0 {
+            Reason::PumpBackwards
         } else if wp.abs() > limit {
             Reason::AbovePumpSpeedLimit
         } else {
@@ -262,14 +264,14 @@ impl Backward {
     }
 
     /// Turbine at rest: `T = k_±·ω_p²` on either side of ω_p = 0, `k_± = T_del(±1, 0)`; the pump
-    /// turning the way the torque points preferred.
+    /// turning forwards preferred (a negative torque at rest needs it turned backwards).
     fn stall(&self, t: f64) -> Option<(f64, Forward)> {
         let side = |sign: f64| {
             let k = self.model.f(sign, 0.0);
             let w2 = t / k;
             (w2.is_finite() && w2 > 0.0).then(|| sign * w2.sqrt())
         };
-        let wp = if t > 0.0 { side(1.0).or_else(|| side(-1.0)) } else { side(-1.0).or_else(|| side(1.0)) }?;
+        let wp = side(1.0).or_else(|| side(-1.0))?;
         self.polish(wp, 0.0, t, f64::NEG_INFINITY, f64::INFINITY)
     }
 
@@ -441,7 +443,7 @@ fn brent(g: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64, mut fa: f64, mut fb: f6
 }
 
 /// The monotone pieces of `F_s` in the order the roots are preferred: u ≥ 0 upwards, then u < 0
-/// downwards (smallest |ω_p| first, the pump turning with the turbine first).
+/// downwards (the pump turning forwards first, each side from the smallest |ω_p|).
 fn pieces_of(model: &Model, s: f64, knots: &[f64]) -> Vec<Piece> {
     // the knots are given for s = +1; the regions depend on SR = s/u, so for s = −1 they mirror
     let mut k: Vec<f64> = knots.iter().map(|v| s * v).filter(|v| v.is_finite()).collect();
@@ -472,9 +474,8 @@ fn pieces_of(model: &Model, s: f64, knots: &[f64]) -> Vec<Piece> {
             pieces.push(p);
         }
     }
-    // the pump turning with the turbine (s·u ≥ 0) first, each side from u = 0 outwards
-    let (mut with, mut against): (Vec<Piece>, Vec<Piece>) =
-        pieces.into_iter().partition(|p| if s > 0.0 { p.lo >= 0.0 } else { p.hi <= 0.0 });
+    // the pump turning forwards (u ≥ 0) first, each side from u = 0 outwards
+    let (mut with, mut against): (Vec<Piece>, Vec<Piece>) = pieces.into_iter().partition(|p| p.lo >= 0.0);
     let outwards = |a: &Piece, b: &Piece| {
         let key = |p: &Piece| p.lo.abs().min(p.hi.abs());
         key(a).total_cmp(&key(b))
@@ -742,12 +743,15 @@ mod tests {
             };
             for (wp, wt) in grid() {
                 let back = assert_round_trip(name, f, &b, wp, wt);
-                // the lowest pump speed turning with the turbine: never above the grid's own (the pump at
-                // rest comes back as round-off of either sign)
+                // the lowest pump speed turning forwards: never above the grid's own, whichever way the
+                // turbine turns (the pump at rest comes back as round-off of either sign); a torque only
+                // a backward pump gives (both speeds negative) comes back with the smallest backward one
                 if wp == 0.0 {
                     assert!(back.abs() <= 1e-12 * wt.abs(), "{name} ({wp}, {wt}): {back}");
-                } else if wp * wt > 0.0 {
-                    assert!(back.abs() <= wp.abs() * (1.0 + 1e-9) && back * wt > 0.0, "{name} ({wp}, {wt}): {back}");
+                } else if wp > 0.0 {
+                    assert!(back >= 0.0 && back <= wp * (1.0 + 1e-9), "{name} ({wp}, {wt}): {back}");
+                } else if wt < 0.0 {
+                    assert!(back < 0.0 && back >= wp * (1.0 + 1e-9), "{name} ({wp}, {wt}): {back}");
                 }
                 // where F is monotone (Table C.1 with the pump turning with the turbine) the point itself
                 if name.starts_with("C.1") && wp * wt > 0.0 {
@@ -773,9 +777,46 @@ mod tests {
         let (tr, cf) = (0.5 * (1.84 + 1.70), 0.5 * (3.228e-3 + 3.181e-3));
         let p = b.point(50.0, tr * cf * 200.0 * 200.0, f64::INFINITY);
         assert!((p.pump_speed_rad_s - 200.0).abs() < 1e-9, "{p:?}");
-        // the same point in reverse (both speeds negative)
+        // the same point in reverse (both speeds negative): only a pump turned backwards gives it
         let q = b.point(-50.0, -tr * cf * 200.0 * 200.0, f64::INFINITY);
-        assert!((q.pump_speed_rad_s + 200.0).abs() < 1e-9, "{q:?}");
+        assert!((q.pump_speed_rad_s + 200.0).abs() < 1e-9 && q.reason == Reason::PumpBackwards, "{q:?}");
+    }
+
+    /// The pump is the engine's: a vehicle rolling back in drive (ω_t < 0, T > 0) has it turning
+    /// forwards, a valid point; a negative torque at standstill or while rolling back needs it turned
+    /// backwards, flagged (it was the mirror image, ω_p < 0, called valid, and the rollback point
+    /// flagged).
+    #[test]
+    fn the_pump_turns_forwards_when_rolling_back_and_a_backward_pump_is_flagged() {
+        let g = HtGeometry::appendix_d();
+        let ht = |wp: f64, wt: f64| {
+            let s = steady_state(&g, wp, wt).unwrap();
+            (s.pump_torque_nm, s.turbine_torque_nm)
+        };
+        let table = |wp: f64, wt: f64| {
+            let t = c1().torques(wp, wt);
+            (t.pump_nm, t.delivered_nm)
+        };
+        for (name, b) in [("C.1", Backward::table(&c1())), ("H&T", Backward::hrovat_tobler(&g))] {
+            let f = |wp: f64, wt: f64| if name == "H&T" { ht(wp, wt) } else { table(wp, wt) };
+            // rolling back at 20 rad/s with 100 N·m to hold: the pump forwards, the torque met
+            let p = b.point(-20.0, 100.0, f64::INFINITY);
+            assert!(p.reason == Reason::Ok && p.pump_speed_rad_s > 20.0, "{name} {p:?}");
+            assert!((f(p.pump_speed_rad_s, -20.0).1 - 100.0).abs() < 1e-9 * 100.0, "{name} {p:?}");
+            assert!(p.speed_ratio < 0.0 && p.efficiency < 0.0, "{name} {p:?}");
+            // the round trip of a forward pump against a rolling-back turbine gives the pump speed back
+            // or a lower forward one
+            let t = f(150.0, -30.0).1;
+            let back = b.point(-30.0, t, f64::INFINITY);
+            assert!(back.reason == Reason::Ok && back.pump_speed_rad_s <= 150.0 * (1.0 + 1e-9), "{name} {back:?}");
+            // a negative torque at standstill and while rolling back: only a backward pump gives it
+            for (wt, t) in [(0.0, -50.0), (-20.0, -100.0)] {
+                let p = b.point(wt, t, f64::INFINITY);
+                assert!(p.reason == Reason::PumpBackwards && p.pump_speed_rad_s < 0.0, "{name} ({wt}, {t}) {p:?}");
+                assert!((f(p.pump_speed_rad_s, wt).1 - t).abs() < 1e-9 * t.abs(), "{name} {p:?}");
+                assert!(!p.reason.valid());
+            }
+        }
     }
 
     #[test]
@@ -800,10 +841,10 @@ mod tests {
         let p = b.point(100.0, -stall, f64::INFINITY);
         assert!(p.reason == Reason::Ok && p.pump_speed_rad_s.abs() < 1e-6, "{p:?}");
         let p = b.point(100.0, -1.01 * stall, f64::INFINITY);
-        assert!(p.reason == Reason::PumpAgainstTurbine && p.pump_speed_rad_s < 0.0, "{p:?}");
+        assert!(p.reason == Reason::PumpBackwards && p.pump_speed_rad_s < 0.0, "{p:?}");
         // beyond TR(0)·CF(0)·ω_t² the pump turns backwards faster than the turbine (SR ∈ (−1, 0))
         let p = b.point(100.0, -3.0 * stall, f64::INFINITY);
-        assert!(p.reason == Reason::PumpAgainstTurbine && p.pump_speed_rad_s < -100.0, "{p:?}");
+        assert!(p.reason == Reason::PumpBackwards && p.pump_speed_rad_s < -100.0, "{p:?}");
         // a torque that overflows at this turbine speed
         let p = b.point(1e-160, 1e300, f64::INFINITY);
         assert_eq!(p.reason, Reason::Overflow);
