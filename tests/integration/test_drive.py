@@ -178,6 +178,22 @@ def test_unknown_cycle_name_is_refused(cli, tmp_path):
     )
 
 
+def test_a_trace_in_km_h_under_the_m_s_name_is_warned_of_and_runs(tmp_path, cli):
+    """The first 199 s of UDDS in km/h under ``vehicle_speed_m_s`` (63 km/h read as 63 m/s: within
+    the speed limit) ran with only a speed-error warning; its acceleration is now warned of first."""
+    c = read_cycle(bundled_cycle_path("udds"), "udds")
+    n = int(np.argmax(c.vehicle_speed_m_s * 3.6 > 65.0))
+    trace = tmp_path / "wrong.csv"
+    pd.DataFrame({"time_s": c.time_s[:n], "vehicle_speed_m_s": c.vehicle_speed_m_s[:n] * 3.6}).to_csv(
+        trace, index=False
+    )
+    r = cli("drive", "--cycle", trace, "--model", "table", "--no-plots", "--out", tmp_path / "o")
+    assert r.code == 0, r.stderr
+    first = r.stderr.strip().splitlines()[0]
+    assert first.startswith(f"warning: {trace}: vehicle_speed_m_s's change per second from row 164 (time_s 163) = 5.31")
+    assert "a trace in km/h read as m/s" in first
+
+
 def test_a_trace_in_km_h_is_read_as_its_m_s_twin(tmp_path, cli):
     # fresh-eyes trial: drive cycles are published in km/h and a trace file took m/s only
     t = np.arange(0.0, 31.0)

@@ -18,7 +18,9 @@ import scipy.io
 from asammdf import MDF, Signal
 
 from tcsim import errors
+from tcsim.analysis.drive import BUNDLED_CYCLES, trace_acceleration, warn_of_acceleration
 from tcsim.errors import InputError, TcsimWarning
+from tcsim.io.cycle import bundled_cycle_path, read_cycle
 from tcsim.io.measurement import read_measurement
 from tcsim.io.scenario import read_scenario
 from tcsim.models.converter import load_converter
@@ -404,3 +406,42 @@ def test_a_byte_that_is_not_utf8_far_into_a_csv_is_placed_in_the_whole_file(tmp_
     offset = data.index(b"\xb0")
     assert offset > 262144  # beyond pandas' first chunk
     refused(lambda: read_measurement(path), "(file)", f"byte 0xb0 on line 15001 (offset {offset})")
+
+
+def _udds_below_69_km_h() -> tuple[np.ndarray, np.ndarray]:
+    """The first 199 s of UDDS (up to 63 km/h: below the core's 250 km/h limit in either unit), km/h."""
+    c = read_cycle(bundled_cycle_path("udds"), "udds")
+    n = int(np.argmax(c.vehicle_speed_m_s * 3.6 > 65.0))
+    return c.time_s[:n], c.vehicle_speed_m_s[:n] * 3.6
+
+
+def test_a_cycle_in_km_h_under_the_m_s_name_is_warned_of_by_its_acceleration(tmp_path):
+    """UDDS in km/h under ``vehicle_speed_m_s`` ran with exit 0 and only a speed-error warning: its
+    1.48 m/s² reads as 5.3 m/s², beyond the plausible 5 (the range's own text names the mistake)."""
+    time_s, km_h = _udds_below_69_km_h()
+    wrong = tmp_path / "wrong.csv"
+    pd.DataFrame({"time_s": time_s, "vehicle_speed_m_s": km_h}).to_csv(wrong, index=False)
+    with pytest.warns(TcsimWarning) as record:
+        warn_of_acceleration(read_cycle(wrong))
+    (message,) = [str(w.message) for w in record]
+    assert "vehicle_speed_m_s's change per second from row 164 (time_s 163) = 5.31" in message, message
+    assert "km/h read as m/s" in message, message
+    right = tmp_path / "right.csv"
+    pd.DataFrame({"time_s": time_s, "vehicle_speed_km_h": km_h}).to_csv(right, index=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warn_of_acceleration(read_cycle(right))
+
+
+def test_the_bundled_cycles_are_plausible_and_the_acceleration_spans_a_second():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for name in BUNDLED_CYCLES:
+            warn_of_acceleration(read_cycle(bundled_cycle_path(name), name))
+    # 10 Hz samples: the change over a second, not one sample's noise; 2 s apart: the next sample
+    t = np.arange(0.0, 3.01, 0.1)
+    v = 2.0 * t + np.where(np.arange(t.size) % 2 == 0, 0.05, -0.05)
+    a = trace_acceleration(t, v)
+    # (sample to sample the ±0.05 m/s noise alone is ±1 m/s²; over a second at most ±0.1)
+    assert np.abs(a[:20] - 2.0).max() <= 0.1 + 1e-9 and a.size == t.size - 1
+    np.testing.assert_allclose(trace_acceleration(np.array([0.0, 2.0, 4.0]), np.array([0.0, 4.0, 4.0])), [2.0, 0.0])

@@ -71,6 +71,15 @@ pub const RANGES: &[PlausibleRange] = &[
               seconds gives more, seconds read as milliseconds less",
     },
     PlausibleRange {
+        quantity: "trace_acceleration_m_s2",
+        unit: "m/s²",
+        low: -10.0,
+        high: 5.0,
+        why: "a drive trace's speed change over a second: published cycles stay below 4 m/s² (US06: 3.8), \
+              0–100 km/h in 5.5 s is 5, braking at 1 g 10; a trace in km/h read as m/s has 3.6 times its \
+              own (UDDS's 1.48 m/s² reads as 5.3)",
+    },
+    PlausibleRange {
         quantity: "torque_ratio",
         unit: "",
         low: 0.0,

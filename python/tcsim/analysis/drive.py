@@ -31,6 +31,7 @@ import pandas as pd
 from .. import _core
 from ..errors import InputError, TcsimWarning, core_input_error, from_core
 from ..models.dynamic import DynamicModel, select_models, warn_about_runs
+from ..models.plausibility import warn_implausible
 from ..models.vehicle import Vehicle
 from ..simulation.transient import SolverError
 from ..units import KM_H
@@ -149,6 +150,32 @@ def located(error: InputError, cycle: Cycle) -> InputError:
     return InputError(error.source, column, where, expected, core_source=error.core_source)
 
 
+#: The span a trace's acceleration is taken over, s: a second, as drive cycles are published.
+ACCELERATION_SPAN_S = 1.0
+
+
+def trace_acceleration(time_s: np.ndarray, speed_m_s: np.ndarray) -> np.ndarray:
+    """The speed change per second from each sample to the first one at least
+    :data:`ACCELERATION_SPAN_S` later (the next one where samples are further apart), m/s²; one value
+    per sample but the last (a measured trace's noise averages out over the span)."""
+    later = np.searchsorted(time_s, time_s[:-1] + ACCELERATION_SPAN_S)
+    later = np.clip(later, np.arange(1, len(time_s)), len(time_s) - 1)
+    return (speed_m_s[later] - speed_m_s[:-1]) / (time_s[later] - time_s[:-1])
+
+
+def warn_of_acceleration(cycle: Cycle) -> None:
+    """Warn of a trace whose speed changes faster than a road vehicle's (``trace_acceleration_m_s2``),
+    most often one in km/h under the m/s name, naming the file's column, data row and time stamp;
+    the drive runs on (the driver follows what it can, and the speed error says how well)."""
+    time_s = np.asarray(cycle.time_s, float)
+
+    def where(i: int) -> str:
+        return f"{cycle.speed_column}'s change per second from row {i + 1} (time_s {time_s[i] + cycle.start_time_s:g})"
+
+    accel = trace_acceleration(time_s, np.asarray(cycle.vehicle_speed_m_s, float))
+    warn_implausible("trace_acceleration_m_s2", accel, cycle.source, where)
+
+
 def run_drive(
     vehicle: Vehicle,
     cycle: Cycle,
@@ -169,6 +196,7 @@ def run_drive(
         raw = _core.drive_runs([m.spec for m in models], vehicle.core, cycle.core_spec(), options, threads)
     except _core.CoreInputError as e:
         raise located(from_core(e, files), cycle) from None
+    warn_of_acceleration(cycle)  # the trace passed the core's checks
     finished: list[tuple[DynamicModel, DriveRun]] = []
     for model, run in zip(models, raw):
         result = _unpack(run, model.name, files)
