@@ -533,7 +533,7 @@ mod tests {
             "1e7",
             "1.1e7",
             "[driveline].front_shaft_stiffness_nm_per_rad",
-            "greater than 0 and at most 10000000",
+            "greater than 0 and at most 1e7",
         ),
         (
             "driveline",
@@ -541,7 +541,7 @@ mod tests {
             "1e7",
             "1.1e7",
             "[driveline].rear_shaft_stiffness_nm_per_rad",
-            "greater than 0 and at most 10000000",
+            "greater than 0 and at most 1e7",
         ),
         (
             "driveline",

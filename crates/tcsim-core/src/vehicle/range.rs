@@ -1,7 +1,7 @@
 //! The allowed values of a vehicle file's numbers, and the names of its fields: shared by the
 //! parameters ([`super::parameters`]) and the components they configure ([`super::shift`]).
 
-use crate::error::{CoreError, CoreResult};
+use crate::error::{sig, CoreError, CoreResult};
 
 /// The name of a vehicle file's field as the file writes it: `[section].key`.
 pub fn field(section: &str, key: &str) -> String {
@@ -49,10 +49,10 @@ impl Range {
     pub fn expected(&self) -> String {
         let mut ends = Vec::new();
         if let Some((lo, closed)) = self.low {
-            ends.push(if closed { format!("at least {lo}") } else { format!("greater than {lo}") });
+            ends.push(if closed { format!("at least {}", sig(lo)) } else { format!("greater than {}", sig(lo)) });
         }
         if let Some((hi, closed)) = self.high {
-            ends.push(if closed { format!("at most {hi}") } else { format!("less than {hi}") });
+            ends.push(if closed { format!("at most {}", sig(hi)) } else { format!("less than {}", sig(hi)) });
         }
         match ends.is_empty() {
             true => "a finite number".into(),
@@ -67,5 +67,21 @@ impl Range {
         } else {
             Err(CoreError::new(name, v, self.expected()))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bounds in a message: six significant digits, the exponent form far from 1 (Rust's `{}`
+    /// wrote 1e-9 as 0.000000001 and 1e7 as 10000000).
+    #[test]
+    fn the_bounds_are_written_as_numbers_are_in_messages() {
+        let r = Range { low: Some((1e-9, false)), high: Some((1e7, true)) };
+        assert_eq!(r.expected(), "a finite number greater than 1e-9 and at most 1e7");
+        let r = Range { low: Some((-50.0, true)), high: Some((250.0 / 3.6, false)) };
+        assert_eq!(r.expected(), "a finite number at least -50 and less than 69.4444");
+        assert_eq!(Range { low: None, high: None }.expected(), "a finite number");
     }
 }
