@@ -7,6 +7,7 @@ wrong is a failure of tcsim or of a solver (exit code 1).
 
 from __future__ import annotations
 
+import re
 import signal
 import unicodedata
 from collections.abc import Mapping
@@ -65,6 +66,10 @@ class CoreText(str):
 _SHORT_ESCAPES = {"\n": "\\n", "\r": "\\r", "\t": "\\t"}
 
 
+#: A line break as the readers split lines: CRLF, CR or LF.
+_LINE_BREAK = re.compile(rb"\r\n|\r|\n")
+
+
 def read_user_text(path: str | Path, expected: str = "a readable UTF-8 text file") -> str:
     """The text of a user's file (UTF-8, a byte-order mark skipped); a file that cannot be read, or
     is not UTF-8, is an :class:`InputError` naming the file and why (not the exception's name)."""
@@ -89,7 +94,7 @@ def not_utf8(path: str | Path, e: UnicodeDecodeError) -> InputError:
     if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
         what = "UTF-16 text"
     else:
-        line = data[: e.start].count(b"\n") + 1
+        line = len(_LINE_BREAK.findall(data, 0, e.start)) + 1  # CR-only files (old Mac exports) too
         what = f"byte 0x{data[e.start]:02x} on line {line} (offset {e.start})"
     return InputError(str(path), "(file)", what, "UTF-8 text (save the file as UTF-8)")
 

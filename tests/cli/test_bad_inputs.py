@@ -36,6 +36,8 @@ COMMANDS = (
     "launch",
     "export-fmu",
     "operating-point",
+    "monte-carlo",
+    "design",
 )
 
 

@@ -18,7 +18,7 @@ import scipy.io
 from asammdf import MDF, Signal
 
 from tcsim import errors
-from tcsim.analysis.drive import BUNDLED_CYCLES, trace_acceleration, warn_of_acceleration
+from tcsim.analysis.drive import BUNDLED_CYCLES, Cycle, trace_acceleration, warn_of_acceleration
 from tcsim.errors import InputError, TcsimWarning
 from tcsim.io.cycle import bundled_cycle_path, read_cycle
 from tcsim.io.measurement import read_measurement
@@ -442,6 +442,27 @@ def test_the_bundled_cycles_are_plausible_and_the_acceleration_spans_a_second():
     t = np.arange(0.0, 3.01, 0.1)
     v = 2.0 * t + np.where(np.arange(t.size) % 2 == 0, 0.05, -0.05)
     a = trace_acceleration(t, v)
-    # (sample to sample the ±0.05 m/s noise alone is ±1 m/s²; over a second at most ±0.1)
-    assert np.abs(a[:20] - 2.0).max() <= 0.1 + 1e-9 and a.size == t.size - 1
+    # (sample to sample the ±0.05 m/s noise alone is ±1 m/s²; over a second at most ±0.1), and none in
+    # the last second, whose spans would shrink to one sample's
+    assert np.abs(a - 2.0).max() <= 0.1 + 1e-9 and a.size in (20, 21), a.size
     np.testing.assert_allclose(trace_acceleration(np.array([0.0, 2.0, 4.0]), np.array([0.0, 4.0, 4.0])), [2.0, 0.0])
+    # shorter than a second: its first-to-last change
+    np.testing.assert_allclose(trace_acceleration(np.array([0.0, 0.5]), np.array([0.0, 3.0])), [6.0])
+
+
+def test_noise_in_a_trace_s_last_second_is_not_an_acceleration():
+    """A 100 Hz trace at a steady 20 m/s with 0.03 m/s of noise: the last second's changes were taken
+    over ever shorter spans (one sample's at the end) and warned of as up to 9 m/s²."""
+    rng = np.random.default_rng(7)
+    t = np.arange(0.0, 60.0, 0.01)
+    v = np.concatenate([np.linspace(0.0, 20.0, 1000), np.full(t.size - 1000, 20.0)]) + 0.03 * rng.standard_normal(
+        t.size
+    )
+    v[0] = 0.0
+    a = trace_acceleration(t, v)
+    # the 2 m/s² of the ramp and the noise over a second (σ 0.04 m/s²); the steady end stays small
+    assert np.abs(a).max() < 2.3 and np.abs(a[-100:]).max() < 0.3, (np.abs(a).max(), np.abs(a[-100:]).max())
+    assert t[a.size - 1] <= t[-1] - 1.0 + 1e-9, a.size
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        warn_of_acceleration(Cycle("noisy", "noisy.csv", t, v))

@@ -237,7 +237,8 @@ def _guarded(path: Path, what: str, read: Callable[[], _T]) -> _T:
     except InputError:
         raise
     except Exception as e:  # noqa: BLE001 - a corrupt file can fail in any way inside a library
-        failure = f"{type(e).__name__}: {e}"
+        # a file the system cannot read says why (its errno's text); a library's failure says what it is
+        failure = e.strerror if isinstance(e, OSError) and e.strerror else f"{type(e).__name__}: {e}"
     gc.collect()
     raise InputError(str(path), "(file)", failure, f"a readable {what} file")
 
