@@ -330,6 +330,10 @@ impl Instance {
             if !value.is_finite() {
                 return Err(format!("start-value parameter {vr} = {value}: expected a finite value"));
             }
+            if vr == vr::START_FROM_STEADY_STATE && value != 0.0 && value != 1.0 {
+                // a flag held as a Real: 0.5 or 2 would have meant 1 without a word
+                return Err(format!("start_from_steady_state = {value}: expected 0 or 1"));
+            }
             self.start[i] = value;
             return Ok(false);
         }
@@ -583,6 +587,12 @@ mod tests {
         inst.initialize().unwrap();
         assert_eq!(inst.get(1), Some(123.0));
         assert_eq!(inst.get(31), Some(123.0));
+        // the flag is 0 or 1: any other value is refused and changes nothing
+        let mut inst = Instance::new(Configuration::parse(CONFIG).unwrap());
+        for bad in [0.5, 2.0, -1.0] {
+            assert!(inst.set(30, bad).unwrap_err().contains("expected 0 or 1"), "{bad}");
+        }
+        assert_eq!(inst.get(30), Some(1.0));
     }
 
     #[test]
