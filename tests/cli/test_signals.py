@@ -260,3 +260,24 @@ def test_an_interrupt_python_dropped_stops_a_sharded_study_after_its_chunk(cli, 
     manifest = json.loads((tmp_path / "o" / shards.MANIFEST).read_text())
     assert len(calls) == 1
     assert len(manifest["chunks"]) == 1
+
+
+@pytest.mark.parametrize("sig", [signal.SIGINT, signal.SIGTERM])
+def test_a_signal_after_the_run_has_reported_does_not_kill_the_process(tmp_path, sig):
+    """A signal in the interpreter's teardown (about 0.2 s after the success line) killed the process
+    by the signal, which a shell took for an interrupted run (130/143) with its whole output written.
+    The run's own exit code stands: the signal lands here after ``main`` returned, as it would then."""
+    script = (
+        "import os, signal, sys, time\n"
+        "from tcsim.cli.app import main\n"
+        "sys.argv = ['tcsim', 'converters']\n"
+        "code = main()\n"
+        f"os.kill(os.getpid(), {int(sig)})\n"
+        "time.sleep(0.2)\n"
+        "print('after the signal', flush=True)\n"
+        "sys.exit(code)\n"
+    )
+    r = subprocess.run([sys.executable, "-c", script], cwd=tmp_path, capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0, (r.returncode, r.stderr)
+    assert "after the signal" in r.stdout and "li-sunden-2016" in r.stdout
+    assert "Traceback" not in r.stderr and "interrupted" not in r.stderr, r.stderr

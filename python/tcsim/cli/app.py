@@ -243,6 +243,18 @@ def main(argv: list[str] | None = None) -> int:
         if isinstance(sys.stdout, _ReaderMayLeave):
             sys.stdout.flush()
             sys.stdout = shown
+        if argv is None:  # the process ends with this run
+            _ignore_signals_until_exit()
+
+
+def _ignore_signals_until_exit() -> None:
+    """The run is over and reported (its output committed or nothing written, its exit code
+    decided): SIGINT and SIGTERM are ignored while the interpreter tears down (about 0.2 s). A
+    signal then killed the process after the success line, which a shell took for an interrupted
+    run (130) with its whole output written."""
+    with contextlib.suppress(ValueError):  # not the main thread: not ours to change
+        for sig in (signal.SIGINT, signal.SIGTERM):
+            signal.signal(sig, signal.SIG_IGN)
 
 
 def _main(argv: list[str] | None) -> int:
