@@ -438,3 +438,17 @@ def test_models_far_apart_each_get_bins_of_their_own():
         filled = np.unique(np.digitize(far[m], bins[m][1:-1])).size
         assert filled >= 5, (m, filled)
     assert histogram_bins({"table": np.full(4, 2.0)})["table"].tolist() == np.linspace(2.0, 3.0, 6).tolist()
+
+
+def test_an_output_no_run_reaches_gets_an_empty_histogram_not_a_crash(tmp_path, cli):
+    """A trial's part-pedal study: no run reaches 100 km/h, so ``time_0_100_km_h_s`` has no finite
+    value and the histogram took the minimum of an empty array (exit 1, a ValueError)."""
+    assert histogram_bins({"table": np.empty(0)}) == {}
+    text = STUDY.format(runs=2, seed=7).replace("runs = 2\n", 'runs = 2\nscenario = "part-pedal"\nmodels = ["table"]\n')
+    study = tmp_path / "pp.toml"
+    study.write_text(text, encoding="utf-8")
+    r = cli("monte-carlo", study, "--out", tmp_path / "o")
+    assert r.code == 0, r.stderr
+    frame = pd.read_csv(tmp_path / "o" / "monte_carlo.csv")
+    assert frame["time_0_100_km_h_s"].isna().all() and frame["time_0_50_km_h_s"].notna().all()
+    assert (tmp_path / "o" / "monte_carlo_time_0_100_km_h_s.png").stat().st_size > 0

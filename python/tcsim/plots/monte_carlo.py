@@ -31,6 +31,8 @@ def histogram_bins(finite: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
     whose values spread fills fewer than :data:`MIN_SHARED_BINS` of them (models far apart, each
     narrow: a trial's spread showed as one bar); then each model has bins over its own values."""
     everything = np.concatenate([v for v in finite.values()] or [np.empty(0)])
+    if not everything.size:  # no run has a value (an output never reached, e.g. 0–100 km/h at part pedal)
+        return {}
     count = min(BINS, max(5, int(np.sqrt(everything.size))))
 
     def edges(v: np.ndarray) -> np.ndarray:
