@@ -197,6 +197,25 @@ def test_characterise_input_torque_cli(cli, tmp_path, two):
     assert not (tmp_path / "p").exists() and not (tmp_path / "q").exists()
 
 
+@pytest.mark.filterwarnings("ignore::tcsim.errors.TcsimWarning")  # the table's mirror extension above SR 1
+@pytest.mark.parametrize("model", ["table", "hrovat-tobler"])
+def test_an_input_torque_no_speed_ratio_carries_is_refused_and_coast_needs_overrun(cli, tmp_path, model):
+    """A trial: ``--input-torque-nm -100`` over SR 0-1 wrote 102 rows of NaN with exit 0; a coast
+    torque is carried above SR 1; a torque of 1e300 N·m wrote pump speeds of 1.8e151 rad/s."""
+    r = cli("characterise", "li-sunden-2016", "-m", model, "--input-torque-nm", "-100", "--out", tmp_path / "n")
+    assert r.code == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "--input-torque-nm = -100: expected a torque the converter carries" in r.stderr
+    assert "speed ratio of the sweep (0 to 1)" in r.stderr and "--speed-ratio 1:2" in r.stderr
+    sr = np.linspace(1.1, 2.0, 10)
+    coast = characterise(load_converter("li-sunden-2016"), model, speed_ratio=sr, input_torque_nm=-100.0)
+    solved = coast["pump_speed_rad_s"].notna().to_numpy()
+    assert solved.sum() >= 5 and (coast["pump_speed_rad_s"][solved] > 0).all()
+    np.testing.assert_allclose(coast["pump_torque_nm"][solved], -100.0, rtol=1e-9)
+    r = cli("characterise", "li-sunden-2016", "-m", model, "--input-torque-nm", "1e300", "--out", tmp_path / "h")
+    assert r.code == 2 and "plausible" in r.stderr and "--allow-implausible" in r.stderr, r.stderr
+    assert not (tmp_path / "n").exists() and not (tmp_path / "h").exists()
+
+
 # ---------------------------------------------------------------------------------------------
 # files
 

@@ -19,7 +19,7 @@ from .. import _core
 from ..errors import InputError, core_value, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .converter import Converter
-from .plausibility import check_plausible_rpm
+from .plausibility import check_plausible, check_plausible_rpm
 
 #: Codes of the ``stator_mode`` column of the core's steady states and their names (the core's).
 STATOR_MODES: dict[int, str] = _core.steady_mode_names()
@@ -405,12 +405,16 @@ def characterise(
     A pump speed outside the plausible range (``speed_rad_s``) is refused unless ``allow_implausible``."""
     conv.require(model)
     if input_torque_nm is not None:
-        return characterise_at_input_torque(conv, model, input_torque_nm, speed_ratio)
+        return characterise_at_input_torque(conv, model, input_torque_nm, speed_ratio, allow_implausible)
     return CHARACTERISE[model](conv, pump_speed_rpm, speed_ratio, allow_implausible)
 
 
 def characterise_at_input_torque(
-    conv: Converter, model: str, input_torque_nm: float, speed_ratio: np.ndarray | None = None
+    conv: Converter,
+    model: str,
+    input_torque_nm: float,
+    speed_ratio: np.ndarray | None = None,
+    allow_implausible: bool = False,
 ) -> pd.DataFrame:
     """Steady states at a fixed pump (input) torque ``input_torque_nm``, N·m, over ``speed_ratio``
     (default: the sweep of :func:`characterise`), the positive pump speed solved in the core.
@@ -424,12 +428,27 @@ def characterise_at_input_torque(
     Raises
     ------
     InputError
-        ``--input-torque-nm`` not a finite, non-zero number.
+        ``--input-torque-nm`` not a finite, non-zero number; outside the plausible ``torque_nm``
+        unless ``allow_implausible``; or carried at no speed ratio of the sweep (a negative torque
+        over speed ratios 0–1 gave every row NaN with exit 0).
     """
     conv.require(model)
     if not (np.isfinite(input_torque_nm) and input_torque_nm != 0.0):
         raise InputError("command line", "--input-torque-nm", input_torque_nm, "a finite, non-zero torque in N·m")
-    t = float(input_torque_nm)
+    check_plausible("torque_nm", [input_torque_nm], "command line", "--input-torque-nm", allow_implausible)
+    frame = _at_input_torque(conv, model, float(input_torque_nm), speed_ratio)
+    if not np.isfinite(frame["pump_speed_rad_s"].to_numpy(dtype=float)).any():
+        sr = frame["speed_ratio"].to_numpy(dtype=float)
+        expected = (
+            f"a torque the converter carries at some speed ratio of the sweep ({sr.min():g} to {sr.max():g}); "
+            "a negative (coast) torque needs speed ratios above 1, e.g. --speed-ratio 1:2:0.01"
+        )
+        raise InputError("command line", "--input-torque-nm", input_torque_nm, expected)
+    return frame
+
+
+def _at_input_torque(conv: Converter, model: str, t: float, speed_ratio: np.ndarray | None) -> pd.DataFrame:
+    """The frame of :func:`characterise_at_input_torque` (rows of NaN where no pump speed carries t)."""
     if model == "hrovat-tobler":
         sr = np.linspace(0.0, 1.0, 101) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
         if speed_ratio is None and (cp := coupling_point(conv)) is not None:
