@@ -91,6 +91,18 @@ def test_recovers_identifiable_parameters(bundled, truth):
         assert r.values[name] == pytest.approx(TRUTH[name], rel=1e-6), name
 
 
+def test_a_fit_with_fewer_values_than_free_parameters_warns(bundled, truth):
+    """A trial: 10 parameters fitted to 2 points reported success with exit 0; only fit_report.md
+    said that JᵀJ was singular. A full table with the default free set (rank 7 of 10) does not warn."""
+    with pytest.warns(TcsimWarning, match=r"not unique: 2 points give 4 values \(TR and CF\) for 10 free"):
+        r = fit_hrovat_tobler(bundled.geometry, model_table(truth, np.array([0.0, 0.5])), n_starts=2)
+    assert r.singular
+    with warnings.catch_warnings():
+        warnings.filterwarnings("error", message=".*not unique.*", category=TcsimWarning)
+        r = fit_hrovat_tobler(bundled.geometry, model_table(truth, GRID), n_starts=2)
+    assert r.singular  # the default set's own deficiency, explained in the report
+
+
 def test_default_free_set_recovers_the_curve_not_the_parameters(bundled, truth):
     # The default set frees all 10 losses and angles: 3 more than the table determines (see
     # above), so the fit finds one of a 3-parameter family of equivalent points. It must still

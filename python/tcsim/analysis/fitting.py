@@ -25,6 +25,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -36,7 +37,7 @@ import pandas as pd
 from scipy.optimize import least_squares
 
 from .. import _core
-from ..errors import InputError
+from ..errors import InputError, TcsimWarning
 from ..models.characteristic import Characteristic
 from ..models.converter import STEADY_KEYS, STEADY_SCALE, Converter, GeometrySection, InertiaSection, load_converter
 from ..models.steady import characterise_hrovat_tobler, ratio_frame
@@ -573,6 +574,16 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
             f"JᵀJ is singular (rank {stats['rank']} of {len(problem.free)}): the table determines only "
             f"{stats['rank']} combinations of the free parameters, and the fit is one of many equivalent "
             "points; correlations from the pseudo-inverse, standard errors only for identifiable parameters"
+        )
+    if 2 * len(tr) < len(problem.free):
+        # on the terminal too: a fit of 10 parameters to 2 points reported success with exit 0 (the
+        # default free set's own rank deficiency, 7 of 10 on a full table, is the report's to explain)
+        warnings.warn(
+            f"{table.source}: the fit is not unique: {len(tr)} points give {2 * len(tr)} values (TR and "
+            f"CF) for {len(problem.free)} free parameters (rank {stats['rank']}); free fewer (--free) or "
+            "fit a table with more points",
+            TcsimWarning,
+            stacklevel=2,
         )
     size = ("fluid_density_kg_m3" in problem.free, "flow_area_m2" in problem.free, bool(set(problem.free) & set(RADII)))
     if sum(size) > 1:
