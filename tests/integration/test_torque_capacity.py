@@ -211,6 +211,20 @@ def test_an_input_torque_no_speed_ratio_carries_is_refused_and_coast_needs_overr
     solved = coast["pump_speed_rad_s"].notna().to_numpy()
     assert solved.sum() >= 5 and (coast["pump_speed_rad_s"][solved] > 0).all()
     np.testing.assert_allclose(coast["pump_torque_nm"][solved], -100.0, rtol=1e-9)
+    # a drive torque over overrun speed ratios only: the hint points the other way
+    r = cli(
+        "characterise",
+        "li-sunden-2016",
+        "-m",
+        model,
+        "--input-torque-nm",
+        "100",
+        "--speed-ratio",
+        "1.1:2:0.1",
+        "--out",
+        tmp_path / "p",
+    )
+    assert r.code == 2 and "(1.1 to 2); a positive (drive) torque needs speed ratios below 1" in r.stderr, r.stderr
     r = cli("characterise", "li-sunden-2016", "-m", model, "--input-torque-nm", "1e300", "--out", tmp_path / "h")
     assert r.code == 2 and "plausible" in r.stderr and "--allow-implausible" in r.stderr, r.stderr
     assert not (tmp_path / "n").exists() and not (tmp_path / "h").exists()

@@ -439,9 +439,13 @@ def characterise_at_input_torque(
     frame = _at_input_torque(conv, model, float(input_torque_nm), speed_ratio)
     if not np.isfinite(frame["pump_speed_rad_s"].to_numpy(dtype=float)).any():
         sr = frame["speed_ratio"].to_numpy(dtype=float)
-        expected = (
-            f"a torque the converter carries at some speed ratio of the sweep ({sr.min():g} to {sr.max():g}); "
+        need = (
             "a negative (coast) torque needs speed ratios above 1, e.g. --speed-ratio 1:2:0.01"
+            if input_torque_nm < 0
+            else "a positive (drive) torque needs speed ratios below 1, e.g. --speed-ratio 0:1:0.01"
+        )
+        expected = (
+            f"a torque the converter carries at some speed ratio of the sweep ({sr.min():g} to {sr.max():g}); {need}"
         )
         raise InputError("command line", "--input-torque-nm", input_torque_nm, expected)
     return frame
