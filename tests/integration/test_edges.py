@@ -309,3 +309,24 @@ def test_speed_ratio_sweep_grid():
     np.testing.assert_allclose(speed_ratio_sweep("0:1:0.01"), np.linspace(0.0, 1.0, 101), atol=1e-15)
     assert speed_ratio_sweep("0:1:0.3").tolist()[-1] == pytest.approx(0.9)
     assert len(speed_ratio_sweep(f"0:1:{1 / (MAX_SWEEP_POINTS - 1)!r}")) == MAX_SWEEP_POINTS
+
+
+@pytest.mark.parametrize("model", ["table", "quasi-dynamic"])
+def test_a_sweep_keeps_the_table_points_past_its_last_step(tmp_path, model):
+    """conventions.md: the table's speed ratios in [MIN, MAX] are added, also those past the grid's
+    last step (``0:1:0.7`` has the grid 0, 0.7; it dropped the table's 0.8–1)."""
+    df = characterised(tmp_path, model, "0:1:0.7")
+    table = tcsim.load_converter(CONVERTER).characteristic.speed_ratio
+    assert df["speed_ratio"].tolist() == np.union1d([0.0, 0.7], table[(table >= 0) & (table <= 1)]).tolist()
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_default_sweeps_hold_no_near_duplicates(model):
+    """The default sweep merges a grid point within 1e-9 of a step into the table point (or the
+    coupling point) it stands for: the table's sweep had 0.7 and 0.7000000000000001 as two rows."""
+    sr = tcsim.characterise(CONVERTER, model=model)["speed_ratio"].to_numpy()
+    step = (sr[-1] - sr[0]) / 100
+    assert np.diff(sr).min() > 1e-6 * step
+    table = tcsim.load_converter(CONVERTER).characteristic.speed_ratio
+    if model != "hrovat-tobler":
+        assert np.isin(table, sr).all()

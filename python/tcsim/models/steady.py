@@ -91,7 +91,26 @@ def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
     """A sweep over the table's own range that contains every table point."""
     assert conv.characteristic is not None  # the callers' conv.require checked it
     sr = np.concatenate([t.speed_ratio for t in conv.characteristic.tables()])
-    return np.unique(np.concatenate([np.linspace(sr.min(), sr.max(), n), sr]))
+    lo, hi = float(sr.min()), float(sr.max())
+    return with_points(np.linspace(lo, hi, n), sr, lo, hi)
+
+
+def ht_speed_ratios(conv: Converter) -> np.ndarray:
+    """The default Hrovat & Tobler sweep: SR 0–1 in steps of 0.01 with the coupling point."""
+    cp = coupling_point(conv)
+    return with_points(np.linspace(0.0, 1.0, 101), np.array([] if cp is None else [cp]), 0.0, 1.0)
+
+
+def with_points(grid: np.ndarray, points: np.ndarray, lo: float, hi: float) -> np.ndarray:
+    """The sorted ``grid`` (equal steps) with the ``points`` that lie in ``[lo, hi]`` added, a grid
+    point within 1e-9 of a step of one of them replaced by it (0.05·6 is the table's 0.3: one row,
+    not 0.3 and 0.30000000000000004)."""
+    step = float(grid[1] - grid[0]) if grid.size > 1 else 1.0
+    inside = np.unique(points[(points >= lo) & (points <= hi)])
+    near = np.zeros(grid.shape, dtype=bool)
+    for x in inside:
+        near |= np.abs(grid - x) <= 1e-9 * step
+    return np.unique(np.concatenate([grid[~near], inside]))
 
 
 def characterise_table(
@@ -190,13 +209,7 @@ def characterise_hrovat_tobler(
     error about ``--pump-speed-rpm``, never a ``no-flow`` point."""
     conv.require("hrovat-tobler")
     wp = _check_speed(pump_speed_rpm, allow_implausible)
-    if speed_ratio is None:
-        sr = np.linspace(0.0, 1.0, 101)
-        cp = coupling_point(conv)
-        if cp is not None:
-            sr = np.unique(np.append(sr, cp))
-    else:
-        sr = np.asarray(speed_ratio, dtype=float)
+    sr = ht_speed_ratios(conv) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
     pump = np.full(sr.shape, wp)
     try:
         df = _ht_frame(conv, pump, sr * wp, sr)
@@ -300,23 +313,18 @@ def speed_ratio_sweep(text: str) -> np.ndarray:
 
 def sweep_speed_ratios(conv: Converter, model: str, text: str) -> np.ndarray:
     """The speed ratios of ``characterise --speed-ratio text``: the grid of :func:`speed_ratio_sweep`
-    with, inside its range, the table's own speed ratios (table, quasi-dynamic) or the coupling
-    point (hrovat-tobler), as in the default sweeps; a grid point within 1e-9 of a step of one of
-    those is replaced by it."""
+    with the table's own speed ratios (table, quasi-dynamic) or the coupling point (hrovat-tobler)
+    that lie in [MIN, MAX], as in the default sweeps (:func:`with_points`)."""
     grid = speed_ratio_sweep(text)
+    lo, hi, _ = parse_speed_ratio_sweep(text)
     if model == "hrovat-tobler":
         cp = coupling_point(conv)
         extra = np.array([] if cp is None else [cp])
     else:
         assert conv.characteristic is not None  # the caller's conv.require checked it
-        extra = np.unique(np.concatenate([t.speed_ratio for t in conv.characteristic.tables()]))
-    inside = extra[(extra >= grid[0]) & (extra <= grid[-1])]
-    step = float(grid[1] - grid[0]) if grid.size > 1 else 1.0
-    # a grid point within round-off of an added one is that point (0.05·6 is the table's 0.3)
-    near = np.zeros(grid.shape, dtype=bool)
-    for x in inside:
-        near |= np.abs(grid - x) <= 1e-9 * step
-    return np.unique(np.concatenate([grid[~near], inside]))
+        extra = np.concatenate([t.speed_ratio for t in conv.characteristic.tables()])
+    # the points in [MIN, MAX], also past the grid's last step (0:1:0.7 keeps the table's 0.8–1)
+    return with_points(grid, extra, lo, hi)
 
 
 #: The models :func:`steady_state` and :func:`characterise` know.
@@ -454,10 +462,7 @@ def characterise_at_input_torque(
 def _at_input_torque(conv: Converter, model: str, t: float, speed_ratio: np.ndarray | None) -> pd.DataFrame:
     """The frame of :func:`characterise_at_input_torque` (rows of NaN where no pump speed carries t)."""
     if model == "hrovat-tobler":
-        sr = np.linspace(0.0, 1.0, 101) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
-        if speed_ratio is None and (cp := coupling_point(conv)) is not None:
-            sr = np.unique(np.append(sr, cp))
-        sr = np.ascontiguousarray(sr, dtype=float)
+        sr = np.ascontiguousarray(ht_speed_ratios(conv) if speed_ratio is None else speed_ratio, dtype=float)
         wp = _core.ht_pump_speeds_at_pump_torque(conv.core_geometry(), t, sr)
         with np.errstate(invalid="ignore"):
             return _order(_derived(_ht_frame(conv, wp, sr * wp, sr, strict=False)))
