@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import re
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, TypedDict
 
@@ -13,7 +13,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError, TcsimWarning, core_value, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
-from .plausibility import warn_implausible
+from .plausibility import RANGES, warn_implausible
 
 
 class CoreRules(TypedDict, total=False):
@@ -177,6 +177,7 @@ class Characteristic:
                 float(cap[i]),
                 f"a {convention} whose capacity factor is a finite positive number (it converts to {cf[i]:g} N·m·s²)",
             )
+        _check_torques_finite(cf, cap, lambda i: name(convention, i), source, convention)
         warn_implausible("torque_ratio", tr, source, lambda i: name("torque_ratio", i))
         try:
             _core.table_check(sr, tr, cf, overrun, interpolation)
@@ -205,7 +206,7 @@ class Characteristic:
         """Pump torque at SR = 0 (or the table's first SR ≥ 0) and the given pump speed."""
         i = int(np.searchsorted(self.speed_ratio, 0.0))
         i = min(i, len(self.speed_ratio) - 1)
-        return float(self.capacity_factor_nm_s2[i] * (pump_speed_rpm * RAD_S_PER_RPM) ** 2)
+        return float(self.capacity_factor_nm_s2[i]) * (pump_speed_rpm * RAD_S_PER_RPM) ** 2
 
     def warn_if_implausible(self) -> None:
         t = self.stall_torque_nm()
@@ -221,6 +222,24 @@ class Characteristic:
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self.speed_ratio, self.torque_ratio, self.capacity_factor_nm_s2
+
+
+def _check_torques_finite(
+    cf: np.ndarray, cap: np.ndarray, name: Callable[[int], str], source: str, convention: str
+) -> None:
+    """A capacity whose torque CF·ω² overflows at a plausible pump speed is an :class:`InputError`
+    naming its row as written (1e308 N·m·s² was run, and its overflow blamed on ``--pump-speed-rpm``)."""
+    w = RANGES["speed_rad_s"].high
+    with np.errstate(over="ignore"):
+        bad = np.flatnonzero(~np.isfinite(np.abs(cf) * (w * w)))
+    if bad.size:
+        i = int(bad[0])
+        raise InputError(
+            source,
+            name(i),
+            float(cap[i]),
+            f"a {convention} whose torques are finite at pump speeds up to {w:g} rad/s (CF·ω² overflows)",
+        )
 
 
 def extension_reached(table: dict[str, Any], pump_speed_rad_s, turbine_speed_rad_s) -> float | None:
