@@ -275,3 +275,19 @@ def test_a_radius_in_mm_blames_the_design_not_the_bundled_vehicle(tmp_path, cli)
     assert any(w.startswith("the derived [geometry].fluid_length_m = ") for w in warned), warned
     assert not any(w.startswith(("[inertia]", "[geometry]")) for w in warned), warned
     assert sorted(p.name for p in tmp_path.iterdir()) == ["mm.toml"]
+
+
+def test_a_shape_effect_beyond_the_mass_matrix_blames_the_design_file(tmp_path, cli):
+    """Fresh-eyes trial: a pump exit angle of 89.999° (warned of as implausible) derives a pump
+    shape effect no mass matrix allows; the take-off then failed with ``model:
+    geometry.pump_shape_effect_m2``, a source and a field the user never wrote. The derived
+    converter is checked as a run builds it, and the error is the design file's derived value."""
+    design = tmp_path / "steep.toml"
+    design.write_text(_edit(_bundled_text(), "pump_exit_angle_deg = -20.0", "pump_exit_angle_deg = 89.999"))
+    r = cli("design", design, "--out", tmp_path / "o")
+    assert r.code == 2, r.stderr
+    lines = r.stderr.strip().splitlines()
+    assert lines[-1].startswith(f"error: {design}: the derived [geometry].pump_shape_effect_m2 = "), r.stderr
+    assert "positive definite" in lines[-1] and lines[-1].endswith("check the [design] values")
+    assert all(line.startswith(f"warning: {design}: ") for line in lines[:-1]), r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["steep.toml"]

@@ -28,7 +28,8 @@ from typing import TYPE_CHECKING, Any, get_type_hints
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, create_model
 
-from ..errors import InputError, TcsimWarning, read_user_text
+from .. import _core
+from ..errors import InputError, TcsimWarning, from_core, read_user_text
 from .converter import Converter, GeometrySection, InertiaSection, load_converter, parse_converter
 from .design import DEFAULT_POINTS, DesignGeometry, TorusDesign, design_geometry, design_table, geometry_of_row
 
@@ -266,7 +267,28 @@ def _converter_of(file: DesignFile, g: DesignGeometry) -> DerivedConverter:
             warnings.warn(_as_design_field(file, str(w.message)), TcsimWarning, stacklevel=3)
         else:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    _check_dynamics(file, converter)
     return DerivedConverter(document, converter, g, defaults)
+
+
+def _check_dynamics(file: DesignFile, converter: Converter) -> None:
+    """The core's check of the derived converter's Hrovat & Tobler model (the mass matrix's bound on
+    the shape effects), its refusal named as the design file's derived value: a blade angle of
+    89.999° was blamed on ``model: geometry.pump_shape_effect_m2`` when the take-off ran."""
+    from .dynamic import dynamic_model  # noqa: PLC0415  (dynamic imports this module's neighbours)
+
+    try:
+        _core.check_model(dynamic_model(converter, "hrovat-tobler").spec)
+    except _core.CoreInputError as e:
+        err = from_core(e, file.path)
+        section, _, key = err.field.partition(".")
+        if key in file.losses:
+            field = f"[losses].{key}"
+        elif key in {f.name for f in fields(TorusDesign)}:
+            field = f"[design].{key}"
+        else:
+            field = f"the derived [{section}].{key}"
+        raise InputError(file.path, field, err.value, f"{err.expected}; check the [design] values") from None
 
 
 def _as_design_field(file: DesignFile, message: str) -> str:
