@@ -45,7 +45,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from .. import _core
 from ..errors import CoreText, InputError, TcsimWarning, from_core, read_user_text
 from .converter import MODELS, Converter, bundled_names, parse_converter
-from .vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, _load_named_converter, load_vehicle
+from .vehicle import DEFAULT_VEHICLE, SECTIONS, Vehicle, _load_named_converter, bundled_vehicle_names, load_vehicle
 
 #: The most cases of one study, and the most without ``--chunk-size`` (all rows in memory).
 MAX_RUNS = 10_000_000
@@ -425,6 +425,19 @@ def _converter(spec: str, path: Path) -> Converter:
         raise InputError(str(path), "converter", spec, expected) from None
 
 
+def _vehicle(spec: str, path: Path) -> Vehicle:
+    """The study file's ``vehicle``: a bundled name or a vehicle .toml relative to the study file."""
+    where = _relative(spec, path)
+    try:
+        return load_vehicle(where)
+    except InputError as e:
+        if not (e.source == where and e.field == "vehicle"):  # the vehicle file itself is bad
+            raise
+        names = ", ".join(bundled_vehicle_names())
+        expected = f"a bundled vehicle ({names}) or a vehicle .toml file relative to the study file"
+        raise InputError(str(path), "vehicle", spec, expected) from None
+
+
 def _parameter(key: str, dist: Any, path: str, converter: Converter, vehicle: Vehicle) -> Parameter:
     """The parameter a ``[distributions]`` key names, or :class:`InputError` naming it."""
     field = f'distributions."{key}"'
@@ -648,7 +661,7 @@ def load_study_file(path: str | Path) -> StudyFile:
     :class:`InputError` (one line naming the file and field) before anything runs."""
     doc = read_monte_carlo_file(path)
     p = Path(path)
-    vehicle = load_vehicle(_relative(doc.vehicle, p))
+    vehicle = _vehicle(doc.vehicle, p)
     converter = vehicle.converter if doc.converter is None else _converter(doc.converter, p)
     models = tuple(dict.fromkeys(doc.models)) if doc.models else converter.models
     for m in models:
