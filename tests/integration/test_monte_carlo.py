@@ -349,6 +349,26 @@ def test_a_study_file_changed_between_runs_is_refused(cli, tmp_path):
     assert snapshot(out) == before
 
 
+def test_a_plain_study_directory_is_named_as_such_when_refused(cli, tmp_path):
+    """A trial: a sharded study into a plain study's output said "2 files tcsim did not write as a
+    study", of files tcsim had written; the refusal names the command whose output it holds. Files
+    of no tcsim run are still named as such."""
+    path = write_study(tmp_path / "s.toml", runs=4)
+    out = tmp_path / "o"
+    assert cli("monte-carlo", path, "--out", out).code == 0
+    before = snapshot(out)
+    r = cli("monte-carlo", path, "--out", out, "--chunk-size", "2")
+    assert r.code == 2 and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert f"it holds the output of an unsharded 'tcsim monte-carlo' run: {len(before)} files, e.g. " in r.stderr, (
+        r.stderr
+    )
+    assert snapshot(out) == before
+    (tmp_path / "notes").mkdir()
+    (tmp_path / "notes" / "a.txt").write_text("x")
+    r = cli("monte-carlo", path, "--out", tmp_path / "notes", "--chunk-size", "2")
+    assert r.code == 2 and "it holds 1 file tcsim did not write as a sharded study, e.g. 'a.txt'" in r.stderr
+
+
 def test_a_study_whose_client_stops_resumes_without_recomputing(tmp_path, study, unchunked):
     out = tmp_path / "s"
     written: list[int] = []

@@ -50,6 +50,7 @@ import pyarrow.parquet as pq
 
 from ..analysis.chunked import ChunkedStudy, check_chunk_size, check_scheduler, chunk_count, iter_chunks
 from ..errors import InputError, raise_if_interrupted
+from .outputs import MANIFEST as OUTPUT_MANIFEST
 from .outputs import _blocked, _contained_inputs, _sha256, _umask
 from .tables import SPEED_UNITS, to_speed_unit
 
@@ -135,6 +136,21 @@ def _is_ours(name: str) -> bool:
     return folder == SHARDS and "/" not in base and (_SHARD.fullmatch(base) is not None or base.endswith(".partial"))
 
 
+def _foreign(out: Path, foreign: Sequence[str]) -> str:
+    """What the files ``foreign`` of ``out`` are: another tcsim command's output when its output
+    manifest (:data:`tcsim.io.outputs.MANIFEST`) says so (a plain, unsharded study's), else files
+    tcsim did not write."""
+    many = len(foreign) != 1
+    try:
+        command = [str(w) for w in json.loads((out / OUTPUT_MANIFEST).read_text(encoding="utf-8"))["command"]]
+    except (OSError, ValueError, TypeError, KeyError):
+        return f"{len(foreign)} file{'s' if many else ''} tcsim did not write as a sharded study, e.g. {foreign[0]!r}"
+    name = command[1] if len(command) > 1 else "tcsim"
+    return (
+        f"the output of an unsharded 'tcsim {name}' run: {len(foreign)} file{'s' if many else ''}, e.g. {foreign[0]!r}"
+    )
+
+
 def _check_dir(
     out: Path, record: dict[str, Any], chunk_size: int, inputs: Sequence[str | Path]
 ) -> dict[str, Any] | None:
@@ -153,8 +169,7 @@ def _check_dir(
     manifest, problem = _manifest_or_problem(out)
     foreign = sorted(n for n in names if not _is_ours(n))
     if foreign:
-        what = f"{len(foreign)} files tcsim did not write as a study, e.g. {foreign[0]!r}"
-        raise _refuse(out, f"{EXPECTED} (it holds {what}; choose another --out)")
+        raise _refuse(out, f"{EXPECTED} (it holds {_foreign(out, foreign)}; choose another --out)")
     if manifest is None:
         advice = "" if "repair" in problem or "cannot be read" in problem else "; choose another --out"
         raise _refuse(out, f"{EXPECTED} (it holds {problem}{advice})")
