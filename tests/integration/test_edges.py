@@ -222,6 +222,9 @@ def test_steady_state_broadcasts_any_sign_and_marks_points_without_a_steady_stat
         (100.0, [[0.0, 1.0], [np.inf, 2.0]], "turbine_speed_rad_s[1, 0]"),
         ([1.0, 2.0], [1.0, 2.0, 3.0], "turbine_speed_rad_s"),
         ("fast", 0.0, "pump_speed_rad_s"),
+        # scalars too (a scalar NaN gave a row of NaN: argwhere of a 0-d array finds nothing)
+        (np.nan, 100.0, "pump_speed_rad_s"),
+        (100.0, -np.inf, "turbine_speed_rad_s"),
     ],
 )
 def test_steady_state_input_errors_name_the_argument_and_index(wp, wt, field):

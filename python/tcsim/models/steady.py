@@ -340,6 +340,8 @@ def _finite_speeds(**speeds) -> tuple[np.ndarray, np.ndarray]:
             a = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
             raise InputError("steady_state", name, value, "numbers (rad/s)") from None
+        if a.ndim == 0 and not np.isfinite(a):  # argwhere of a 0-d array finds nothing: a scalar NaN passed
+            raise InputError("steady_state", name, float(a), "a finite speed in rad/s")
         bad = np.argwhere(~np.isfinite(a))
         if bad.size:
             index = tuple(int(i) for i in bad[0])
