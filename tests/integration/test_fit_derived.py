@@ -186,6 +186,35 @@ def test_fitted_model_without_coupling_point_or_flow_is_written_with_warnings(bu
     assert cli("characterise", out / "fitted.toml", "--model", "hrovat-tobler", "--out", tmp_path / "c").code == 0
 
 
+def test_a_table_that_never_couples_is_not_said_to_couple(tmp_path, cli):
+    """A trial: a table whose last point is SR 0.6 at TR 1.3 was said to "couple at SR 0.6" (the top
+    of the fitted range, not a coupling point) in the warning about the fitted model's."""
+    short = tmp_path / "short.csv"
+    short.write_text(
+        "speed_ratio,torque_ratio,capacity_factor_nm_s2\n0,2.14,0.003272\n0.3,1.7,0.003181\n0.6,1.3,0.002887\n"
+    )
+    r = cli("fit", "li-sunden-2016", "--target", short, "--out", tmp_path / "fit")
+    assert r.code == 0, r.stderr
+    coupling = [line for line in r.stderr.splitlines() if "no coupling point below SR 1" in line]
+    assert len(coupling) == 1 and "the table does not reach TR 1 below SR 1 either" in coupling[0], r.stderr
+    assert "couples at" not in r.stderr
+
+
+def test_a_fit_that_misses_the_table_is_warned_of(tmp_path, cli):
+    """A trial: a fit ending 100 % off the table's stall capacity (1e300, a capacity in no unit)
+    reported success with exit 0, its error only in the report. A miss beyond 20 % is warned of on
+    the terminal with the point; a good fit (Table C.1) has no such warning."""
+    rows = TABLE_C1.read_text(encoding="utf-8").replace("0.00,2.14,3.272e-3", "0.00,2.14,3.272e-1")
+    table = tmp_path / "off.csv"
+    table.write_text(rows, encoding="utf-8")
+    r = cli("fit", "li-sunden-2016", "--target", table, "--out", tmp_path / "off")
+    assert r.code == 0, r.stderr
+    missed = [line for line in r.stderr.splitlines() if "misses the table" in line]
+    assert len(missed) == 1 and "CF 99 % off at SR 0 (more than 20 %)" in missed[0], r.stderr
+    good = cli("fit", "li-sunden-2016", "--target", TABLE_C1, "--out", tmp_path / "good")
+    assert good.code == 0 and "misses the table" not in good.stderr, good.stderr
+
+
 def test_fitted_converter_a_command_would_refuse_is_not_written(bundled, tmp_path, cli, monkeypatch):
     # no fit the core solves leaves SR 0–1 without a steady state today (a random search of 10⁴
     # geometries found none), so the refusal is exercised with characterise refusing as it would

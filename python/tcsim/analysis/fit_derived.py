@@ -134,7 +134,8 @@ def check_usable(conv: Converter, label: str, table_coupling_sr: float | None) -
     Refused: no steady state of the Hrovat & Tobler model at some SR of 0–1 (``characterise``); a
     transient model that does not build (``replay``, ``launch``, ``export-fmu``); a mass matrix of
     eqs 2.12–2.15 that is not positive definite. Warned (one line each): no coupling point below
-    SR 1 (``table_coupling_sr``, the table's, for the message), no through-flow at some SR below 1.
+    SR 1 (``table_coupling_sr``, the table's coupling point or None, for the message), no
+    through-flow at some SR below 1.
     """
     try:
         curve = characterise_hrovat_tobler(conv)
@@ -164,7 +165,11 @@ def _curve_warnings(curve, cp: float | None, label: str, table_coupling_sr: floa
     sr, mode = curve["speed_ratio"].to_numpy(), curve["stator_mode"].to_numpy()
     lines = []
     if cp is None:
-        table = f"; the table couples at SR {table_coupling_sr:g}" if table_coupling_sr is not None else ""
+        table = (
+            f"; the table couples at SR {table_coupling_sr:g}"
+            if table_coupling_sr is not None
+            else "; the table does not reach TR 1 below SR 1 either"
+        )
         free = sr[mode == "free-wheeling"]
         if free.size:
             why = f"its stator free-wheels from SR {free[0]:g}, but it has no locked-stator steady state at SR 1"

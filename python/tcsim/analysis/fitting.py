@@ -182,17 +182,25 @@ def resolve_bounds(
 # the fitted range of the table
 
 
+def table_coupling_point(table: Characteristic) -> float | None:
+    """The table's coupling point: its first point with 0 ≤ SR < 1 and TR ≤ 1 (+1e-9); None when
+    no point below SR 1 has reached TR = 1."""
+    sr, tr, _ = table.arrays()
+    coupled = np.flatnonzero((sr >= 0) & (sr < 1) & (tr <= COUPLING_TR))
+    return float(sr[coupled[0]]) if coupled.size else None
+
+
 def default_speed_ratio_max(table: Characteristic) -> float:
-    """The table's coupling point: the first SR ≥ 0 with TR ≤ 1 (+1e-9), kept below SR = 1.
+    """The table's coupling point (:func:`table_coupling_point`), else its last point below SR 1.
 
     At SR = 1 the model's steady state has no flow and no torque, so a table point there cannot
     be matched; a table that reaches TR = 1 only at SR = 1 is fitted up to its last point below.
     """
-    sr, tr, _ = table.arrays()
+    coupling = table_coupling_point(table)
+    if coupling is not None:
+        return coupling
+    sr, _, _ = table.arrays()
     drive = (sr >= 0) & (sr < 1)
-    coupled = np.flatnonzero(drive & (tr <= COUPLING_TR))
-    if coupled.size:
-        return float(sr[coupled[0]])
     if not drive.any():
         raise InputError(
             table.source, "speed_ratio", f"{sr[0]:g} to {sr[-1]:g}", "table points with SR from 0 to below 1"
@@ -559,6 +567,29 @@ def _active(problem: _Problem, u: np.ndarray, mask: np.ndarray) -> dict[str, str
     return out
 
 
+#: A fitted model whose TR or CF misses a table point by more than this (relative) is warned of.
+MISSED_RELATIVE_ERROR = 0.2
+
+
+def warn_if_missed(source: str, sr, tr_table, cf_table, tr_model, cf_model) -> None:
+    """Warn on the terminal when the fitted model misses a table point by more than
+    :data:`MISSED_RELATIVE_ERROR` in TR or CF: a fit that ends 100 % off a table (a capacity in the
+    wrong unit) reported success with exit 0, its error only in the report."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        errors = {"TR": np.abs(tr_model / tr_table - 1), "CF": np.abs(cf_model / cf_table - 1)}
+    name, e = max(errors.items(), key=lambda kv: float(np.nanmax(kv[1], initial=0.0)))
+    if not np.nanmax(e, initial=0.0) > MISSED_RELATIVE_ERROR and np.isfinite(e).all():
+        return
+    i = int(np.nanargmax(np.where(np.isfinite(e), e, np.inf)))
+    warnings.warn(
+        f"{source}: the fitted model misses the table: {name} {100 * e[i]:.3g} % off at SR {sr[i]:g} "
+        f"(more than {100 * MISSED_RELATIVE_ERROR:g} %); the model cannot follow this table with the free "
+        "parameters in their bounds: check the table's capacity convention and units, or free more (--free, --bound)",
+        TcsimWarning,
+        stacklevel=3,
+    )
+
+
 def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elapsed) -> FitResult:
     x = problem.to_x(res.x)
     values = geometry.model_dump()
@@ -585,6 +616,7 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
             TcsimWarning,
             stacklevel=2,
         )
+    warn_if_missed(table.source, problem.sr, problem.tr, problem.cf, np.asarray(tr), np.asarray(cf))
     size = ("fluid_density_kg_m3" in problem.free, "flow_area_m2" in problem.free, bool(set(problem.free) & set(RADII)))
     if sum(size) > 1:
         notes.append(
@@ -704,7 +736,7 @@ def fit_outcome(start: Converter, result: FitResult, table: Characteristic, labe
     """The fitted converter of ``result``, checked by :func:`.fit_derived.check_usable` (an
     :class:`InputError` on the target table if a command would refuse it), with its provenance."""
     conv = fitted_converter(start, result, table, label)
-    checks = check_usable(conv, table.source, result.speed_ratio_max)
+    checks = check_usable(conv, table.source, table_coupling_point(table))
     derived = start.inertia is not None and conv.inertia != start.inertia
     lines = provenance(start, result.free, derived, label, start.quasi_dynamic is not None)
     return FitOutcome(conv, tuple(lines), (*result.warnings, *checks))
