@@ -442,6 +442,11 @@ def test_the_summary_counts_finished_runs_without_a_value():
     ]
     df["time_0_100_km_h_s"] = [9.0, 11.0, 10.0, np.nan, 8.0, 8.0]
     assert summary_lines(df, study) == ["  time_0_100_km_h_s: table 10 ± 1 (n = 3), hrovat-tobler 8 ± 0 (n = 2)"]
+    # one value has no sample spread: no "± nan" (a trial's runs = 1)
+    df["time_0_100_km_h_s"] = [9.0, np.nan, np.nan, np.nan, 8.0, 8.0]
+    assert summary_lines(df, study) == [
+        "  time_0_100_km_h_s: table 9 (n = 1; 2 finished without a value), hrovat-tobler 8 ± 0 (n = 2)"
+    ]
 
 
 def test_models_far_apart_each_get_bins_of_their_own():

@@ -50,7 +50,8 @@ def summary_lines(df: pd.DataFrame, study: MonteCarloStudy) -> list[str]:
         for model in study.models:
             finished = df.loc[(df["model"] == model) & (df["error"] == ""), output].astype(float)
             v = finished[finished.notna()]
-            part = f"{model} {v.mean():.4g} ± {v.std(ddof=1):.3g} (n = {len(v)}" if len(v) else f"{model} - (n = 0"
+            spread = f" ± {v.std(ddof=1):.3g}" if len(v) > 1 else ""  # one run has no sample spread (it was ± nan)
+            part = f"{model} {v.mean():.4g}{spread} (n = {len(v)}" if len(v) else f"{model} - (n = 0"
             missing = len(finished) - len(v)
             parts.append(part + (f"; {missing} finished without a value)" if missing else ")"))
         lines.append(f"  {output}: " + ", ".join(parts))
