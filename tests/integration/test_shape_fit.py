@@ -17,6 +17,7 @@ from tcsim.analysis.effective import measured_effective_torques, smoothed_rate
 from tcsim.analysis.shape_fit import ShapeFitResult, fit_shape_effects, shape_effect_sweep, sweep_minima
 from tcsim.cli.fit_shapes import shape_fit_command
 from tcsim.errors import InputError
+from tcsim.models.dynamic import NearCouplingWarning
 from tcsim.models.shape_effects import THESIS_PAIR_M2, THESIS_VALUES_M2, mass_matrix_bound
 from tcsim.transient import PumpTorqueTurbineSpeed, dynamic_model, isolated_takeoff, simulate
 
@@ -291,3 +292,21 @@ def test_a_shape_effect_at_a_bound_is_warned_of_like_a_fit_parameter():
         )
         == []
     )
+
+
+def test_the_near_coupling_warning_is_the_fitted_models_alone(tmp_path, drive_a, cli):
+    """A trial: ``fit-shapes --model quasi-dynamic`` printed the near-coupling warning 23 times, once
+    per trial shape effect of the fit. The fit warns once, for the fitted values; the command line
+    prints no line twice."""
+    truth = (0.015, 0.2)
+    measured = simulate(dynamic_model(CONVERTER, "quasi-dynamic").with_shape_effects(*truth), drive_a)
+    with pytest.warns(NearCouplingWarning) as caught:
+        r = fit_shape_effects(CONVERTER, "quasi-dynamic", drive_a, measured["time_s"], measured["turbine_torque_nm"])
+    near = [str(w.message) for w in caught if issubclass(w.category, NearCouplingWarning)]
+    assert r.evaluations > 5 and len(near) == 1, near
+    assert f"for shape effects {r.pump_shape_effect_m2:g}, {r.turbine_shape_effect_m2:g} m²" in near[0]
+    csv = _measurement_csv(tmp_path / "takeoff.csv", drive_a, truth=truth)
+    run = cli("fit-shapes", CONVERTER, csv, "--model", "quasi-dynamic", "--out", tmp_path / "fit")
+    lines = run.stderr.strip().splitlines()
+    assert run.code == 0 and lines and len(lines) == len(set(lines)), run.stderr
+    assert sum("may ring or oscillate" in line for line in lines) <= 1 + len(THESIS_VALUES_M2), run.stderr

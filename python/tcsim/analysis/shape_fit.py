@@ -21,9 +21,11 @@ The Hrovat & Tobler model accepts only shape effects that keep its mass matrix p
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
-from collections.abc import Mapping, Sequence
+import warnings
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -35,7 +37,7 @@ from scipy.optimize import least_squares
 from ..errors import InputError
 from ..models.converter import Converter
 from ..models.drives import PumpTorqueTurbineSpeed, Speeds
-from ..models.dynamic import DynamicModel, dynamic_model, resolve_model
+from ..models.dynamic import DynamicModel, NearCouplingWarning, dynamic_model, resolve_model
 from ..models.measurement import Measurement
 from ..models.shape_effects import THESIS_VALUES_M2, MassMatrixBound, inadmissible_note, mass_matrix_bound
 from ..simulation.transient import SolverError, TransientResult, simulate_batch
@@ -315,6 +317,52 @@ def fit_shape_effects(
     times, measured = _fit_points(measured_time_s, measured_target, time_window)
     lo, hi = (np.array([bp[0]]), np.array([bp[1]])) if equal else (np.array([bp[0], bt[0]]), np.array([bp[1], bt[1]]))
     problem = _Problem(base, drive, times, measured, target, equal, bound, lo, hi, rtol)
+    with _fitted_model_warnings_only() as fitted:
+        res, zero = _solve(problem, lo, hi)
+        sp, st = problem.shapes(res.x)
+        fitted.append(base.with_shape_effects(sp, st))
+    names = ("shape_effect_m2",) if equal else ("pump_shape_effect_m2", "turbine_shape_effect_m2")
+    return ShapeFitResult(
+        model=base.name,
+        target=target,
+        pump_shape_effect_m2=sp,
+        turbine_shape_effect_m2=st,
+        rmse=_rmse(problem.evaluate([res.x])[0]),
+        rmse_at_zero=_rmse(zero),
+        evaluations=problem.runs,
+        bound_m2=single,
+        pump_bounds_m2=bp,
+        turbine_bounds_m2=bp if equal else bt,
+        equal=equal,
+        points=len(times),
+        time_window_s=(float(times[0]), float(times[-1])),
+        active=_active(res.x, lo, hi, names),
+        message=str(res.message),
+        elapsed_s=time.perf_counter() - t0,
+    )
+
+
+@contextlib.contextmanager
+def _fitted_model_warnings_only() -> Iterator[list[DynamicModel]]:
+    """Warnings of the runs inside, each message once, with the near-coupling warning of the model
+    the caller appends (the fitted one) instead of one per trial point (``fit-shapes --model
+    quasi-dynamic`` printed it 23 times, for 23 trial shape effects)."""
+    fitted: list[DynamicModel] = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        yield fitted
+    seen: set[str] = set()
+    for w in caught:
+        if not issubclass(w.category, NearCouplingWarning) and str(w.message) not in seen:
+            seen.add(str(w.message))
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    for model in fitted:
+        model.warn_if_fragile_near_coupling()
+
+
+def _solve(problem: _Problem, lo: np.ndarray, hi: np.ndarray):
+    """The least-squares fit of ``problem`` from S = 0 (clipped into the bounds), and the residuals
+    at S = 0."""
     x0 = np.clip(np.zeros(len(lo)), lo, hi)
     r0 = problem.evaluate([x0])[0]
     if r0 is None or not np.isfinite(r0).all():
@@ -337,27 +385,7 @@ def fit_shape_effects(
         gtol=1e-12,
         max_nfev=60 * (len(x0) + 1),
     )
-    sp, st = problem.shapes(res.x)
-    zero = problem.evaluate([np.zeros(len(lo))])[0]
-    names = ("shape_effect_m2",) if equal else ("pump_shape_effect_m2", "turbine_shape_effect_m2")
-    return ShapeFitResult(
-        model=base.name,
-        target=target,
-        pump_shape_effect_m2=sp,
-        turbine_shape_effect_m2=st,
-        rmse=_rmse(problem.evaluate([res.x])[0]),
-        rmse_at_zero=_rmse(zero),
-        evaluations=problem.runs,
-        bound_m2=single,
-        pump_bounds_m2=bp,
-        turbine_bounds_m2=bp if equal else bt,
-        equal=equal,
-        points=len(times),
-        time_window_s=(float(times[0]), float(times[-1])),
-        active=_active(res.x, lo, hi, names),
-        message=str(res.message),
-        elapsed_s=time.perf_counter() - t0,
-    )
+    return res, problem.evaluate([np.zeros(len(lo))])[0]
 
 
 # ---------------------------------------------------------------------------------------------

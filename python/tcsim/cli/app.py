@@ -108,7 +108,16 @@ def say(line: str) -> None:
     stdout.print(rich_text(line))
 
 
+#: The warning lines this command has printed: a line is printed once (a fit's model and the run of
+#: the fitted model gave the same line twice, from two places in the code).
+_shown: set[str] = set()
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None):
+    text = f"{category.__name__}: {message}"
+    if text in _shown:
+        return
+    _shown.add(text)
     if issubclass(category, TcsimWarning):
         console.print(f"[yellow]warning:[/yellow] {rich_text(message)}", highlight=False, soft_wrap=True)
     else:
@@ -261,6 +270,7 @@ def _main(argv: list[str] | None) -> int:
     from ..io import outputs
 
     warnings.showwarning = _show_warning
+    _shown.clear()
     outputs.command_line = ["tcsim", *(sys.argv[1:] if argv is None else argv)]
     outputs.committed.clear()
     if (shards := sys.modules.get("tcsim.io.shards")) is not None:

@@ -30,6 +30,11 @@ COUPLING_MARGIN = 5.0
 # Models
 
 
+class NearCouplingWarning(TcsimWarning):
+    """:meth:`DynamicModel.warn_if_fragile_near_coupling`'s warning: a fit that runs the model at many
+    trial shape effects (``fit-shapes``) keeps it for the fitted values alone."""
+
+
 @dataclass(frozen=True)
 class DynamicModel:
     """A converter model ready for the transient engine.
@@ -62,7 +67,7 @@ class DynamicModel:
                 f"turbine's stability bound ({bound:.3g} s) for shape effects {self.shape_effect_m2[0]:g}, "
                 f"{self.shape_effect_m2[1]:g} m²: the quasi-dynamic model may ring or oscillate near coupling "
                 "(docs/models.md)",
-                TcsimWarning,
+                NearCouplingWarning,
                 stacklevel=3,
             )
 
