@@ -332,3 +332,11 @@ def test_a_fit_whose_flow_cannot_start_is_not_reported_as_a_good_fit(tmp_path, c
     assert run.code == 0, run.stderr
     assert_the_report_is_the_written_converters(out)
     assert json.loads((out / "fit_report.json").read_text())["errors"]["rms_torque_ratio"] < 0.01
+
+
+@pytest.mark.parametrize("n_starts", [0, -1, 1.5, True])
+def test_a_start_count_below_one_or_not_an_integer_is_refused(bundled, n_starts):
+    """``n_starts=0`` ran one start without a word (``max(1, n_starts)``)."""
+    with pytest.raises(InputError) as e:
+        fit_hrovat_tobler(bundled.geometry, bundled.characteristic, n_starts=n_starts)
+    assert e.value.field == "n_starts" and e.value.source == "fit_hrovat_tobler"

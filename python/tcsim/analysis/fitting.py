@@ -531,6 +531,8 @@ def fit_hrovat_tobler(
     it are run and the best kept. Raises :class:`InputError` for bad names, bounds or ranges.
     """
     t0 = time.perf_counter()
+    if isinstance(n_starts, bool) or not isinstance(n_starts, int | np.integer) or n_starts < 1:
+        raise InputError("fit_hrovat_tobler", "n_starts", n_starts, "an integer of at least 1 (the start itself)")
     free = check_free(free)
     radii = [getattr(geometry, n) for n in RADII]
     if not radii_ordered(*radii):
@@ -553,7 +555,7 @@ def fit_hrovat_tobler(
             f"no steady state at SR {bad[0]:g}",
             "a start point with a steady state at every fitted speed ratio",
         )
-    best, n_run = _best_fit(problem, u0, max(1, n_starts))
+    best, n_run = _best_fit(problem, u0, int(n_starts))
     return _result(problem, best, geometry, resolved, srmax, table, n_run, time.perf_counter() - t0)
 
 
