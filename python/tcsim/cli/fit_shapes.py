@@ -85,8 +85,8 @@ def shape_fit_command(
     base = dynamic_model(conv, model)
     inertia = base.spec["inertia_kg_m2"]
     effective = measured_effective_torques(meas, inertia[1], inertia[0])
-    drv = sf.drive_of(meas, drive)
-    result = sf.fit_shape_effects(conv, base, drv, meas.time_s, effective[target], target, equal=equal)
+    drv, y = sf.drive_of(meas, drive), effective[target]
+    result = sf.fit_shape_effects(conv, base, drv, meas.time_s, y, target, equal=equal, rates="filtered")
     for line in result.bound_warnings(meas.source):
         warnings.warn(line, TcsimWarning, stacklevel=1)
     fitted = (result.pump_shape_effect_m2, result.turbine_shape_effect_m2)
