@@ -282,31 +282,31 @@ def _check_dynamics(file: DesignFile, converter: Converter) -> None:
     except _core.CoreInputError as e:
         err = from_core(e, file.path)
         section, _, key = err.field.partition(".")
-        if key in file.losses:
-            field = f"[losses].{key}"
-        elif key in {f.name for f in fields(TorusDesign)}:
-            field = f"[design].{key}"
-        else:
-            field = f"the derived [{section}].{key}"
+        field = _design_field(file, f"[{section}]", key)
         raise InputError(file.path, field, err.value, f"{err.expected}; check the [design] values") from None
 
 
+def _design_field(file: DesignFile, section: str, key: str) -> str:
+    """The derived converter's ``section.key`` (``[geometry]``, ``[inertia]``) as the design file
+    names it: where the file holds the value (``[design].pump_exit_radius_m``,
+    ``[losses].friction_loss``), else said to be derived (``the derived [inertia].pump_kg_m2``)."""
+    if section == "[geometry]" and key in file.losses:
+        return f"[losses].{key}"
+    if section == "[geometry]" and key in {f.name for f in fields(TorusDesign)}:
+        return f"[design].{key}"
+    return f"the derived {section}.{key}"
+
+
 def _as_design_field(file: DesignFile, message: str) -> str:
-    """A plausibility warning of the derived converter as the design file's: a value the file holds
-    named where it holds it (``[design].pump_exit_radius_m``, ``[losses].friction_loss``), a derived
-    one said to be derived (a trial's warnings named ``[inertia].pump_kg_m2`` in a design file that
-    has no such section)."""
+    """A plausibility warning of the derived converter as the design file's (:func:`_design_field`:
+    a trial's warnings named ``[inertia].pump_kg_m2`` in a design file that has no such section)."""
     head = f"{file.path}: "
     rest = message.removeprefix(head)
     field, sep, tail = rest.partition(" = ")
     section, _, key = field.partition(".")
     if not (sep and message.startswith(head) and section.startswith("[")):
         return message
-    if section == "[geometry]" and key in file.losses:
-        return f"{head}[losses].{key} = {tail}"
-    if section == "[geometry]" and key in {f.name for f in fields(TorusDesign)}:
-        return f"{head}[design].{key} = {tail}"
-    return f"{head}the derived {field} = {tail}"
+    return f"{head}{_design_field(file, section, key)} = {tail}"
 
 
 __all__ = [

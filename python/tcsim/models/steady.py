@@ -87,18 +87,26 @@ def _speed_error(e: Exception, pump_speed_rpm: float, converter_file: str, field
     return from_core(e, converter_file, field_prefix)
 
 
+def _own_points(conv: Converter, model: str) -> np.ndarray:
+    """The speed ratios every sweep of ``model`` holds: the table's own (table, quasi-dynamic) or
+    the coupling point (hrovat-tobler; none without one)."""
+    if model == "hrovat-tobler":
+        cp = coupling_point(conv)
+        return np.array([] if cp is None else [cp])
+    assert conv.characteristic is not None  # the callers' conv.require checked it
+    return np.concatenate([t.speed_ratio for t in conv.characteristic.tables()])
+
+
 def table_speed_ratios(conv: Converter, n: int = 101) -> np.ndarray:
     """A sweep over the table's own range that contains every table point."""
-    assert conv.characteristic is not None  # the callers' conv.require checked it
-    sr = np.concatenate([t.speed_ratio for t in conv.characteristic.tables()])
+    sr = _own_points(conv, "table")
     lo, hi = float(sr.min()), float(sr.max())
     return with_points(np.linspace(lo, hi, n), sr, lo, hi)
 
 
 def ht_speed_ratios(conv: Converter) -> np.ndarray:
     """The default Hrovat & Tobler sweep: SR 0–1 in steps of 0.01 with the coupling point."""
-    cp = coupling_point(conv)
-    return with_points(np.linspace(0.0, 1.0, 101), np.array([] if cp is None else [cp]), 0.0, 1.0)
+    return with_points(np.linspace(0.0, 1.0, 101), _own_points(conv, "hrovat-tobler"), 0.0, 1.0)
 
 
 def with_points(grid: np.ndarray, points: np.ndarray, lo: float, hi: float) -> np.ndarray:
@@ -315,16 +323,9 @@ def sweep_speed_ratios(conv: Converter, model: str, text: str) -> np.ndarray:
     """The speed ratios of ``characterise --speed-ratio text``: the grid of :func:`speed_ratio_sweep`
     with the table's own speed ratios (table, quasi-dynamic) or the coupling point (hrovat-tobler)
     that lie in [MIN, MAX], as in the default sweeps (:func:`with_points`)."""
-    grid = speed_ratio_sweep(text)
     lo, hi, _ = parse_speed_ratio_sweep(text)
-    if model == "hrovat-tobler":
-        cp = coupling_point(conv)
-        extra = np.array([] if cp is None else [cp])
-    else:
-        assert conv.characteristic is not None  # the caller's conv.require checked it
-        extra = np.concatenate([t.speed_ratio for t in conv.characteristic.tables()])
     # the points in [MIN, MAX], also past the grid's last step (0:1:0.7 keeps the table's 0.8–1)
-    return with_points(grid, extra, lo, hi)
+    return with_points(speed_ratio_sweep(text), _own_points(conv, model), lo, hi)
 
 
 #: The models :func:`steady_state` and :func:`characterise` know.
