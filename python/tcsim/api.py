@@ -17,12 +17,16 @@ def characterise(
     pump_speed_rpm: float = DEFAULT_PUMP_SPEED_RPM,
     speed_ratio=None,
     input_torque_nm: float | None = None,
+    allow_implausible: bool = False,
 ):
     """Steady-state characteristic of a converter (bundled name, path or :class:`Converter`) at a fixed
     pump speed, or with ``input_torque_nm`` (N·m) at a fixed pump torque, the pump speed solved
-    (docs/torque_capacity.md)."""
+    (docs/torque_capacity.md). A speed or torque outside its plausible range is an
+    :class:`~tcsim.InputError` unless ``allow_implausible``, which warns instead."""
     conv = converter if isinstance(converter, Converter) else load_converter(converter)
-    return _steady.characterise(conv, model, pump_speed_rpm, speed_ratio, input_torque_nm=input_torque_nm)
+    return _steady.characterise(
+        conv, model, pump_speed_rpm, speed_ratio, allow_implausible=allow_implausible, input_torque_nm=input_torque_nm
+    )
 
 
 def steady_state(converter, model: str, pump_speed_rad_s, turbine_speed_rad_s):

@@ -14,21 +14,85 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+#: The ``source`` of an error about an argument of a function call (its ``field`` is the parameter's
+#: name, ``pump_speed_rpm``); the command line shows it as the option of that name
+#: (:meth:`InputError.on_command_line`).
+ARGUMENT = "argument"
+
+#: The keyword argument that runs an implausible input anyway (the command line's ``--allow-implausible``).
+ALLOW_IMPLAUSIBLE = "allow_implausible"
+
+#: Parameters whose command-line option is not the name with dashes.
+_OPTION_OF = {"out_path": "--out", "bounds": "--bound"}
+
+
+def option_name(parameter: str) -> str:
+    """The command-line option of the function parameter ``parameter`` (``pump_speed_rpm`` →
+    ``--pump-speed-rpm``; the options take the parameters' names, ``out_path`` is ``--out``, ``bounds`` ``--bound``)."""
+    return _OPTION_OF.get(parameter, "--" + parameter.replace("_", "-"))
+
+
+_ARGUMENT_AT_START = re.compile(rf"^{ARGUMENT}: ([a-z_][a-z0-9_]*)")
+
+
+def on_command_line(message: str) -> str:
+    """A warning's ``message`` as the command line words it: one that starts with an argument
+    (``argument: pump_speed_rpm = …``) names the option instead (``command line: --pump-speed-rpm``)."""
+    return _ARGUMENT_AT_START.sub(lambda m: f"command line: {option_name(m.group(1))}", message, count=1)
+
 
 class InputError(Exception):
-    """Bad user input: a file, a field in it, the offending value and what was expected."""
+    """Bad user input: a file, a field in it, the offending value and what was expected.
 
-    def __init__(self, source: str, field: str, value: Any, expected: str, core_source: str | None = None):
+    ``override`` names the keyword argument that runs the input anyway (:data:`ALLOW_IMPLAUSIBLE`),
+    said after ``expected``.
+    """
+
+    def __init__(
+        self,
+        source: str,
+        field: str,
+        value: Any,
+        expected: str,
+        core_source: str | None = None,
+        override: str | None = None,
+    ):
         self.source = str(source)
         self.field = field
         self.value = value
         self.expected = expected
         #: The input the core blamed (``tcsim._core.input_sources()``), as data, when the core found it.
         self.core_source = core_source
+        self.override = override
         super().__init__(str(self))
 
+    @classmethod
+    def argument(cls, parameter: str, value: Any, expected: str, **kwargs: Any) -> InputError:
+        """An error about the argument ``parameter`` of a function call (source :data:`ARGUMENT`)."""
+        return cls(ARGUMENT, parameter, value, expected, **kwargs)
+
+    def replace(self, **changes: Any) -> InputError:
+        """A copy with ``changes`` to its fields (``source``, ``field``, ``value``, ``expected``,
+        ``core_source``, ``override``); the others, the override included, are kept."""
+        fields = {k: getattr(self, k) for k in ("source", "field", "value", "expected", "core_source", "override")}
+        return InputError(**(fields | changes))
+
     def __str__(self) -> str:
-        return escape_controls(f"{self.source}: {self.field} = {_show(self.value)}: expected {self.expected}")
+        expected = self.expected if self.override is None else f"{self.expected}; {self.override}=True runs it anyway"
+        return escape_controls(f"{self.source}: {self.field} = {_show(self.value)}: expected {expected}")
+
+    def on_command_line(self) -> InputError:
+        """This error as the command line words it: an argument is the option of its name
+        (:func:`option_name`), the override is its option (``--allow-implausible``)."""
+        if self.source != ARGUMENT and self.override is None:
+            return self
+        source, field = (self.source, self.field)
+        if self.source == ARGUMENT:
+            source, field = "command line", option_name(self.field)
+        expected = self.expected
+        if self.override is not None:
+            expected = f"{expected}; {option_name(self.override)} runs it anyway"
+        return InputError(source, field, self.value, expected, self.core_source)
 
 
 class Interrupted(KeyboardInterrupt):

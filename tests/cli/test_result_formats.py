@@ -16,7 +16,7 @@ import scipy.io
 
 from interrupts import interrupt
 from tcsim import transient
-from tcsim.errors import TcsimWarning
+from tcsim.errors import InputError, TcsimWarning
 from tcsim.io import tables
 from tcsim.io.measurement import read_measurement
 from tcsim.io.results import write_frames
@@ -261,8 +261,10 @@ def test_a_bad_option_value_is_refused_before_anything_runs(cli, tmp_path, comma
 def test_table_format_refuses_what_the_options_refuse():
     assert TableFormat().file_name("summary.csv") == "summary.csv"
     assert TableFormat("mat", "rpm").file_name("hrovat-tobler.csv") == "hrovat-tobler.mat"
-    with pytest.raises(Exception, match="--format"):
+    with pytest.raises(InputError, match="^argument: format = 'MAT'"):
         TableFormat("MAT")
+    with pytest.raises(InputError, match="^argument: speed_unit = 'deg/s'"):
+        TableFormat("csv", "deg/s")
 
 
 # ---------------------------------------------------------------------------------------------

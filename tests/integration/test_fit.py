@@ -239,10 +239,10 @@ def test_start_without_geometry_is_an_input_error(bundled, tmp_path):
 def test_api_raises_input_errors(bundled):
     with pytest.raises(InputError) as e:
         fit_hrovat_tobler(bundled.geometry, bundled.characteristic, ["pump_shock_loss", "bogus"])
-    assert e.value.field == "--free"
+    assert e.value.field == "free"
     with pytest.raises(InputError) as e:
         fit_hrovat_tobler(bundled.geometry, bundled.characteristic, LOSSES, bounds={"friction_loss": (0.5, 0.4)})
-    assert e.value.field == "--bound"
+    assert e.value.field == "bounds"
 
 
 # --------------------------------------------------------------------------------------------
@@ -339,4 +339,27 @@ def test_a_start_count_below_one_or_not_an_integer_is_refused(bundled, n_starts)
     """``n_starts=0`` ran one start without a word (``max(1, n_starts)``)."""
     with pytest.raises(InputError) as e:
         fit_hrovat_tobler(bundled.geometry, bundled.characteristic, n_starts=n_starts)
-    assert e.value.field == "n_starts" and e.value.source == "fit_hrovat_tobler"
+    assert e.value.field == "n_starts" and e.value.source == "argument"
+
+
+def test_the_api_names_its_own_arguments_and_refuses_wrong_types(bundled):
+    """A trial: the function's errors named the command line's options (``--free``, ``--bound``,
+    ``--speed-ratio-max``); ``free="friction_loss"`` was read as its letters (``--free = 'f'``); a
+    Converter as the geometry or a name as the table was an AttributeError."""
+    g, table = bundled.geometry, bundled.characteristic
+    cases = [
+        (dict(free="friction_loss"), "free", "friction_loss"),
+        (dict(free=["nope"]), "free", "nope"),
+        (dict(bounds={"friction_loss": (1.0, 0.1)}), "bounds", "friction_loss=1:0.1"),
+        (dict(speed_ratio_max=1.5), "speed_ratio_max", 1.5),
+    ]
+    for kwargs, field, value in cases:
+        with pytest.raises(InputError) as e:
+            fit_hrovat_tobler(g, table, **kwargs)
+        assert (e.value.source, e.value.field, e.value.value) == ("argument", field, value)
+        option = "--bound" if field == "bounds" else "--" + field.replace("_", "-")
+        assert str(e.value.on_command_line()).startswith(f"command line: {option} = ")
+    with pytest.raises(InputError, match="^argument: geometry = 'Converter'"):
+        fit_hrovat_tobler(bundled, table)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="^argument: table = 'str'"):
+        fit_hrovat_tobler(g, "li-sunden-2016")  # type: ignore[arg-type]

@@ -205,7 +205,7 @@ def test_an_input_torque_no_speed_ratio_carries_is_refused_and_coast_needs_overr
     r = cli("characterise", "li-sunden-2016", "-m", model, "--input-torque-nm", "-100", "--out", tmp_path / "n")
     assert r.code == 2 and r.stderr.count("\n") == 1, r.stderr
     assert "--input-torque-nm = -100: expected a torque the converter carries" in r.stderr
-    assert "speed ratio of the sweep (0 to 1)" in r.stderr and "--speed-ratio 1:2" in r.stderr
+    assert "speed ratio of the sweep (0 to 1)" in r.stderr and "speed ratios above 1 (for example 1 to 2)" in r.stderr
     sr = np.linspace(1.1, 2.0, 10)
     coast = characterise(load_converter("li-sunden-2016"), model, speed_ratio=sr, input_torque_nm=-100.0)
     solved = coast["pump_speed_rad_s"].notna().to_numpy()

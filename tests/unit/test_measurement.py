@@ -256,12 +256,12 @@ BAD_CSV = {
     "rad/s that look like rpm": (
         {"pump_speed_rad_s": ORIGINAL["pump_speed_rad_s"] * 30.0 / math.pi * 8},
         "pump_speed_rad_s",
-        ["plausible", "rad/s", "--allow-implausible"],
+        ["plausible", "rad/s", "allow_implausible=True runs it anyway"],
     ),
     "torque too large": (
         {"turbine_torque_nm": ORIGINAL["turbine_torque_nm"] * 1000},
         "turbine_torque_nm",
-        ["N·m", "10000", "--allow-implausible"],
+        ["N·m", "10000", "allow_implausible=True runs it anyway"],
     ),
     "time in ms named _s": ({"time_s": TIME_S * 1e6}, "time_s", ["time in seconds"]),
     "one row": ({k: v[:1] for k, v in {"time_s": TIME_S, **ORIGINAL}.items()}, "time_s", ["1 rows", "at least 2"]),

@@ -10,7 +10,7 @@ import pytest
 
 from tcsim import _core
 from tcsim.errors import InputError, TcsimWarning
-from tcsim.models.plausibility import OVERRIDE_OPTION, RANGES, check_plausible, warn_implausible
+from tcsim.models.plausibility import RANGES, check_plausible, warn_implausible
 
 
 def test_ranges_are_the_cores():
@@ -31,7 +31,9 @@ def test_outside_is_refused_naming_the_range_and_the_override(value):
         check_plausible("speed_rad_s", [10.0, value, 2e4], "m.csv", "pump_speed_rad_s")
     msg = str(e.value)
     assert msg.startswith(f"m.csv: pump_speed_rad_s = {value:.6g}: expected a plausible value, -1100 to 1100 rad/s")
-    assert OVERRIDE_OPTION in msg and "\n" not in msg
+    assert msg.endswith("; allow_implausible=True runs it anyway") and "\n" not in msg
+    # the command line names its option instead
+    assert str(e.value.on_command_line()).endswith("; --allow-implausible runs it anyway")
 
 
 def test_the_override_turns_the_refusal_into_one_warning():

@@ -36,6 +36,9 @@ TIME_S = np.linspace(0.0, 2.0, N)  # 100 Hz
 CHANNELS = {"pump_torque_nm": 150.0 + 40.0 * np.sin(3.0 * TIME_S), "turbine_speed_rad_s": 90.0 * TIME_S}
 
 
+ANYWAY = "allow_implausible=True runs it anyway"
+
+
 def refused(read, *words: str) -> InputError:
     """The InputError of ``read()``: one line, holding ``words``."""
     with pytest.raises(InputError) as excinfo:
@@ -177,7 +180,7 @@ def _csv(path: Path, time_s=TIME_S, **changes) -> Path:
 def test_rpm_in_a_rad_s_column_below_1500_is_refused_and_can_be_allowed(tmp_path):
     rpm = 1400.0 * TIME_S / 2.0  # a take-off to 1400 rpm, written in a rad/s column
     path = _csv(tmp_path / "m.csv", turbine_speed_rad_s=rpm)
-    err = refused(lambda: read_measurement(path), "turbine_speed_rad_s", "rad/s at row", "--allow-implausible")
+    err = refused(lambda: read_measurement(path), "turbine_speed_rad_s", "rad/s at row", ANYWAY)
     assert err.field == "turbine_speed_rad_s"
     with pytest.warns(TcsimWarning, match="outside the plausible"):
         m = read_measurement(path, allow_implausible=True)
@@ -186,13 +189,13 @@ def test_rpm_in_a_rad_s_column_below_1500_is_refused_and_can_be_allowed(tmp_path
 
 def test_a_torque_far_outside_the_range_is_refused(tmp_path):
     path = _csv(tmp_path / "m.csv", pump_torque_nm=CHANNELS["pump_torque_nm"] * 100)
-    refused(lambda: read_measurement(path), "pump_torque_nm", "N·m at row", "--allow-implausible")
+    refused(lambda: read_measurement(path), "pump_torque_nm", "N·m at row", ANYWAY)
 
 
 def test_milliseconds_in_a_time_s_column_are_refused_by_the_median_step(tmp_path):
     t_ms = np.arange(N) * 1.0  # 1 kHz logged in ms: a 0.2 s record read as 199 s
     path = _csv(tmp_path / "m.csv", time_s=t_ms)
-    err = refused(lambda: read_measurement(path), "time_s (median time step, s)", "= 1:", "--allow-implausible")
+    err = refused(lambda: read_measurement(path), "time_s (median time step, s)", "= 1:", ANYWAY)
     assert err.value == 1.0
     with pytest.warns(TcsimWarning):
         read_measurement(path, allow_implausible=True)
@@ -202,7 +205,7 @@ def test_a_scenario_with_a_time_ms_column_read_as_seconds_is_refused(tmp_path):
     path = tmp_path / "s.csv"
     t = np.arange(0.0, 30_001.0, 500.0)  # a 30 s take-off written in ms under time_s
     pd.DataFrame({"time_s": t, "accelerator_pedal": 1.0, "brake_pedal": 0.0}).to_csv(path, index=False)
-    refused(lambda: read_scenario(path), "time_s (time span, s)", "30000", "scenario", "--allow-implausible")
+    refused(lambda: read_scenario(path), "time_s (time span, s)", "30000", "scenario", ANYWAY)
     with pytest.warns(TcsimWarning):
         assert read_scenario(path, allow_implausible=True).end_time_s == 30_000.0
     slow = tmp_path / "slow.csv"  # rows far apart are fine in a pedal scenario

@@ -110,7 +110,7 @@ def parameter_warnings(
         side = active.get(name)
         if side is not None:
             lo, hi = bounds[name]
-            reasons.append(f"ends at its {side} bound (bounds {lo:.6g} to {hi:.6g}; --bound {name}=LO:HI moves them)")
+            reasons.append(f"ends at its {side} bound (bounds {lo:.6g} to {hi:.6g}; wider bounds let it move)")
         rng = DESIGN_RANGES.get(name)
         if rng is not None and not rng.contains(value):
             reasons.append(f"lies outside the measured range {rng.describe()}")

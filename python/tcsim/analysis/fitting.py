@@ -88,16 +88,19 @@ def parse_free(text: str | None) -> tuple[str, ...]:
 
 
 def check_free(free: Sequence[str]) -> tuple[str, ...]:
-    """Known, distinct user-facing names; raises InputError on ``--free``."""
+    """Known, distinct user-facing names; raises InputError on the argument ``free`` (a sequence of
+    names: one name alone is refused, not read as its letters)."""
+    if isinstance(free, str):
+        raise InputError.argument("free", free, f"a list of names, e.g. [{free!r}]")
     names = tuple(free)
     if not names:
-        raise InputError("command line", "--free", "", "at least one parameter")
+        raise InputError.argument("free", "", "at least one parameter")
     for n in names:
         if n not in STEADY_KEYS:
-            raise InputError("command line", "--free", n, f"one of {', '.join(STEADY_KEYS)}")
+            raise InputError.argument("free", n, f"one of {', '.join(STEADY_KEYS)}")
     if len(set(names)) != len(names):
         dup = next(n for n in names if names.count(n) > 1)
-        raise InputError("command line", "--free", dup, "each parameter once")
+        raise InputError.argument("free", dup, "each parameter once")
     return names
 
 
@@ -152,29 +155,23 @@ def resolve_bounds(
     for name, (lo, hi) in bounds.items():
         text = f"{name}={lo:g}:{hi:g}"
         if name not in STEADY_KEYS:
-            raise InputError("command line", "--bound", text, f"a bound on one of {', '.join(STEADY_KEYS)}")
+            raise InputError.argument("bounds", text, f"a bound on one of {', '.join(STEADY_KEYS)}")
         if name not in free:
-            raise InputError(
-                "command line",
-                "--bound",
-                text,
-                f"a bound on a free parameter ({', '.join(free)}); add {name} to --free",
+            raise InputError.argument(
+                "bounds", text, f"a bound on a free parameter ({', '.join(free)}); make {name} free too"
             )
         if not lo < hi:
-            raise InputError("command line", "--bound", text, "LO < HI")
+            raise InputError.argument("bounds", text, "LO < HI")
         a_lo, a_hi, inclusive = _admissible(name)
         if lo < a_lo or (lo == a_lo and not inclusive) or hi >= a_hi:
             low = f"{'≥' if inclusive else '>'} {a_lo:g}"
-            raise InputError(
-                "command line",
-                "--bound",
+            raise InputError.argument(
+                "bounds",
                 text,
                 f"bounds the model accepts: LO {low}" + (f", HI < {a_hi:g}" if math.isfinite(a_hi) else ""),
             )
         if not lo <= start[name] <= hi:
-            raise InputError(
-                "command line", "--bound", text, f"bounds that contain the start value {name} = {start[name]:g}"
-            )
+            raise InputError.argument("bounds", text, f"bounds that contain the start value {name} = {start[name]:g}")
     return {n: bounds.get(n) or default_bounds(n, start[n]) for n in free}
 
 
@@ -215,16 +212,12 @@ def fit_points(
     if speed_ratio_max is None:
         speed_ratio_max = default_speed_ratio_max(table)
     elif not (math.isfinite(speed_ratio_max) and 0 < speed_ratio_max <= 1):
-        raise InputError("command line", "--speed-ratio-max", speed_ratio_max, "a speed ratio above 0, at most 1")
+        raise InputError.argument("speed_ratio_max", speed_ratio_max, "a speed ratio above 0, at most 1")
     sr, tr, cf = table.arrays()
     keep = (sr >= 0) & (sr <= speed_ratio_max + 1e-12)
     if keep.sum() < 2:
-        raise InputError(
-            "command line",
-            "--speed-ratio-max",
-            speed_ratio_max,
-            f"a range from SR 0 holding at least 2 points of {table.source}",
-        )
+        points = f"at least 2 points of {table.source or 'the table'}"
+        raise InputError.argument("speed_ratio_max", speed_ratio_max, f"a range from SR 0 holding {points}")
     return float(speed_ratio_max), sr[keep], tr[keep], cf[keep]
 
 
@@ -532,7 +525,13 @@ def fit_hrovat_tobler(
     """
     t0 = time.perf_counter()
     if isinstance(n_starts, bool) or not isinstance(n_starts, int | np.integer) or n_starts < 1:
-        raise InputError("fit_hrovat_tobler", "n_starts", n_starts, "an integer of at least 1 (the start itself)")
+        raise InputError.argument("n_starts", n_starts, "an integer of at least 1 (the start itself)")
+    if not isinstance(geometry, GeometrySection):
+        expected = "a GeometrySection (the [geometry] of a converter: tcsim.load_converter(name).geometry)"
+        raise InputError.argument("geometry", type(geometry).__name__, expected)
+    if not isinstance(table, Characteristic):
+        expected = "a Characteristic (a table: tcsim.fitting.target_table(name or file))"
+        raise InputError.argument("table", type(table).__name__, expected)
     free = check_free(free)
     radii = [getattr(geometry, n) for n in RADII]
     if not radii_ordered(*radii):
@@ -586,7 +585,8 @@ def warn_if_missed(source: str, sr, tr_table, cf_table, tr_model, cf_model) -> N
     warnings.warn(
         f"{source}: the fitted model misses the table: {name} {100 * e[i]:.3g} % off at SR {sr[i]:g} "
         f"(more than {100 * MISSED_RELATIVE_ERROR:g} %); the model cannot follow this table with the free "
-        "parameters in their bounds: check the table's capacity convention and units, or free more (--free, --bound)",
+        "parameters in their bounds: check the table's capacity convention and units, or free more "
+        "parameters or widen their bounds",
         TcsimWarning,
         stacklevel=3,
     )
@@ -613,7 +613,7 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
         # default free set's own rank deficiency, 7 of 10 on a full table, is the report's to explain)
         warnings.warn(
             f"{table.source}: the fit is not unique: {len(tr)} points give {2 * len(tr)} values (TR and "
-            f"CF) for {len(problem.free)} free parameters (rank {stats['rank']}); free fewer (--free) or "
+            f"CF) for {len(problem.free)} free parameters (rank {stats['rank']}); free fewer parameters or "
             "fit a table with more points",
             TcsimWarning,
             stacklevel=2,

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.console import Console
 
-from ..errors import InputError, Interrupted, TcsimWarning, received_signals
+from ..errors import InputError, Interrupted, TcsimWarning, on_command_line, received_signals
 from ..reports.format import rich_text
 
 if TYPE_CHECKING:
@@ -114,6 +114,7 @@ _shown: set[str] = set()
 
 
 def _show_warning(message, category, filename, lineno, file=None, line=None):
+    message = on_command_line(str(message))
     text = f"{category.__name__}: {message}"
     if text in _shown:
         return
@@ -293,7 +294,7 @@ def _run(argv: list[str] | None) -> int:
     try:
         rv = app(args=argv, standalone_mode=False)
     except InputError as e:
-        console.print(f"[red]error:[/red] {rich_text(e)}", highlight=False, soft_wrap=True)
+        console.print(f"[red]error:[/red] {rich_text(e.on_command_line())}", highlight=False, soft_wrap=True)
         return 2
     except typer.Abort:
         console.print("aborted")

@@ -44,7 +44,7 @@ def fit_command(
         result = fitting.fit_hrovat_tobler(start.geometry, table, free_names, user_bounds, speed_ratio_max)
     except InputError as e:
         if e.source == "start converter":
-            raise InputError(start.path, e.field, e.value, e.expected) from None
+            raise e.replace(source=start.path) from None
         raise
     outcome = fitting.fit_outcome(start, result, table, fitting.target_label(target))
     for line in outcome.warnings:  # only once the fitted converter passed its checks

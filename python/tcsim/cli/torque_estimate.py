@@ -50,7 +50,7 @@ def read_torque(path: str | Path, column: str | None, option: str, allow_implaus
         meas = read_measurement(path, channels, required=(CHANNEL,), optional=(), allow_implausible=allow_implausible)
     except InputError as e:
         expected = e.expected.replace(f"--channel {CHANNEL}=", f"{option} ")
-        raise InputError(e.source, e.field, e.value, expected) from None
+        raise e.replace(expected=expected) from None
     return TorqueSignal(meas.source, meas.time_s, meas.channels[CHANNEL])
 
 

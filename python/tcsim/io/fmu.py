@@ -137,7 +137,7 @@ class Parameter:
 
 def _check_causality(causality: str) -> tuple[str, str]:
     if causality not in CAUSALITIES:
-        raise InputError("command line", "--causality", causality, f"one of {', '.join(CAUSALITIES)}")
+        raise InputError.argument("causality", causality, f"one of {', '.join(CAUSALITIES)}")
     return CAUSALITIES[causality]
 
 
@@ -588,12 +588,12 @@ def _output_path(out_path: str | Path) -> Path:
     :func:`tcsim.io.outputs.output_file`'s."""
     out = Path(out_path)
     if out.suffix.lower() != ".fmu":
-        raise InputError("command line", "--out", str(out), "a file name ending in .fmu")
+        raise InputError.argument("out_path", str(out), "a file name ending in .fmu")
     if out.is_dir():
-        raise InputError("command line", "--out", str(out), "a .fmu file (a directory of that name exists)")
+        raise InputError.argument("out_path", str(out), "a .fmu file (a directory of that name exists)")
     if out.is_file() and not _is_fmu(out):
         expected = "a new .fmu file or an FMU to replace (the file is not an FMU)"
-        raise InputError("command line", "--out", str(out), expected)
+        raise InputError.argument("out_path", str(out), expected)
     return out
 
 

@@ -205,7 +205,7 @@ def fmi_version(value: int | str) -> FmiVersion:
     """The FMI version of a ``--fmi-version`` value (``2`` or ``3``); anything else is an
     :class:`~tcsim.errors.InputError`."""
     if str(value) not in FMI_VERSIONS:
-        raise InputError("command line", "--fmi-version", value, " or ".join(FMI_VERSIONS))
+        raise InputError.argument("fmi_version", value, " or ".join(FMI_VERSIONS))
     return FMI_VERSIONS[str(value)]
 
 

@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError, TcsimWarning, not_utf8
+from ..errors import ALLOW_IMPLAUSIBLE, InputError, TcsimWarning, not_utf8
 from ..models.measurement import Measurement
 from ..models.plausibility import check_plausible
 from ..units import LBF_FT_IN_NM, RAD_S_PER_RPM
@@ -626,7 +626,7 @@ def _short_ms_record(path: Path, column: str, span_s: float, allow: bool) -> Non
         f"a record of at least {MIN_MS_RECORD_S * 1e3:g} ms (seconds under a milliseconds name? name the column time_s)"
     )
     if not allow:
-        raise InputError(str(path), column, shown, f"{expected}; --allow-implausible runs it anyway")
+        raise InputError(str(path), column, shown, expected, override=ALLOW_IMPLAUSIBLE)
     warnings.warn(f"{path}: {column} = {shown}: expected {expected}", TcsimWarning, stacklevel=4)
 
 

@@ -60,7 +60,7 @@ committed: list[Path] = []
 
 
 def _refuse(out: Path, expected: str) -> InputError:
-    return InputError("command line", "--out", str(out), expected)
+    return InputError.argument("out", str(out), expected)
 
 
 def _listing(names: Sequence[str]) -> str:

@@ -54,9 +54,9 @@ _MATLAB_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 _RPM_SUFFIXES: tuple[tuple[str, str], ...] = (("_rad_s2", "_rpm_per_s"), ("_rad_s", "_rpm"))
 
 
-def _choice(option: str, value: str, choices: tuple[str, ...]) -> str:
+def _choice(parameter: str, value: str, choices: tuple[str, ...]) -> str:
     if value not in choices:
-        raise InputError("command line", option, value, f"one of {', '.join(choices)}")
+        raise InputError.argument(parameter, value, f"one of {', '.join(choices)}")
     return value
 
 
@@ -69,8 +69,8 @@ class TableFormat:
     speed_unit: str = SPEED_UNITS[0]
 
     def __post_init__(self) -> None:
-        _choice("--format", self.format, FORMATS)
-        _choice("--speed-unit", self.speed_unit, SPEED_UNITS)
+        _choice("format", self.format, FORMATS)
+        _choice("speed_unit", self.speed_unit, SPEED_UNITS)
 
     def file_name(self, name: str) -> str:
         """``name`` (``summary.csv``) with this format's suffix (``summary.mat``)."""
@@ -100,7 +100,7 @@ def matlab_name(column: str) -> str:
 def column_in_unit(column: str, unit: str) -> str:
     """The name of the column ``column`` (named in rad/s) with angular speeds in ``unit``:
     ``pump_speed_rad_s`` → ``pump_speed_rpm``, ``pump_accel_rad_s2`` → ``pump_accel_rpm_per_s``."""
-    _choice("--speed-unit", unit, SPEED_UNITS)
+    _choice("speed_unit", unit, SPEED_UNITS)
     column = str(column)
     if unit == "rpm":
         for suffix, rpm in _RPM_SUFFIXES:

@@ -177,7 +177,7 @@ class Converter:
     def require(self, model: str) -> None:
         """Raise an InputError unless the converter has the sections ``model`` needs."""
         if model not in MODELS:
-            raise InputError("command line", "--model", model, f"one of {', '.join(MODELS)}")
+            raise InputError.argument("model", model, f"one of {', '.join(MODELS)}")
         for section in _REQUIRED[model]:
             if getattr(self, section) is None:
                 raise InputError(self.path, f"[{section}]", "missing", f"a [{section}] section for the {model} model")

@@ -197,7 +197,7 @@ def _table_d1() -> GeometrySection:
 def _design_error(e: InputError) -> InputError:
     """The core's error on a design's field, with the field as the design file writes it."""
     field = e.field if e.field == "points" else f"[design].{e.field}"
-    return InputError(e.source, field, e.value, e.expected, e.core_source)
+    return e.replace(field=field)
 
 
 def derive_converter(file: DesignFile, points: int | None = None) -> DerivedConverter:

@@ -216,7 +216,7 @@ def resolve_model(
 ) -> DynamicModel:
     """A :class:`DynamicModel` given directly (as ``model``, or as ``converter``), or the model named
     ``model`` of ``converter`` (a :class:`Converter`, bundled name or file). A model outside
-    ``allowed`` is an InputError on ``--model`` (``why`` explains the restriction)."""
+    ``allowed`` is an InputError on the argument ``model`` (``why`` explains the restriction)."""
     expected = f"one of {', '.join(allowed)}{why}"
     if isinstance(model, DynamicModel):
         m = model
@@ -224,12 +224,12 @@ def resolve_model(
         m = converter
     else:
         if model not in allowed:
-            raise InputError("command line", "--model", model, expected)
+            raise InputError.argument("model", model, expected)
         if converter is None:
-            raise InputError("command line", "converter", "none", "a converter (or a DynamicModel as the model)")
+            raise InputError.argument("converter", None, "a converter (or a DynamicModel as the model)")
         m = dynamic_model(converter, model)
     if m.name not in allowed:
-        raise InputError("command line", "--model", m.name, expected)
+        raise InputError.argument("model", m.name, expected)
     return m
 
 
@@ -238,7 +238,7 @@ def select_models(converter: Any, requested: Sequence[str]) -> list[DynamicModel
     model of ``converter.models`` whose transient sections are present (at least one)."""
     for name in requested:
         if name not in MODELS:
-            raise InputError("command line", "--model", name, f"one of {', '.join(MODELS)}")
+            raise InputError.argument("model", name, f"one of {', '.join(MODELS)}")
     if requested:
         return [dynamic_model(converter, m) for m in dict.fromkeys(requested)]
     models, first_error = [], None

@@ -21,11 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from .. import _core
-from ..errors import CoreText, InputError, TcsimWarning
+from ..errors import ALLOW_IMPLAUSIBLE, CoreText, InputError, TcsimWarning
 from ..units import RAD_S_PER_RPM
-
-#: The command-line option that turns a refusal of :func:`check_plausible` into a warning.
-OVERRIDE_OPTION = "--allow-implausible"
 
 
 @dataclass(frozen=True)
@@ -64,7 +61,7 @@ def check_plausible(
     locate: Callable[[int], str] | None = None,
 ) -> None:
     """Refuse the first of ``values`` outside the range of ``quantity`` (an :class:`InputError` of
-    ``source``/``field`` naming the range and :data:`OVERRIDE_OPTION`), or with ``allow`` warn.
+    ``source``/``field`` naming the range and the override ``allow_implausible``), or with ``allow`` warn.
     ``locate(i)`` says where the ``i``-th value is (``row 5 (time_s 0.04)``), shown after the value
     and its unit. Non-finite values are the readers' to refuse and are skipped here."""
     rng, bad, index = _first_outside(quantity, values)
@@ -72,7 +69,7 @@ def check_plausible(
         return
     shown: object = bad if locate is None else CoreText(f"{bad:.6g} {rng.unit} at {locate(index)}".replace("  ", " "))
     if not allow:
-        raise InputError(source, field, shown, f"a plausible value, {rng.describe()}; {OVERRIDE_OPTION} runs it anyway")
+        raise InputError(source, field, shown, f"a plausible value, {rng.describe()}", override=ALLOW_IMPLAUSIBLE)
     _warn(rng, bad, source, field)
 
 
@@ -98,5 +95,5 @@ def check_plausible_rpm(rpm: float, source: str, field: str, allow: bool = False
         return
     shown = f"{rng.low / RAD_S_PER_RPM:.0f} to {rng.high / RAD_S_PER_RPM:.0f} rpm, i.e. {rng.describe()}"
     if not allow:
-        raise InputError(source, field, rpm, f"a plausible speed, {shown}; {OVERRIDE_OPTION} runs it anyway")
+        raise InputError(source, field, rpm, f"a plausible speed, {shown}", override=ALLOW_IMPLAUSIBLE)
     warnings.warn(f"{source}: {field} = {rpm:.6g} is outside the plausible {shown}", TcsimWarning, stacklevel=2)

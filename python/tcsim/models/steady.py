@@ -16,7 +16,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError, core_value, from_core
+from ..errors import ARGUMENT, InputError, core_value, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
 from .converter import Converter
 from .plausibility import check_plausible, check_plausible_rpm
@@ -66,24 +66,23 @@ def _check_speed(pump_speed_rpm: float, allow_implausible: bool = False) -> floa
     """The pump speed in rad/s: finite and positive, and plausible (``speed_rad_s``) unless
     ``allow_implausible`` (``--allow-implausible``), which warns instead."""
     if not (np.isfinite(pump_speed_rpm) and pump_speed_rpm >= MIN_PUMP_SPEED_RPM):
-        raise InputError(
-            "command line",
-            "--pump-speed-rpm",
+        raise InputError.argument(
+            "pump_speed_rpm",
             pump_speed_rpm,
             f"a finite pump speed of at least {MIN_PUMP_SPEED_RPM:g} rpm (below it the torques underflow)",
         )
-    check_plausible_rpm(pump_speed_rpm, "command line", "--pump-speed-rpm", allow_implausible)
+    check_plausible_rpm(pump_speed_rpm, ARGUMENT, "pump_speed_rpm", allow_implausible)
     return pump_speed_rpm * RAD_S_PER_RPM
 
 
 def _speed_error(e: Exception, pump_speed_rpm: float, converter_file: str, field_prefix: str = "") -> InputError:
-    """A core error of a sweep: about the commanded speed (source ``drive``) it names
-    ``--speed-ratio`` when the core refused a speed ratio, else ``--pump-speed-rpm`` (the steady
-    state overflowed); any other error names the converter file."""
+    """A core error of a sweep: about the commanded speed (source ``drive``) it names the argument
+    ``speed_ratio`` when the core refused a speed ratio, else ``pump_speed_rpm`` (the steady state
+    overflowed); any other error names the converter file."""
     if e.args[4] == "drive" and str(e.args[1]).startswith("speed_ratio"):
-        return InputError("command line", "--speed-ratio", core_value(e.args[2]), e.args[3], core_source="drive")
+        return InputError.argument("speed_ratio", core_value(e.args[2]), e.args[3], core_source="drive")
     if e.args[4] == "drive":
-        return InputError("command line", "--pump-speed-rpm", pump_speed_rpm, e.args[3], core_source="drive")
+        return InputError.argument("pump_speed_rpm", pump_speed_rpm, e.args[3], core_source="drive")
     return from_core(e, converter_file, field_prefix)
 
 
@@ -213,8 +212,8 @@ def characterise_hrovat_tobler(
 ) -> pd.DataFrame:
     """Closed-form steady state over ``speed_ratio`` (default SR 0–1 in steps of 0.01 with the
     coupling point) with the one-way clutch; a speed ratio the core does not solve is an error about
-    ``--speed-ratio``. A steady state that overflows (pump speeds above about 1e150 rad/s) is an
-    error about ``--pump-speed-rpm``, never a ``no-flow`` point."""
+    ``speed_ratio``. A steady state that overflows (pump speeds above about 1e150 rad/s) is an
+    error about ``pump_speed_rpm``, never a ``no-flow`` point."""
     conv.require("hrovat-tobler")
     wp = _check_speed(pump_speed_rpm, allow_implausible)
     sr = ht_speed_ratios(conv) if speed_ratio is None else np.asarray(speed_ratio, dtype=float)
@@ -439,26 +438,26 @@ def characterise_at_input_torque(
     Raises
     ------
     InputError
-        ``--input-torque-nm`` not a finite, non-zero number; outside the plausible ``torque_nm``
+        ``input_torque_nm`` not a finite, non-zero number; outside the plausible ``torque_nm``
         unless ``allow_implausible``; or carried at no speed ratio of the sweep (a negative torque
         over speed ratios 0–1 gave every row NaN with exit 0).
     """
     conv.require(model)
     if not (np.isfinite(input_torque_nm) and input_torque_nm != 0.0):
-        raise InputError("command line", "--input-torque-nm", input_torque_nm, "a finite, non-zero torque in N·m")
-    check_plausible("torque_nm", [input_torque_nm], "command line", "--input-torque-nm", allow_implausible)
+        raise InputError.argument("input_torque_nm", input_torque_nm, "a finite, non-zero torque in N·m")
+    check_plausible("torque_nm", [input_torque_nm], ARGUMENT, "input_torque_nm", allow_implausible)
     frame = _at_input_torque(conv, model, float(input_torque_nm), speed_ratio)
     if not np.isfinite(frame["pump_speed_rad_s"].to_numpy(dtype=float)).any():
         sr = frame["speed_ratio"].to_numpy(dtype=float)
         need = (
-            "a negative (coast) torque needs speed ratios above 1, e.g. --speed-ratio 1:2:0.01"
+            "a negative (coast) torque needs speed ratios above 1 (for example 1 to 2)"
             if input_torque_nm < 0
-            else "a positive (drive) torque needs speed ratios below 1, e.g. --speed-ratio 0:1:0.01"
+            else "a positive (drive) torque needs speed ratios below 1 (for example 0 to 1)"
         )
         expected = (
             f"a torque the converter carries at some speed ratio of the sweep ({sr.min():g} to {sr.max():g}); {need}"
         )
-        raise InputError("command line", "--input-torque-nm", input_torque_nm, expected)
+        raise InputError.argument("input_torque_nm", input_torque_nm, expected)
     return frame
 
 

@@ -1,0 +1,64 @@
+"""Errors of the Python API name the function's own arguments; the command line shows the same
+errors with its options (a trial: ``tcsim.characterise(..., pump_speed_rpm=0)`` said
+``command line: --pump-speed-rpm``, and its refusal of an implausible speed named an override,
+``--allow-implausible``, that the function did not have)."""
+
+from __future__ import annotations
+
+import pytest
+
+import tcsim
+from tcsim.errors import ARGUMENT, InputError, on_command_line, option_name
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field", "value"),
+    [
+        (dict(model="table", pump_speed_rpm=0.0), "pump_speed_rpm", 0.0),
+        (dict(model="no-such-model"), "model", "no-such-model"),
+        (dict(model="table", input_torque_nm=0.0), "input_torque_nm", 0.0),
+    ],
+)
+def test_characterise_names_its_arguments(kwargs, field, value):
+    with pytest.raises(InputError) as e:
+        tcsim.characterise("li-sunden-2016", **kwargs)
+    assert (e.value.source, e.value.field, e.value.value) == (ARGUMENT, field, value)
+    assert str(e.value).startswith(f"argument: {field} = ")
+    cli = e.value.on_command_line()
+    assert (cli.source, cli.field, cli.value) == ("command line", "--" + field.replace("_", "-"), value)
+
+
+def test_the_override_named_is_the_functions_own_and_it_works():
+    with pytest.raises(InputError) as e:
+        tcsim.characterise("li-sunden-2016", "table", pump_speed_rpm=12000.0)
+    assert str(e.value).endswith("; allow_implausible=True runs it anyway")
+    assert str(e.value.on_command_line()).endswith("; --allow-implausible runs it anyway")
+    with pytest.warns(tcsim.TcsimWarning, match="^argument: pump_speed_rpm = 12000 is outside the plausible"):
+        frame = tcsim.characterise("li-sunden-2016", "table", pump_speed_rpm=12000.0, allow_implausible=True)
+    assert len(frame) > 0
+
+
+def test_a_copy_keeps_the_override_and_the_core_source():
+    e = InputError("m.csv", "pump_speed_rad_s", 9000.0, "a plausible value", core_source="drive", override="x_y")
+    moved = e.replace(source="n.csv")
+    assert (moved.source, moved.field, moved.core_source, moved.override) == (
+        "n.csv",
+        "pump_speed_rad_s",
+        "drive",
+        "x_y",
+    )
+    assert (
+        str(moved.on_command_line())
+        == "n.csv: pump_speed_rad_s = 9000: expected a plausible value; --x-y runs it anyway"
+    )
+    assert e.on_command_line() is not e and InputError("f", "k", 1, "x").on_command_line().source == "f"
+
+
+def test_warnings_and_options_as_the_command_line_words_them():
+    assert (
+        on_command_line("argument: pump_speed_rpm = 12000 is outside")
+        == "command line: --pump-speed-rpm = 12000 is outside"
+    )
+    assert on_command_line("m.csv: argument: x = 1") == "m.csv: argument: x = 1"  # only at the start
+    assert option_name("out_path") == "--out" and option_name("bounds") == "--bound"
+    assert option_name("speed_ratio_max") == "--speed-ratio-max"
