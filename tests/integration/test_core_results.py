@@ -100,6 +100,39 @@ def test_initial_state_errors_name_the_initial_state():
     assert (e.value.source, e.value.field) == ("initial state", "initial stator_speed_rad_s")
 
 
+@pytest.mark.parametrize(
+    ("options", "field", "value", "expected"),
+    [
+        (dict(rtoll=1e-10), "rtoll", 1e-10, "a known name, one of rtol, speed_atol_rad_s"),
+        (dict(speed_atol=1e-3), "speed_atol", 1e-3, "a known name, one of rtol, speed_atol_rad_s"),
+        (dict(rtol="a"), "rtol", "'a'", "a number"),
+        (dict(max_events=1.5), "max_events", 1.5, "a whole number"),
+    ],
+)
+def test_a_misspelt_or_mistyped_solver_option_is_refused(options, field, value, expected):
+    """A trial: ``rtoll=1e-10`` ran with the default rtol and no word (the result was the default
+    run's, bit for bit); ``rtol="a"`` was a ValueError, not an InputError."""
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="table", times_s=T, **options)
+    assert (e.value.source, e.value.field, e.value.value) == ("solver options", field, value)
+    assert e.value.expected.startswith(expected)
+
+
+def test_a_misspelt_or_mistyped_initial_value_is_refused():
+    for initial, field in [({"pump_speed": 1.0}, "pump_speed"), ({"pump_speed_rad_s": "x"}, "pump_speed_rad_s")]:
+        with pytest.raises(InputError) as e:
+            tr.simulate("li-sunden-2016", tr.isolated_takeoff(), times_s=T, initial=initial)
+        assert (e.value.source, e.value.field) == ("initial state", field)
+
+
+def test_the_columns_chosen_are_kept_even_when_the_model_lacks_them():
+    """A trial: the table model's ``flow_m3_s`` alone gave an empty (3, 0) frame."""
+    r = tr.simulate("li-sunden-2016", tr.isolated_takeoff(), "table", times_s=T, columns=["flow_m3_s"])
+    assert list(r.frame().columns) == ["flow_m3_s"] and r.frame()["flow_m3_s"].isna().all()
+    full = tr.simulate("li-sunden-2016", tr.isolated_takeoff(), "table", times_s=T).frame()
+    assert "flow_m3_s" not in full.columns and "time_s" in full.columns  # the default drops what the model lacks
+
+
 def test_option_errors_name_the_solver_options():
     with pytest.raises(InputError) as e:
         tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="table", times_s=T, rtol=-1.0)

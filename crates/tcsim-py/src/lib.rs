@@ -935,25 +935,69 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
     Ok((drive, out))
 }
 
+/// The keys of an initial state (`init_from`).
+const INITIAL_KEYS: [&str; 4] = ["pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s"];
+
+/// The keys of the solver options (`options_from`).
+const OPTION_KEYS: [&str; 6] =
+    ["rtol", "speed_atol_rad_s", "flow_atol_m3_s", "first_step_s", "max_events", "max_output_bytes"];
+
+/// An input error of `source` unless every key of `d` is one of `known` (a misspelt option, such as
+/// `rtoll`, was ignored: the run went on with the default).
+fn known_keys(d: &Bound<'_, PyDict>, source: InputSource, known: &[&str]) -> PyResult<()> {
+    for (k, v) in d.iter() {
+        let name = k.str()?.to_string_lossy().into_owned();
+        if !known.contains(&name.as_str()) {
+            let expected = format!("a known name, one of {}", known.join(", "));
+            let value = v.repr().map(|r| r.to_string_lossy().into_owned()).unwrap_or_default();
+            return Err(input_error(CoreError::of(source, name, value, expected)));
+        }
+    }
+    Ok(())
+}
+
+/// The value of `key` in `d` (None when absent or None), else an input error of `source` naming
+/// the key and the value (a string where a number goes).
+fn opt_input<'py, T: FromPyObjectOwned<'py>>(
+    d: &Bound<'py, PyDict>,
+    source: InputSource,
+    key: &str,
+    expected: &str,
+) -> PyResult<Option<T>> {
+    match d.get_item(key)? {
+        None => Ok(None),
+        Some(v) if v.is_none() => Ok(None),
+        Some(v) => v.extract::<T>().map(Some).map_err(|_| {
+            let value = v.repr().map(|r| r.to_string_lossy().into_owned()).unwrap_or_default();
+            input_error(CoreError::of(source, key, value, expected))
+        }),
+    }
+}
+
 fn init_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<InitialState> {
     let Some(d) = d else { return Ok(InitialState::default()) };
+    known_keys(d, InputSource::Initial, &INITIAL_KEYS)?;
+    let value = |key: &str| opt_input(d, InputSource::Initial, key, "a number");
     Ok(InitialState {
-        pump_speed_rad_s: opt_item(d, "pump_speed_rad_s")?,
-        turbine_speed_rad_s: opt_item(d, "turbine_speed_rad_s")?,
-        stator_speed_rad_s: opt_item(d, "stator_speed_rad_s")?,
-        flow_m3_s: opt_item(d, "flow_m3_s")?,
+        pump_speed_rad_s: value(INITIAL_KEYS[0])?,
+        turbine_speed_rad_s: value(INITIAL_KEYS[1])?,
+        stator_speed_rad_s: value(INITIAL_KEYS[2])?,
+        flow_m3_s: value(INITIAL_KEYS[3])?,
     })
 }
 
-fn options_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<SolverOptions> {
+/// The solver options of `d`; its other keys must be among `extra` (the caller's own options).
+fn options_from(d: Option<&Bound<'_, PyDict>>, extra: &[&str]) -> PyResult<SolverOptions> {
     let mut o = SolverOptions::default();
     if let Some(d) = d {
-        o.rtol = opt_item(d, "rtol")?.unwrap_or(o.rtol);
-        o.speed_atol_rad_s = opt_item(d, "speed_atol_rad_s")?.unwrap_or(o.speed_atol_rad_s);
-        o.flow_atol_m3_s = opt_item(d, "flow_atol_m3_s")?.unwrap_or(o.flow_atol_m3_s);
-        o.first_step_s = opt_item(d, "first_step_s")?.unwrap_or(o.first_step_s);
-        o.max_events = opt_item(d, "max_events")?.unwrap_or(o.max_events);
-        o.max_output_bytes = opt_item(d, "max_output_bytes")?.unwrap_or(o.max_output_bytes);
+        known_keys(d, InputSource::Options, &[&OPTION_KEYS[..], extra].concat())?;
+        let number = |key: &str| opt_input::<f64>(d, InputSource::Options, key, "a number");
+        o.rtol = number("rtol")?.unwrap_or(o.rtol);
+        o.speed_atol_rad_s = number("speed_atol_rad_s")?.unwrap_or(o.speed_atol_rad_s);
+        o.flow_atol_m3_s = number("flow_atol_m3_s")?.unwrap_or(o.flow_atol_m3_s);
+        o.first_step_s = number("first_step_s")?.unwrap_or(o.first_step_s);
+        o.max_events = opt_input(d, InputSource::Options, "max_events", "a whole number")?.unwrap_or(o.max_events);
+        o.max_output_bytes = number("max_output_bytes")?.unwrap_or(o.max_output_bytes);
     }
     if !(o.max_output_bytes.is_finite() && o.max_output_bytes > 0.0) {
         let expected = "a finite, positive number of bytes";
@@ -1149,7 +1193,7 @@ fn sized_transient_jobs(
     columns: usize,
 ) -> PyResult<(Vec<TransientJob>, Vec<usize>)> {
     let init = init_from(init.as_ref())?;
-    let options = options_from(options.as_ref())?;
+    let options = options_from(options.as_ref(), &[])?;
     let (jobs, skips) = transient_jobs(models, drives, init, options)?;
     let samples = jobs.iter().map(|j| j.times_s.len()).sum();
     isolated_output_size(1, samples, columns, &options)
@@ -1384,7 +1428,7 @@ fn launch_runs<'py>(
     guard(|| {
         let v = vehicle.get().doc.vehicle.clone();
         let sc = scenario_from(&scenario)?;
-        let solver = options_from(options.as_ref())?;
+        let solver = options_from(options.as_ref(), &["output_step_s"])?;
         let step: f64 = match options.as_ref() {
             Some(o) => opt_item(o, "output_step_s")?.unwrap_or(DEFAULT_OUTPUT_STEP_S),
             None => DEFAULT_OUTPUT_STEP_S,
@@ -1417,14 +1461,18 @@ fn drive_columns() -> Vec<&'static str> {
 
 /// The driver's gains from `options` (`driver_kp_per_s`, `driver_ki_per_s2`,
 /// `driver_control_step_s`, `driver_hold_brake`, `driver_preview_s`), defaults otherwise.
+/// The driver's options of `drive_runs` (`driver_from`).
+const DRIVER_KEYS: [&str; 5] =
+    ["driver_kp_per_s", "driver_ki_per_s2", "driver_control_step_s", "driver_hold_brake", "driver_preview_s"];
+
 fn driver_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<tcsim_core::vehicle::cycle::Driver> {
     let mut g = tcsim_core::vehicle::cycle::Driver::default();
     if let Some(d) = d {
-        g.kp_per_s = opt_item(d, "driver_kp_per_s")?.unwrap_or(g.kp_per_s);
-        g.ki_per_s2 = opt_item(d, "driver_ki_per_s2")?.unwrap_or(g.ki_per_s2);
-        g.control_step_s = opt_item(d, "driver_control_step_s")?.unwrap_or(g.control_step_s);
-        g.hold_brake = opt_item(d, "driver_hold_brake")?.unwrap_or(g.hold_brake);
-        g.preview_s = opt_item(d, "driver_preview_s")?.unwrap_or(g.preview_s);
+        g.kp_per_s = opt_item(d, DRIVER_KEYS[0])?.unwrap_or(g.kp_per_s);
+        g.ki_per_s2 = opt_item(d, DRIVER_KEYS[1])?.unwrap_or(g.ki_per_s2);
+        g.control_step_s = opt_item(d, DRIVER_KEYS[2])?.unwrap_or(g.control_step_s);
+        g.hold_brake = opt_item(d, DRIVER_KEYS[3])?.unwrap_or(g.hold_brake);
+        g.preview_s = opt_item(d, DRIVER_KEYS[4])?.unwrap_or(g.preview_s);
     }
     g.validate().map_err(input_error)?;
     Ok(g)
@@ -1453,7 +1501,7 @@ fn drive_runs<'py>(
         let trace =
             Trace::new(item(&cycle, "time_s")?, item(&cycle, "vehicle_speed_m_s")?, opt_item(&cycle, "grade_percent")?)
                 .map_err(input_error)?;
-        let mut solver = options_from(options.as_ref())?;
+        let mut solver = options_from(options.as_ref(), &DRIVER_KEYS)?;
         if options.as_ref().map_or(Ok(None), |o| opt_item::<f64>(o, "rtol"))?.is_none() {
             solver.rtol = tcsim_core::vehicle::cycle::DRIVE_RTOL;
         }

@@ -87,6 +87,34 @@ class Characteristic:
             raise InputError(source, f"{prefixes[order[int(m[1])]]}{m[2]}", core_value(e.args[2]), e.args[3]) from None
         return top
 
+    def __post_init__(self) -> None:
+        """A table made directly (``Characteristic(sr, tr, cf)``, not read from a file) is checked as
+        a file's is: 1-D arrays of numbers, a known ``convention``, TR and CF positive in drive, and
+        the core's rules (finite, as many values in each column, at least 2 points, SR strictly
+        increasing, passive); an :class:`InputError` about ``source`` (else ``Characteristic``)."""
+        where = self.source or "Characteristic"
+        arrays = []
+        for key in ("speed_ratio", "torque_ratio", "capacity_factor_nm_s2"):
+            value = getattr(self, key)
+            try:
+                a = np.asarray(value, dtype=float)
+            except (TypeError, ValueError):
+                raise InputError(where, key, value, "an array of numbers") from None
+            if a.ndim != 1:
+                raise InputError(where, key, f"{a.ndim}-D array", "a 1-D array of numbers")
+            object.__setattr__(self, key, a)
+            arrays.append(a)
+        if self.convention not in CAPACITY_KEYS:
+            raise InputError(where, "convention", self.convention, f"one of {', '.join(CAPACITY_KEYS)}")
+        if self.by_torque:
+            return  # checked as a whole by torque_dependent
+        sr, tr, cf = arrays
+        try:
+            _core.table_check(**self.core_table())
+        except _core.CoreInputError as e:
+            raise from_core(e, where) from None
+        _positive_in_drive(sr, (("torque_ratio", tr), ("capacity_factor_nm_s2", cf)), lambda c, i: f"{c}[{i}]", where)
+
     def tables(self) -> tuple[Characteristic, ...]:
         """The converter's tables by increasing input torque (this one alone for a single table)."""
         return self.by_torque or (self,)
@@ -161,12 +189,7 @@ class Characteristic:
                 f"strictly increasing speed ratio (previous value {sr[i - 1]:g})",
             )
         drive = sr < 1.0
-        for col, v in (("torque_ratio", tr), (convention, cap)):
-            bad = np.flatnonzero(drive & (v <= 0))
-            if bad.size:
-                raise InputError(
-                    source, name(col, int(bad[0])), float(v[bad[0]]), "a positive value in drive (speed ratio below 1)"
-                )
+        _positive_in_drive(sr, (("torque_ratio", tr), (convention, cap)), name, source)
         cf = np.asarray(_core.capacity_to_cf(convention, np.ascontiguousarray(cap)))
         bad = np.flatnonzero(~np.isfinite(cf) | (drive & (cf <= 0)))
         if bad.size:  # the file's value overflows (or underflows) on conversion: name it as written
@@ -222,6 +245,19 @@ class Characteristic:
 
     def arrays(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return self.speed_ratio, self.torque_ratio, self.capacity_factor_nm_s2
+
+
+def _positive_in_drive(
+    sr: np.ndarray, columns: Sequence[tuple[str, np.ndarray]], name: Callable[[str, int], str], source: str
+) -> None:
+    """TR and the capacity are positive in drive (SR below 1), else an :class:`InputError` naming
+    the first row that is not (``name(column, i)``)."""
+    drive = sr < 1.0
+    for col, v in columns:
+        bad = np.flatnonzero(drive & (v <= 0))
+        if bad.size:
+            i = int(bad[0])
+            raise InputError(source, name(col, i), float(v[i]), "a positive value in drive (speed ratio below 1)")
 
 
 def _check_torques_finite(

@@ -12,13 +12,15 @@ Each returns a :class:`pandas.DataFrame` with the columns of ``characteristic.cs
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pandas as pd
 
 from .. import _core
 from ..errors import ARGUMENT, InputError, core_value, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
-from .converter import Converter
+from .converter import Converter, load_converter
 from .plausibility import check_plausible, check_plausible_rpm
 
 #: Codes of the ``stator_mode`` column of the core's steady states and their names (the core's).
@@ -186,10 +188,32 @@ def hrovat_tobler_steady_state(
     ``threads`` workers share the points (0: one per core; a worker gets at least 16 384 points,
     so smaller batches run on fewer threads); the results do not depend on it.
     """
-    geometry = np.ascontiguousarray(np.atleast_2d(geometry), dtype=float)
-    wp = np.ascontiguousarray(pump_speed_rad_s, dtype=float).reshape(-1)
-    wt = np.ascontiguousarray(turbine_speed_rad_s, dtype=float).reshape(-1)
-    return _core.ht_steady_states(geometry, wp, wt, strict, threads)
+    names = _core.ht_parameter_names()
+    geometry = _numbers("geometry", geometry, 2)
+    wp = _numbers("pump_speed_rad_s", pump_speed_rad_s, 1)
+    wt = _numbers("turbine_speed_rad_s", turbine_speed_rad_s, 1)
+    if geometry.shape[1] != len(names):
+        expected = f"rows of the {len(names)} core parameters ({', '.join(names)})"
+        raise InputError.argument("geometry", f"{geometry.shape[1]} columns", expected)
+    if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 0:
+        raise InputError.argument("threads", threads, "a whole number of workers, 0 for one per core")
+    try:
+        return _core.ht_steady_states(geometry, wp, wt, strict, threads)
+    except _core.CoreInputError as e:  # a geometry the core refuses, a NaN speed
+        _message, field, value, expected, source = e.args[:5]
+        if source == "converter":  # a parameter of the geometry: named in what is expected
+            field, expected = "geometry", f"{field}: {expected}"
+        raise InputError.argument(field, core_value(value), expected, core_source=source) from None
+
+
+def _numbers(name: str, values: object, ndim: int) -> np.ndarray:
+    """``values`` as a contiguous float array (``ndim`` 2: one row or rows; 1: flattened), else an
+    :class:`InputError` about the argument ``name``."""
+    try:
+        a = np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError.argument(name, values, "numbers (an array, a list or a number)") from None
+    return np.ascontiguousarray(np.atleast_2d(a) if ndim == 2 else a.reshape(-1))
 
 
 def steady_torque_ratio(out: dict[str, np.ndarray]) -> np.ndarray:
@@ -199,8 +223,12 @@ def steady_torque_ratio(out: dict[str, np.ndarray]) -> np.ndarray:
     return _core.steady_torque_ratio(out["stator_mode"], out["pump_torque_nm"], out["turbine_torque_nm"])
 
 
-def coupling_point(conv: Converter) -> float | None:
-    """Speed ratio where the Hrovat & Tobler stator clutch releases, or None below SR = 1."""
+def coupling_point(conv: Converter | str | Path) -> float | None:
+    """Speed ratio where the Hrovat & Tobler stator clutch releases, or None below SR = 1; ``conv``
+    is a :class:`Converter`, a bundled name or a file."""
+    if not isinstance(conv, Converter):
+        conv = load_converter(conv)
+    conv.require("hrovat-tobler")
     return _core.ht_coupling_point(conv.core_geometry())
 
 
@@ -228,7 +256,9 @@ def characterise_hrovat_tobler(
 def _ht_frame(conv: Converter, wp: np.ndarray, wt: np.ndarray, sr: np.ndarray, strict: bool = True) -> pd.DataFrame:
     """Hrovat & Tobler's columns at speeds ``wp``, ``wt``, rad/s (``strict``: the core's error at the
     first point without a steady state, else a NaN row with mode ``no-steady-state``)."""
-    out = hrovat_tobler_steady_state(conv.core_geometry(), wp, wt, strict)
+    geometry = np.atleast_2d(conv.core_geometry()).astype(float)
+    speeds = (np.ascontiguousarray(wp, dtype=float), np.ascontiguousarray(wt, dtype=float))
+    out = _core.ht_steady_states(geometry, speeds[0], speeds[1], strict, 0)
     return pd.DataFrame(
         {
             "speed_ratio": sr,

@@ -61,13 +61,20 @@ class TransientResult:
     model: str
     columns: dict[str, np.ndarray]
     events: list[Event] = field(default_factory=list)
+    #: Whether the caller chose the columns (``simulate(..., columns=[...])``): :meth:`frame` then
+    #: keeps each of them.
+    chosen_columns: bool = False
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.columns[name]
 
     def frame(self) -> pd.DataFrame:
-        """The columns as a DataFrame, without the all-NaN columns of coordinates the model lacks."""
+        """The columns as a DataFrame, without the all-NaN columns of coordinates the model lacks
+        (the columns the caller chose are all kept: a table model's ``flow_m3_s`` asked for is a
+        column of NaN, not an empty frame)."""
         df = pd.DataFrame(self.columns)
+        if self.chosen_columns:
+            return df
         return df.loc[:, df.notna().any() | (df.columns == "time_s")]
 
 
@@ -221,17 +228,6 @@ class BatchColumns:
         ]
 
 
-def _initial(initial: dict[str, float] | None) -> dict[str, float] | None:
-    allowed = {"pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s"}
-    if initial:
-        bad = set(initial) - allowed
-        if bad:
-            raise InputError(
-                "initial state", sorted(bad)[0], initial[sorted(bad)[0]], f"one of {', '.join(sorted(allowed))}"
-            )
-    return initial
-
-
 def simulate(
     converter: Converter | str | DynamicModel,
     drive: Drive,
@@ -290,7 +286,10 @@ def simulate_batch(
     _warn_about_runs(batch)
     if columns is not None and len(batch.columns) > len(columns):
         batch.columns = {name: batch.columns[name] for name in columns}
-    return batch.runs()
+    runs = batch.runs()
+    for r in runs:
+        r.chosen_columns = columns is not None
+    return runs
 
 
 def _where(i: int, n: int) -> str:
@@ -381,7 +380,7 @@ def _run_batch(
         raw = _core.transient_batch(
             [m.spec for m in models],
             specs,
-            _initial(initial),
+            initial,
             _options(rtol, **solver_options),
             threads,
             _core_columns(models, columns),

@@ -439,6 +439,17 @@ impl HtDynamics {
                 ),
             ));
         }
+        if bound == 0.0 {
+            // "|S| < 0 m²" would ask for a value none meets: the others alone use up ρL_f/A
+            let equal = sig(b.equal_shape_effect_bound_m2());
+            return Err(CoreError::new(
+                SHAPE_KEYS[i],
+                self.shape_effect_m2[i],
+                format!(
+                    "shape effects within the mass matrix's bound: the other shape effects alone already use up ρL_f/A = {inertance} (Σρ²S²/I = {shape_terms}), so no value of this one is admissible; with equal pump and turbine shape effects |S| < {equal} m² (docs/physics.md §4)"
+                ),
+            ));
+        }
         let s = self.shape_effect_m2[i].abs();
         // at the bound six digits show the same number twice: say which side the value is on
         let shown =
@@ -861,6 +872,23 @@ pub(crate) mod tests {
         let e = HtDynamics::new(g, tiny, 0.3, [0.01, 0.001, 0.001]).unwrap_err();
         assert_eq!(e.field, "inertia.pump_kg_m2", "{e}");
         assert!(!e.expected.contains("NaN"), "{e}");
+    }
+
+    #[test]
+    fn shape_effects_beyond_the_bound_together_ask_for_a_value_that_exists() {
+        // a trial: S_p = S_t = 0.5 m² was refused with "expected |S| < 0 m²", a bound no value meets
+        let inertia = Inertias::new(0.109, 0.056, 0.01).unwrap();
+        let e = HtDynamics::new(HtGeometry::appendix_d(), inertia, 0.2914, [0.5, 0.5, 0.001723]).unwrap_err();
+        assert!(!e.expected.contains("|S| < 0 m²"), "{e}");
+        assert!(e.expected.contains("no value of this one is admissible"), "{e}");
+        let ok = HtDynamics::new(HtGeometry::appendix_d(), inertia, 0.2914, [0.001, 0.001, 0.001723]).unwrap();
+        let equal = ok.mass_matrix_bound().equal_shape_effect_bound_m2();
+        assert!(e.expected.contains(&format!("|S| < {} m²", sig(equal))), "{e}");
+        // just inside the equal bound the model is accepted, just outside refused
+        assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia, 0.2914, [0.999 * equal, 0.999 * equal, 0.001723])
+            .is_ok());
+        assert!(HtDynamics::new(HtGeometry::appendix_d(), inertia, 0.2914, [1.001 * equal, 1.001 * equal, 0.001723])
+            .is_err());
     }
 
     #[test]
