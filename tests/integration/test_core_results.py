@@ -91,7 +91,7 @@ def test_drive_errors_name_the_drive():
     assert (e.value.source, e.value.field) == ("drive", "initial pump_torque_nm")
     with pytest.raises(InputError) as e:
         tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="table", times_s=[0.0, 0.5, 0.5])
-    assert (e.value.source, e.value.field) == ("drive", "time_s[2]")
+    assert (e.value.source, e.value.field) == ("argument", "times_s[2]")  # the caller's output times
 
 
 def test_initial_state_errors_name_the_initial_state():
@@ -180,3 +180,42 @@ def test_vehicle_errors_the_core_finds_name_the_vehicle_file():
     m = dynamic_model("li-sunden-2016", "table")
     with pytest.raises(TypeError):
         _core.launch_runs([m.spec], load_vehicle().core_spec(), flip_flop().core_spec())
+
+
+def test_the_batchs_arguments_are_input_errors():
+    """A trial: an empty batch was an IndexError, a converter's name among the models an
+    AttributeError, mismatched lengths a bare ValueError, ``threads=-1`` an OverflowError, a drive
+    of None an AttributeError."""
+    m, d = tr.dynamic_model("li-sunden-2016", "table"), tr.isolated_takeoff()
+    for call, field in [
+        (lambda: tr.simulate_batch([], [d]), "models"),
+        (lambda: tr.simulate_batch([m], []), "drives"),
+        (lambda: tr.simulate_batch(["li-sunden-2016"], [d]), "models[0]"),
+        (lambda: tr.simulate_batch([m, m], [d, d, d]), "drives"),
+        (lambda: tr.simulate_batch([m], [d], threads=-1), "threads"),
+        (lambda: tr.simulate("li-sunden-2016", None), "drive"),
+        (lambda: tr.simulate_batch([m, m], [d, "x"]), "drives[1]"),
+    ]:
+        with pytest.raises(InputError) as e:
+            call()
+        assert (e.value.source, e.value.field) == ("argument", field), str(e.value)
+
+
+def test_output_times_that_do_not_increase_name_the_argument():
+    """A trial: ``times_s=[1, 0.5]`` was blamed on the drive's ``time_s[2]``."""
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), "table", times_s=[1.0, 0.5])
+    assert (e.value.source, e.value.field, e.value.value) == ("argument", "times_s[1]", 0.5)
+    with pytest.raises(InputError, match=r"times_s\[2\]"):
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), "table", times_s=[0.0, 1.0, 1.0])
+
+
+def test_a_dynamic_model_runs_as_it_is_and_another_model_name_is_refused():
+    """A trial: ``simulate(ht_model, drive, model="table")`` ran Hrovat & Tobler without a word."""
+    ht = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
+    assert tr.simulate(ht, tr.isolated_takeoff(), times_s=T).model == "hrovat-tobler"
+    assert tr.simulate(ht, tr.isolated_takeoff(), "hrovat-tobler", times_s=T).model == "hrovat-tobler"
+    with pytest.raises(InputError) as e:
+        tr.simulate(ht, tr.isolated_takeoff(), model="table", times_s=T)
+    assert (e.value.source, e.value.field, e.value.value) == ("argument", "model", "table")
+    assert tr.simulate("li-sunden-2016", tr.isolated_takeoff(), times_s=T).model == "hrovat-tobler"

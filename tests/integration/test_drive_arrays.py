@@ -177,14 +177,14 @@ def test_sample_times_outside_the_span_or_not_finite_are_the_same_input_errors(t
     assert len(messages) == 1
 
 
-def test_decreasing_sample_times_are_the_cores_input_error_as_before():
+def test_decreasing_sample_times_are_one_input_error_whatever_their_type():
     m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
     errors = set()
     for given in ([0.0, 5.0, 3.0], np.array([0.0, 5.0, 3.0])):
         with pytest.raises(InputError) as e:
             tr.simulate(m, tr.isolated_takeoff(), times_s=given)
         errors.add((str(e.value), e.value.core_source))
-    assert len(errors) == 1 and "strictly increasing" in errors.pop()[0]
+    assert len(errors) == 1 and "strictly increasing" in errors.pop()[0]  # about the argument times_s[2]
 
 
 def test_a_drive_whose_start_is_nan_is_refused_by_the_core_as_before():

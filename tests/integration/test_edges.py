@@ -172,7 +172,7 @@ def test_simulate_with_a_later_first_sample_integrates_from_the_drive_start(mode
 def test_simulate_times_outside_the_drive_are_input_errors(times, field):
     with pytest.raises(InputError) as e:
         tcsim.simulate(CONVERTER, transient.isolated_takeoff(), "table", times_s=times)
-    assert e.value.field == field and e.value.source == "simulate"
+    assert e.value.field == field and e.value.source == "argument"
 
 
 # ---------------------------------------------------------------------------------------------
@@ -230,7 +230,7 @@ def test_steady_state_broadcasts_any_sign_and_marks_points_without_a_steady_stat
 def test_steady_state_input_errors_name_the_argument_and_index(wp, wt, field):
     with pytest.raises(InputError) as e:
         tcsim.steady_state(CONVERTER, "table", wp, wt)
-    assert e.value.field == field and e.value.source == "steady_state"
+    assert e.value.field == field and e.value.source == "argument"
 
 
 def test_steady_state_unknown_model():

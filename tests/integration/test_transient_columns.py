@@ -169,9 +169,9 @@ def test_an_unknown_or_repeated_column_is_one_input_error(columns, field, value,
     ):
         with pytest.raises(InputError) as e:
             call()
-        assert (e.value.source, e.value.field, str(e.value.value)) == ("simulate", field, value)
+        assert (e.value.source, e.value.field, str(e.value.value)) == ("argument", field, value)
         assert e.value.expected.startswith(expected) and "\n" not in str(e.value)
-    with pytest.raises(InputError, match=r"^simulate: columns = 'time_s': expected a list of output column names"):
+    with pytest.raises(InputError, match=r"^argument: columns = 'time_s': expected a list of output column names"):
         tr.simulate(m, tr.isolated_takeoff(), columns="time_s")
     if field == "columns[1]" and value == "pump_speed":
         assert e.value.expected.endswith(", ".join(tr.COLUMNS))

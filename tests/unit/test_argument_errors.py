@@ -5,6 +5,7 @@ errors with its options (a trial: ``tcsim.characterise(..., pump_speed_rpm=0)`` 
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import tcsim
@@ -62,3 +63,40 @@ def test_warnings_and_options_as_the_command_line_words_them():
     assert on_command_line("m.csv: argument: x = 1") == "m.csv: argument: x = 1"  # only at the start
     assert option_name("out_path") == "--out" and option_name("bounds") == "--bound"
     assert option_name("speed_ratio_max") == "--speed-ratio-max"
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "field"),
+    [
+        (dict(speed_ratio="0:1"), "speed_ratio"),
+        (dict(speed_ratio=np.zeros((2, 2))), "speed_ratio"),
+        (dict(speed_ratio=[0.3, np.nan]), "speed_ratio[1]"),
+        (dict(pump_speed_rpm="2000"), "pump_speed_rpm"),
+        (dict(pump_speed_rpm=[2000.0]), "pump_speed_rpm"),
+        (dict(input_torque_nm="100"), "input_torque_nm"),
+    ],
+)
+def test_characterise_refuses_arguments_of_the_wrong_kind(kwargs, field):
+    """A trial: these were a TypeError or ValueError from NumPy, or (NaN) an error about the
+    converter file's turbine speed."""
+    with pytest.raises(InputError) as e:
+        tcsim.characterise("li-sunden-2016", "table", **kwargs)
+    assert (e.value.source, e.value.field) == (ARGUMENT, field), str(e.value)
+
+
+def test_characterise_takes_one_speed_ratio_as_a_number():
+    one = tcsim.characterise("li-sunden-2016", "table", speed_ratio=0.5)
+    assert list(one["speed_ratio"]) == [0.5]
+    assert one.equals(tcsim.characterise("li-sunden-2016", "table", speed_ratio=np.array(0.5)))
+
+
+@pytest.mark.parametrize("converter", [None, 5, ["li-sunden-2016"]])
+def test_the_one_liners_refuse_what_is_not_a_converter(converter):
+    for call in (
+        lambda: tcsim.characterise(converter),
+        lambda: tcsim.steady_state(converter, "table", 100.0, 50.0),
+        lambda: tcsim.operating_point(converter, [100.0], [50.0]),
+    ):
+        with pytest.raises(InputError) as e:
+            call()
+        assert (e.value.source, e.value.field) == (ARGUMENT, "converter")

@@ -294,7 +294,7 @@ def _filtered(rates: str, measured_time_s, keep: np.ndarray) -> tuple[np.ndarray
     """``rates`` of :func:`fit_shape_effects`: None for "model", else (every measured time stamp,
     the fit points among them) for "filtered"."""
     if rates not in RATES:
-        raise InputError("fit_shape_effects", "rates", rates, f"one of {', '.join(RATES)}")
+        raise InputError.argument("rates", rates, f"one of {', '.join(RATES)}")
     if rates == "model":
         return None
     t = np.asarray(measured_time_s, dtype=float)

@@ -12,6 +12,7 @@ Each returns a :class:`pandas.DataFrame` with the columns of ``characteristic.cs
 
 from __future__ import annotations
 
+import numbers
 from pathlib import Path
 
 import numpy as np
@@ -369,20 +370,20 @@ def _finite_speeds(**speeds) -> tuple[np.ndarray, np.ndarray]:
         try:
             a = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
-            raise InputError("steady_state", name, value, "numbers (rad/s)") from None
+            raise InputError.argument(name, value, "numbers (rad/s)") from None
         if a.ndim == 0 and not np.isfinite(a):  # argwhere of a 0-d array finds nothing: a scalar NaN passed
-            raise InputError("steady_state", name, float(a), "a finite speed in rad/s")
+            raise InputError.argument(name, float(a), "a finite speed in rad/s")
         bad = np.argwhere(~np.isfinite(a))
         if bad.size:
             index = tuple(int(i) for i in bad[0])
             where = "[" + ", ".join(map(str, index)) + "]" if index else ""
-            raise InputError("steady_state", f"{name}{where}", float(a[index]), "a finite speed in rad/s")
+            raise InputError.argument(f"{name}{where}", float(a[index]), "a finite speed in rad/s")
         arrays.append(a)
     try:
         wp, wt = np.broadcast_arrays(*arrays)
     except ValueError:
         shapes = " and ".join(str(a.shape) for a in arrays)
-        raise InputError("steady_state", "turbine_speed_rad_s", f"shape {shapes}", "shapes that broadcast") from None
+        raise InputError.argument("turbine_speed_rad_s", f"shape {shapes}", "shapes that broadcast") from None
     return np.ascontiguousarray(wp, dtype=float).reshape(-1), np.ascontiguousarray(wt, dtype=float).reshape(-1)
 
 
@@ -415,7 +416,7 @@ def steady_state(conv: Converter, model: str, pump_speed_rad_s, turbine_speed_ra
         (``pump_speed_rad_s[i]``) or shapes that do not broadcast.
     """
     if model not in MODELS:
-        raise InputError("steady_state", "model", model, f"one of {', '.join(MODELS)}")
+        raise InputError.argument("model", model, f"one of {', '.join(MODELS)}")
     conv.require(model)
     wp, wt = _finite_speeds(pump_speed_rad_s=pump_speed_rad_s, turbine_speed_rad_s=turbine_speed_rad_s)
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -444,9 +445,39 @@ def characterise(
     (input) torque, the pump speed solved at each speed ratio (:func:`characterise_at_input_torque`).
     A pump speed outside the plausible range (``speed_rad_s``) is refused unless ``allow_implausible``."""
     conv.require(model)
+    speed_ratio = _speed_ratio_argument(speed_ratio)
     if input_torque_nm is not None:
-        return characterise_at_input_torque(conv, model, input_torque_nm, speed_ratio, allow_implausible)
-    return CHARACTERISE[model](conv, pump_speed_rpm, speed_ratio, allow_implausible)
+        torque = _number_argument("input_torque_nm", input_torque_nm)
+        return characterise_at_input_torque(conv, model, torque, speed_ratio, allow_implausible)
+    return CHARACTERISE[model](conv, _number_argument("pump_speed_rpm", pump_speed_rpm), speed_ratio, allow_implausible)
+
+
+def _number_argument(name: str, value: object) -> float:
+    """``value`` as a float when it is one real number (a Python or NumPy number, a 0-d array),
+    else an :class:`InputError` about the argument ``name`` (a string, a list, a bool)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise InputError.argument(name, value, "a number")
+    return float(value)
+
+
+def _speed_ratio_argument(speed_ratio: object) -> np.ndarray | None:
+    """The speed ratios a caller gave (a number, a list or a 1-D array) as a 1-D float array, None
+    when not given; anything else, or a ratio that is not finite, is an :class:`InputError` about the
+    argument ``speed_ratio`` (NaN was blamed on the converter file's turbine speed)."""
+    if speed_ratio is None:
+        return None
+    try:
+        sr = np.atleast_1d(np.asarray(speed_ratio, dtype=float))
+    except (TypeError, ValueError):
+        raise InputError.argument("speed_ratio", speed_ratio, "speed ratios: a number, a list or a 1-D array") from None
+    if sr.ndim != 1:
+        raise InputError.argument("speed_ratio", f"{sr.ndim}-D array", "speed ratios: a number, a list or a 1-D array")
+    bad = np.flatnonzero(~np.isfinite(sr))
+    if bad.size:
+        raise InputError.argument(f"speed_ratio[{bad[0]}]", float(sr[bad[0]]), "a finite speed ratio")
+    return sr
 
 
 def characterise_at_input_torque(

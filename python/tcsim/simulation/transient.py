@@ -30,7 +30,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError, core_input_error, from_core
+from ..errors import ARGUMENT, InputError, core_input_error, from_core
 from ..models.converter import Converter
 from ..models.drives import Drive
 from ..models.dynamic import DynamicModel, dynamic_model
@@ -228,10 +228,14 @@ class BatchColumns:
         ]
 
 
+#: The model :func:`simulate` runs of a converter when none is named.
+DEFAULT_MODEL = "hrovat-tobler"
+
+
 def simulate(
     converter: Converter | str | DynamicModel,
     drive: Drive,
-    model: str = "hrovat-tobler",
+    model: str | None = None,
     times_s: Sequence[float] | None = None,
     initial: dict[str, float] | None = None,
     rtol: float | None = None,
@@ -240,6 +244,10 @@ def simulate(
     **solver_options,
 ) -> TransientResult:
     """Run one model under one drive; samples at ``times_s`` (default: the drive's time stamps).
+
+    ``converter`` is a converter (a :class:`~tcsim.Converter`, bundled name or file) whose model
+    ``model`` runs (default :data:`DEFAULT_MODEL`), or a :class:`DynamicModel`, which runs as it is
+    (``model`` then none or its own name).
 
     The run always integrates from the drive's first time stamp; ``times_s`` (s, increasing, within
     the drive's span) only chooses the samples, so a later first sample gives the same values as a
@@ -252,7 +260,12 @@ def simulate(
     ``stator_speed_rad_s`` or ``flow_m3_s``. ``files`` names the file of an input the core may
     blame in an :class:`InputError` (``{"drive": "log.csv"}``; see :func:`simulate_batch`).
     """
-    m = converter if isinstance(converter, DynamicModel) else dynamic_model(converter, model)
+    if isinstance(converter, DynamicModel):
+        m = converter
+        if model is not None and model != m.name:  # it was ignored: a table model's run for "hrovat-tobler"
+            raise InputError.argument("model", model, f"none, or the DynamicModel's own ({m.name!r})")
+    else:
+        m = dynamic_model(converter, DEFAULT_MODEL if model is None else model)
     return simulate_batch(
         [m], [drive], times_s, initial, rtol, threads=1, files=files, columns=columns, **solver_options
     )[0]
@@ -304,9 +317,14 @@ def _warning_rows(batch: BatchColumns, i: int) -> dict[str, np.ndarray]:
 def _drive_specs(drives: Sequence[Drive], times_s: Sequence[float] | None) -> tuple[list[dict], np.ndarray | None]:
     """The drives' dicts for the core (with ``output_time_s`` and ``output_skip`` for ``times_s``) and
     the sample times every run shares, s (None when the drives' time stamps differ)."""
+    if isinstance(drives, str) or not isinstance(drives, Sequence) or not drives:
+        raise InputError.argument("drives", drives, "a list of one or more drives")
     specs = []
-    for d in drives:
+    for i, d in enumerate(drives):
         core_spec = getattr(d, "_core_spec", None)  # the series as arrays (a stand-in drive: its spec())
+        if core_spec is None and not callable(getattr(d, "spec", None)):
+            expected = "a drive: tcsim.transient.PumpTorqueTurbineSpeed, Speeds or PumpTorqueLoad"
+            raise InputError.argument("drive" if len(drives) == 1 else f"drives[{i}]", type(d).__name__, expected)
         s = core_spec() if core_spec is not None else d.spec()
         if times_s is not None:
             s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s)
@@ -375,6 +393,7 @@ def _run_batch(
     """The one call of the core's ``transient_batch`` (:func:`simulate_columns`), with the columns
     the warnings read added for table models (:func:`_core_columns`); ``shaped`` as in
     :func:`_batch_columns`."""
+    _check_batch(models, drives, threads)
     specs, shared_time = _drive_specs(drives, times_s)
     try:
         raw = _core.transient_batch(
@@ -387,11 +406,30 @@ def _run_batch(
         )
     except _core.CoreInputError as e:
         if str(e.args[1]).startswith("columns["):
-            raise from_core(e, "simulate") from None
+            raise from_core(e, ARGUMENT) from None
         converters = {m.source for m in models}
         sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
         raise from_core(e, sources) from None
     return _batch_columns(raw, models, shared_time, files, shaped)
+
+
+def _check_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], threads: int) -> None:
+    r"""The arguments of a batch that the core would refuse as a bare ``ValueError`` or an
+    ``OverflowError``, or that fail before it (a converter's name among the models), as
+    :class:`InputError` about them."""
+    if isinstance(models, str) or not isinstance(models, Sequence) or not models:
+        raise InputError.argument(
+            "models", models, "a list of one or more models (tcsim.dynamic_model(converter, name))"
+        )
+    for i, m in enumerate(models):
+        if not isinstance(m, DynamicModel):
+            expected = "a DynamicModel (tcsim.dynamic_model(converter, name); simulate() also takes a name)"
+            raise InputError.argument(f"models[{i}]", type(m).__name__, expected)
+    if isinstance(drives, Sequence) and len(models) != len(drives) and 1 not in (len(models), len(drives)):
+        expected = f"as many drives as models ({len(models)}), or one of either"
+        raise InputError.argument("drives", f"{len(drives)} drives", expected)
+    if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 0:
+        raise InputError.argument("threads", threads, "a whole number of workers, 0 for one per core")
 
 
 def _core_columns(models: Sequence[DynamicModel], columns: Sequence[str] | None) -> list[str] | None:
@@ -399,7 +437,7 @@ def _core_columns(models: Sequence[DynamicModel], columns: Sequence[str] | None)
     if columns is None:
         return None
     if isinstance(columns, str):
-        raise InputError("simulate", "columns", columns, "a list of output column names (one name: [name])")
+        raise InputError.argument("columns", columns, "a list of output column names (one name: [name])")
     chosen = [str(c) for c in columns]
     if any(m.name in ("table", "quasi-dynamic") for m in models):
         chosen += [c for c in _WARNING_COLUMNS if c not in chosen]
@@ -473,20 +511,24 @@ def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float
     span = _floats_1d(drive_time_s)
     start, end = float(span[0]), float(span[-1])
     if t.ndim != 1 or t.size < 1:
-        raise InputError("simulate", "times_s", f"shape {t.shape}", "a one-dimensional sequence of output times")
+        raise InputError.argument("times_s", f"shape {t.shape}", "a one-dimensional sequence of output times")
     if not (start <= t.min() and t.max() <= end):  # a time outside the span or NaN (or a NaN span)
         outside = np.flatnonzero(~np.isfinite(t) | (t < start) | (t > end))
         if outside.size:
             i = int(outside[0])
-            raise InputError(
-                "simulate", f"times_s[{i}]", float(t[i]), f"a time within the drive's span, {start:g} to {end:g} s"
+            raise InputError.argument(
+                f"times_s[{i}]", float(t[i]), f"a time within the drive's span, {start:g} to {end:g} s"
             )
+    if t.size > 1 and not (np.diff(t) > 0).all():  # the core would blame the drive's time_s[i + 1]
+        i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
+        raise InputError.argument(
+            f"times_s[{i}]", float(t[i]), f"strictly increasing times (times_s[{i - 1}] = {t[i - 1]:g})"
+        )
     if t[0] == start:
         return t, 0
     resolution = _core.time_resolution_s(start)
     if t[0] - start < (1.0 - 1e-3) * resolution:
-        raise InputError(
-            "simulate",
+        raise InputError.argument(
             "times_s[0]",
             float(t[0]),
             f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
