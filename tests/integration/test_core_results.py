@@ -219,3 +219,11 @@ def test_a_dynamic_model_runs_as_it_is_and_another_model_name_is_refused():
         tr.simulate(ht, tr.isolated_takeoff(), model="table", times_s=T)
     assert (e.value.source, e.value.field, e.value.value) == ("argument", "model", "table")
     assert tr.simulate("li-sunden-2016", tr.isolated_takeoff(), times_s=T).model == "hrovat-tobler"
+
+
+def test_a_drive_of_one_time_stamp_says_so():
+    """A trial: ``time_s = 1 samples: expected at least two output times`` for a drive the user
+    gave one time stamp."""
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.PumpTorqueLoad([0.0], 100.0, 1.2))
+    assert str(e.value) == "drive: time_s = 1 time stamp: expected at least two"

@@ -151,13 +151,22 @@ def test_a_power_gives_the_torque_p_over_omega():
         ({"model": "vecto"}, "model"),
         ({"pump_speed_limit_rad_s": 0.0}, "pump_speed_limit_rad_s"),
         ({"pump_speed_limit_rad_s": float("nan")}, "pump_speed_limit_rad_s"),
-        ({"turbine_power_w": [1.0]}, "turbine_torque_nm"),
+        ({"turbine_power_w": [1.0]}, "turbine_power_w"),  # with a torque too: named as the one too many
     ],
 )
 def test_api_refuses_bad_arguments(kwargs, field):
     with pytest.raises(InputError) as e:
         tcsim.operating_point("li-sunden-2016", [100.0], [50.0], **kwargs)
-    assert e.value.field == field
+    assert (e.value.source, e.value.field) == ("argument", field)
+
+
+def test_a_load_not_given_asks_for_one():
+    """A trial: ``operating_point(C, [100])`` said ``turbine_torque_nm = 'neither': expected either
+    … not both``."""
+    with pytest.raises(InputError) as e:
+        tcsim.operating_point("li-sunden-2016", [100.0])
+    assert (e.value.field, e.value.value) == ("turbine_torque_nm", None)
+    assert "not both" not in e.value.expected and "turbine_power_w" in e.value.expected
 
 
 def test_api_refuses_text_and_shapes_that_do_not_broadcast():

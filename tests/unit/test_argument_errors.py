@@ -10,6 +10,7 @@ import pytest
 
 import tcsim
 from tcsim.errors import ARGUMENT, InputError, on_command_line, option_name
+from tcsim.io.tables import write_table
 
 
 @pytest.mark.parametrize(
@@ -100,3 +101,16 @@ def test_the_one_liners_refuse_what_is_not_a_converter(converter):
         with pytest.raises(InputError) as e:
             call()
         assert (e.value.source, e.value.field) == (ARGUMENT, "converter")
+
+
+def test_small_edges_of_the_api(tmp_path):
+    """A trial: ``steady_state(C, "table", None, 100)`` said ``pump_speed_rad_s = nan``;
+    ``write_table`` into a missing folder was pandas' OSError."""
+    with pytest.raises(InputError) as e:
+        tcsim.steady_state("li-sunden-2016", "table", None, 100.0)
+    assert (e.value.field, e.value.value) == ("pump_speed_rad_s", None)
+    frame = tcsim.characterise("li-sunden-2016", "table", speed_ratio=[0.0, 0.5])
+    with pytest.raises(InputError) as e:
+        write_table(frame, tmp_path / "missing", "characteristic.csv")
+    assert (e.value.source, e.value.field) == (ARGUMENT, "out_dir") and not (tmp_path / "missing").exists()
+    assert write_table(frame, tmp_path, "characteristic.csv").is_file()

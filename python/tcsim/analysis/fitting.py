@@ -200,7 +200,10 @@ def default_speed_ratio_max(table: Characteristic) -> float:
     drive = (sr >= 0) & (sr < 1)
     if not drive.any():
         raise InputError(
-            table.source, "speed_ratio", f"{sr[0]:g} to {sr[-1]:g}", "table points with SR from 0 to below 1"
+            table.source or "Characteristic",
+            "speed_ratio",
+            f"{sr[0]:g} to {sr[-1]:g}",
+            "table points with SR from 0 to below 1",
         )
     return float(sr[drive][-1])
 
@@ -594,13 +597,14 @@ def warn_if_missed(source: str, sr, tr_table, cf_table, tr_model, cf_model) -> N
 
 def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elapsed) -> FitResult:
     x = problem.to_x(res.x)
+    label = table.source or "the table"  # a Characteristic made in Python has no file
     values = geometry.model_dump()
     values.update({n: float(v) for n, v in zip(problem.free, x)})
     fitted = GeometrySection(**values)
     tr, cf, _, _ = problem.evaluate(res.x)
     stats = _correlation(problem.jacobian(res.x), float(res.cost))
     active = _active(problem, res.x, res.active_mask)
-    warned = parameter_warnings(table.source, {n: getattr(fitted, n) for n in problem.free}, bounds, active)
+    warned = parameter_warnings(label, {n: getattr(fitted, n) for n in problem.free}, bounds, active)
     notes = []
     if stats["rank"] < len(problem.free):
         notes.append(
@@ -612,13 +616,13 @@ def _result(problem: _Problem, res, geometry, bounds, srmax, table, n_run, elaps
         # on the terminal too: a fit of 10 parameters to 2 points reported success with exit 0 (the
         # default free set's own rank deficiency, 7 of 10 on a full table, is the report's to explain)
         warnings.warn(
-            f"{table.source}: the fit is not unique: {len(tr)} points give {2 * len(tr)} values (TR and "
+            f"{label}: the fit is not unique: {len(tr)} points give {2 * len(tr)} values (TR and "
             f"CF) for {len(problem.free)} free parameters (rank {stats['rank']}); free fewer parameters or "
             "fit a table with more points",
             TcsimWarning,
             stacklevel=2,
         )
-    warn_if_missed(table.source, problem.sr, problem.tr, problem.cf, np.asarray(tr), np.asarray(cf))
+    warn_if_missed(label, problem.sr, problem.tr, problem.cf, np.asarray(tr), np.asarray(cf))
     size = ("fluid_density_kg_m3" in problem.free, "flow_area_m2" in problem.free, bool(set(problem.free) & set(RADII)))
     if sum(size) > 1:
         notes.append(

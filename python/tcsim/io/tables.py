@@ -194,6 +194,8 @@ WRITERS: dict[str, Callable[[pd.DataFrame, Path], None]] = {
 
 def write_table(df: pd.DataFrame, out_dir: Path, name: str, table_format: TableFormat = CSV) -> Path:
     """``df`` as ``out_dir/<name>`` with ``table_format``'s suffix, speed unit and writer; the path."""
+    if not Path(out_dir).is_dir():  # pandas' OSError named neither the argument nor what to do
+        raise InputError.argument("out_dir", str(out_dir), "an existing directory")
     path = Path(out_dir) / table_format.file_name(name)
     WRITERS[table_format.format](to_speed_unit(df, table_format.speed_unit), path)
     return path

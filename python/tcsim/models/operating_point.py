@@ -12,7 +12,7 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import InputError
+from ..errors import ARGUMENT, InputError
 from .converter import Converter
 from .steady import MODELS
 
@@ -60,8 +60,11 @@ def _load(source: str, wt, torque, power) -> tuple[np.ndarray, np.ndarray, str]:
     """Turbine speeds and the load (torque or power) as flat float arrays broadcast against each
     other, and which load it is (``turbine_torque_nm`` or ``turbine_power_w``)."""
     if (torque is None) == (power is None):
-        given = "both" if torque is not None else "neither"
-        raise InputError(source, "turbine_torque_nm", given, "either turbine_torque_nm or turbine_power_w, not both")
+        if torque is not None:
+            raise InputError(
+                source, "turbine_power_w", "given too", "either turbine_torque_nm or turbine_power_w, not both"
+            )
+        raise InputError(source, "turbine_torque_nm", None, "a turbine torque, or turbine_power_w (one of them)")
     name = "turbine_torque_nm" if torque is not None else "turbine_power_w"
     speeds = _numbers(source, "turbine_speed_rad_s", wt)
     load = _numbers(source, name, torque if torque is not None else power)
@@ -149,7 +152,7 @@ def operating_point(
     segment of the characteristic the output torque is a quadratic in the input speed, solved in
     closed form.
     """
-    source = "operating_point"
+    source = ARGUMENT
     if model not in MODELS:
         raise InputError(source, "model", model, f"one of {', '.join(MODELS)}")
     conv.require(model)

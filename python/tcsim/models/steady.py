@@ -368,6 +368,8 @@ def _finite_speeds(**speeds) -> tuple[np.ndarray, np.ndarray]:
     arrays = []
     for name, value in speeds.items():
         try:
+            if value is None:  # np.asarray(None, dtype=float) is NaN: "pump_speed_rad_s = nan"
+                raise TypeError
             a = np.asarray(value, dtype=float)
         except (TypeError, ValueError):
             raise InputError.argument(name, value, "numbers (rad/s)") from None

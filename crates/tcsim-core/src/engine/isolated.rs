@@ -417,8 +417,11 @@ pub fn simulate(
 /// co-simulation stepper's probe need not be.
 fn check_times(times_s: &[f64], resolution: bool) -> TransientResult<()> {
     if times_s.len() < 2 {
-        let n = format!("{} samples", times_s.len());
-        return Err(CoreError::of(InputSource::Drive, "time_s", n, "at least two output times").into());
+        let n = match times_s.len() {
+            1 => "1 time stamp".to_string(),
+            n => format!("{n} time stamps"),
+        };
+        return Err(CoreError::of(InputSource::Drive, "time_s", n, "at least two").into());
     }
     if resolution {
         return crate::engine::signal::check_time_stamps("time_s", times_s)
