@@ -227,3 +227,23 @@ def test_a_drive_of_one_time_stamp_says_so():
     with pytest.raises(InputError) as e:
         tr.simulate("li-sunden-2016", tr.PumpTorqueLoad([0.0], 100.0, 1.2))
     assert str(e.value) == "drive: time_s = 1 time stamp: expected at least two"
+
+
+@pytest.mark.parametrize(
+    ("drive", "field"),
+    [
+        (lambda: tr.PumpTorqueTurbineSpeed(np.array(0.0), np.array(1.0), np.array(0.0)), "time_s"),
+        (lambda: tr.PumpTorqueTurbineSpeed([0.0, 1.0, 2.0], ["a", "b", "c"], [0.0, 0.0, 0.0]), "pump_torque_nm"),
+        (lambda: tr.PumpTorqueTurbineSpeed([0.0, 1.0, 2.0], "abc", [0.0, 0.0, 0.0]), "pump_torque_nm"),
+        (lambda: tr.PumpTorqueLoad([0.0, 1.0], [100.0, 100.0], 1.2, load_torque_nm="x"), "load_torque_nm"),
+    ],
+)
+def test_a_drive_series_that_is_not_numbers_names_the_series(drive, field):
+    """A trial: these were ``ValueError: time_s: TypeError: 'float' object is not an instance of
+    'Sequence'`` and NumPy's ``could not convert string to float``."""
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", drive(), "table")
+    assert (e.value.source, e.value.field) == ("drive", field), str(e.value)
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), "table", times_s="0:1")
+    assert (e.value.source, e.value.field) == ("argument", "times_s")

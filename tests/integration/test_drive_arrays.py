@@ -130,14 +130,16 @@ def test_the_binding_gives_an_array_the_errors_of_its_list(key, value):
     assert outcomes[1] == outcomes[0] and outcomes[2] == outcomes[0]
 
 
-def test_a_drive_series_of_another_shape_is_refused_as_its_nested_list_was():
+def test_a_drive_series_of_another_shape_is_refused_as_its_nested_list_is():
     m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
     errors = set()
     for torque in (np.array(TORQUE)[:, None], np.array(TORQUE)[:, None].tolist()):
-        with pytest.raises(ValueError) as e:
+        with pytest.raises(InputError) as e:  # was a bare ValueError naming a TypeError
             tr.simulate(m, tr.PumpTorqueLoad(T4, torque, 1.2), times_s=TIMES)
         errors.add(str(e.value))
-    assert errors == {"pump_torque_nm: TypeError: must be real number, not list"}
+    assert errors == {
+        "drive: pump_torque_nm = [[40.0], [40.0], [120.0], [120.0]]: expected numbers: a list or a 1-D array of them"
+    }
 
 
 def test_a_0d_array_is_a_constant_and_a_nan_one_is_refused_as_a_nan_number():

@@ -821,7 +821,16 @@ fn numbers(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
 
 /// [`item`] for a series ([`numbers`]), with its messages.
 fn numbers_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Vec<f64>> {
-    numbers(&present(d, key)?).map_err(|e| field_error(key, e))
+    let v = present(d, key)?;
+    numbers(&v).map_err(|_| not_numbers(key, &v))
+}
+
+/// The input error of a drive's series `key` that is not numbers (a string, a 0-d array, a list of
+/// text): it was a `ValueError` ("time_s: TypeError: 'float' object is not an instance of
+/// 'Sequence'") that named neither the drive nor what was expected.
+fn not_numbers(key: &str, v: &Bound<'_, PyAny>) -> PyErr {
+    let value = v.repr().map(|r| r.to_string_lossy().into_owned()).unwrap_or_default();
+    input_error(CoreError::of(InputSource::Drive, key, value, "numbers: a list or a 1-D array of them"))
 }
 
 /// [`opt_item`] for a series ([`numbers`]), with its messages.
@@ -829,7 +838,7 @@ fn opt_numbers_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Option<Vec<f64
     match d.get_item(key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
-        Some(v) => numbers(&v).map(Some).map_err(|e| field_error(key, e)),
+        Some(v) => numbers(&v).map(Some).map_err(|_| not_numbers(key, &v)),
     }
 }
 

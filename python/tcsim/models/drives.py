@@ -24,18 +24,24 @@ DERIVATIVE_WINDOW_S = 0.04
 
 
 def _arr(x: Any) -> list[float] | float:
-    if np.isscalar(x):
-        return float(x)  # type: ignore[arg-type]  # a real scalar; complex inputs are not drives
-    return np.asarray(x, dtype=float).tolist()
+    try:
+        if np.isscalar(x):
+            return float(x)  # type: ignore[arg-type]  # a real scalar; complex inputs are not drives
+        return np.asarray(x, dtype=float).tolist()
+    except (TypeError, ValueError):
+        return x  # not numbers: the core's input error names the drive's series
 
 
 def _series(x: Any) -> np.ndarray | list[float] | float:
     """:func:`_arr` for the core (``Drive._core_spec``): a one-dimensional series as a float64 array,
     which the binding copies in one go instead of a list's floats one by one; a number, a 0-d array
     or an array of another shape as :func:`_arr` gives it (so the same constant, or the same error)."""
-    if not isinstance(x, np.ndarray) and np.isscalar(x):  # (an array is never a scalar here)
-        return float(x)  # type: ignore[arg-type]  # a real scalar; complex inputs are not drives
-    a = np.asarray(x, dtype=float)
+    try:
+        if not isinstance(x, np.ndarray) and np.isscalar(x):  # (an array is never a scalar here)
+            return float(x)  # type: ignore[arg-type]  # a real scalar; complex inputs are not drives
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        return x  # not numbers (text): the core's input error names the drive's series
     return a if a.ndim == 1 else a.tolist()
 
 

@@ -507,7 +507,10 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
 
 def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]) -> tuple[np.ndarray, int]:
     """:func:`output_times` with the times as a float64 array (what the runs pass to the core)."""
-    t = _floats_1d(times_s)
+    try:
+        t = _floats_1d(times_s)
+    except (TypeError, ValueError):
+        raise InputError.argument("times_s", times_s, "output times, s: a list or a 1-D array of numbers") from None
     span = _floats_1d(drive_time_s)
     start, end = float(span[0]), float(span[-1])
     if t.ndim != 1 or t.size < 1:
