@@ -295,7 +295,12 @@ def simulate_batch(
     ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs, counting only the
     chosen columns, is refused above it before anything runs)."""
     batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options, shaped=False)
-    batch.check()
+    try:
+        batch.check()
+    except InputError as e:
+        if times_s is not None and e.core_source == "drive":  # the core names the output times the drive's
+            _check_increasing(_floats_1d(times_s))
+        raise
     _warn_about_runs(batch)
     if columns is not None and len(batch.columns) > len(columns):
         batch.columns = {name: batch.columns[name] for name in columns}
@@ -522,11 +527,6 @@ def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float
             raise InputError.argument(
                 f"times_s[{i}]", float(t[i]), f"a time within the drive's span, {start:g} to {end:g} s"
             )
-    if t.size > 1 and not (np.diff(t) > 0).all():  # the core would blame the drive's time_s[i + 1]
-        i = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 1
-        raise InputError.argument(
-            f"times_s[{i}]", float(t[i]), f"strictly increasing times (times_s[{i - 1}] = {t[i - 1]:g})"
-        )
     if t[0] == start:
         return t, 0
     resolution = _core.time_resolution_s(start)
@@ -537,6 +537,16 @@ def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float
             f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
         )
     return np.concatenate(([start], t)), 1
+
+
+def _check_increasing(t: np.ndarray) -> None:
+    """An :class:`InputError` about the argument ``times_s[i]`` unless ``t`` increases strictly (the
+    core checks it on every run and blames the drive's ``time_s[i + 1]``; this names the caller's
+    argument once the core has refused)."""
+    if t.size > 1 and not (t[1:] > t[:-1]).all():
+        i = int(np.flatnonzero(t[1:] <= t[:-1])[0]) + 1
+        expected = f"strictly increasing times (times_s[{i - 1}] = {t[i - 1]:g})"
+        raise InputError.argument(f"times_s[{i}]", float(t[i]), expected)
 
 
 def _floats_1d(x: Any) -> np.ndarray:
