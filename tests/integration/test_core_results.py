@@ -247,3 +247,12 @@ def test_a_drive_series_that_is_not_numbers_names_the_series(drive, field):
     with pytest.raises(InputError) as e:
         tr.simulate("li-sunden-2016", tr.isolated_takeoff(), "table", times_s="0:1")
     assert (e.value.source, e.value.field) == ("argument", "times_s")
+
+
+def test_a_launch_option_of_the_wrong_kind_is_refused():
+    v = load_vehicle()
+    models = select_models(v, ["table"])
+    for options, field in [({"output_step_s": "fine"}, "output_step_s"), ({"output_step": 0.01}, "output_step")]:
+        with pytest.raises(InputError) as e:
+            run_launch(v, flip_flop(), models, options=options)
+        assert (e.value.source, e.value.field) == ("solver options", field)

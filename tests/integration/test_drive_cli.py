@@ -178,3 +178,16 @@ def test_an_out_that_cannot_be_written_is_refused_before_the_drive_runs(cli, tmp
     assert line.startswith(f"error: command line: --out = '{out}': expected a "), line
     assert ("a writable directory (" if where == "a read-only file system" else "(a file of that name exists)") in line
     assert not out.exists() if where == "a read-only file system" else out.read_text() == "kept\n"
+
+
+@pytest.mark.parametrize(
+    ("options", "field"),
+    [({"driver_kp": 1.0}, "driver_kp"), ({"driver_kp_per_s": "fast"}, "driver_kp_per_s"), ({"rtoll": 1e-6}, "rtoll")],
+)
+def test_a_misspelt_or_mistyped_driver_option_is_refused(options, field):
+    """A misspelt option was ignored (the run used the default); a gain given as text was a bare
+    ValueError of the binding."""
+    v = load_vehicle()
+    with pytest.raises(InputError) as e:
+        run_drive(v, standstill(0.01), select_models(v.converter, ["table"]), options=options)
+    assert (e.value.core_source, e.value.field) == ("options", field)

@@ -829,8 +829,12 @@ fn numbers_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Vec<f64>> {
 /// text): it was a `ValueError` ("time_s: TypeError: 'float' object is not an instance of
 /// 'Sequence'") that named neither the drive nor what was expected.
 fn not_numbers(key: &str, v: &Bound<'_, PyAny>) -> PyErr {
-    let value = v.repr().map(|r| r.to_string_lossy().into_owned()).unwrap_or_default();
-    input_error(CoreError::of(InputSource::Drive, key, value, "numbers: a list or a 1-D array of them"))
+    input_error(CoreError::of(InputSource::Drive, key, shown(v), "numbers: a list or a 1-D array of them"))
+}
+
+/// A value as an error shows it: its Python `repr` (`'a'`, `[1.0, 2.0]`).
+fn shown(v: &Bound<'_, PyAny>) -> String {
+    v.repr().map(|r| r.to_string_lossy().into_owned()).unwrap_or_default()
 }
 
 /// [`opt_item`] for a series ([`numbers`]), with its messages.
@@ -958,8 +962,7 @@ fn known_keys(d: &Bound<'_, PyDict>, source: InputSource, known: &[&str]) -> PyR
         let name = k.str()?.to_string_lossy().into_owned();
         if !known.contains(&name.as_str()) {
             let expected = format!("a known name, one of {}", known.join(", "));
-            let value = v.repr().map(|r| r.to_string_lossy().into_owned()).unwrap_or_default();
-            return Err(input_error(CoreError::of(source, name, value, expected)));
+            return Err(input_error(CoreError::of(source, name, shown(&v), expected)));
         }
     }
     Ok(())
@@ -976,10 +979,7 @@ fn opt_input<'py, T: FromPyObjectOwned<'py>>(
     match d.get_item(key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
-        Some(v) => v.extract::<T>().map(Some).map_err(|_| {
-            let value = v.repr().map(|r| r.to_string_lossy().into_owned()).unwrap_or_default();
-            input_error(CoreError::of(source, key, value, expected))
-        }),
+        Some(v) => v.extract::<T>().map(Some).map_err(|_| input_error(CoreError::of(source, key, shown(&v), expected))),
     }
 }
 
@@ -1439,7 +1439,9 @@ fn launch_runs<'py>(
         let sc = scenario_from(&scenario)?;
         let solver = options_from(options.as_ref(), &["output_step_s"])?;
         let step: f64 = match options.as_ref() {
-            Some(o) => opt_item(o, "output_step_s")?.unwrap_or(DEFAULT_OUTPUT_STEP_S),
+            Some(o) => {
+                opt_input(o, InputSource::Options, "output_step_s", "a number")?.unwrap_or(DEFAULT_OUTPUT_STEP_S)
+            }
             None => DEFAULT_OUTPUT_STEP_S,
         };
         let parsed = models.iter().map(|m| model_from(m)).collect::<PyResult<Vec<_>>>()?;
@@ -1468,20 +1470,21 @@ fn drive_columns() -> Vec<&'static str> {
     tcsim_core::vehicle::cycle::drive_column_names()
 }
 
-/// The driver's gains from `options` (`driver_kp_per_s`, `driver_ki_per_s2`,
-/// `driver_control_step_s`, `driver_hold_brake`, `driver_preview_s`), defaults otherwise.
 /// The driver's options of `drive_runs` (`driver_from`).
 const DRIVER_KEYS: [&str; 5] =
     ["driver_kp_per_s", "driver_ki_per_s2", "driver_control_step_s", "driver_hold_brake", "driver_preview_s"];
 
+/// The driver's gains from `options` (`driver_kp_per_s`, `driver_ki_per_s2`,
+/// `driver_control_step_s`, `driver_hold_brake`, `driver_preview_s`), defaults otherwise.
 fn driver_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<tcsim_core::vehicle::cycle::Driver> {
     let mut g = tcsim_core::vehicle::cycle::Driver::default();
     if let Some(d) = d {
-        g.kp_per_s = opt_item(d, DRIVER_KEYS[0])?.unwrap_or(g.kp_per_s);
-        g.ki_per_s2 = opt_item(d, DRIVER_KEYS[1])?.unwrap_or(g.ki_per_s2);
-        g.control_step_s = opt_item(d, DRIVER_KEYS[2])?.unwrap_or(g.control_step_s);
-        g.hold_brake = opt_item(d, DRIVER_KEYS[3])?.unwrap_or(g.hold_brake);
-        g.preview_s = opt_item(d, DRIVER_KEYS[4])?.unwrap_or(g.preview_s);
+        let number = |key: &str| opt_input::<f64>(d, InputSource::Options, key, "a number");
+        g.kp_per_s = number(DRIVER_KEYS[0])?.unwrap_or(g.kp_per_s);
+        g.ki_per_s2 = number(DRIVER_KEYS[1])?.unwrap_or(g.ki_per_s2);
+        g.control_step_s = number(DRIVER_KEYS[2])?.unwrap_or(g.control_step_s);
+        g.hold_brake = number(DRIVER_KEYS[3])?.unwrap_or(g.hold_brake);
+        g.preview_s = number(DRIVER_KEYS[4])?.unwrap_or(g.preview_s);
     }
     g.validate().map_err(input_error)?;
     Ok(g)

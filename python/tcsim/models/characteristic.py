@@ -202,14 +202,13 @@ class Characteristic:
             )
         _check_torques_finite(cf, cap, lambda i: name(convention, i), source, convention)
         warn_implausible("torque_ratio", tr, source, lambda i: name("torque_ratio", i))
-        try:
-            _core.table_check(sr, tr, cf, overrun, interpolation)
-        except _core.CoreInputError as e:
-            row = re.fullmatch(r"torque_ratio\[(\d+)\]", e.args[1])
+        try:  # the core's rules, checked once by __post_init__: the error named as the file writes it
+            return cls(sr, tr, cf, convention, source, overrun, interpolation, input_torque_nm)
+        except InputError as e:
+            row = re.fullmatch(r"torque_ratio\[(\d+)\]", e.field)
             if row is not None and rows is not None:
-                raise InputError(source, name("torque_ratio", int(row[1])), float(tr[int(row[1])]), e.args[3]) from None
-            raise from_core(e, source, where) from None
-        return cls(sr, tr, cf, convention, source, overrun, interpolation, input_torque_nm)
+                raise e.replace(field=name("torque_ratio", int(row[1])), value=float(tr[int(row[1])])) from None
+            raise e.replace(field=f"{where}{e.field}") from None
 
     def core_rules(self) -> CoreRules:
         """The ``overrun`` and ``interpolation`` keys the file gave, for the core's table functions

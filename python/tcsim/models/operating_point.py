@@ -13,6 +13,7 @@ import pandas as pd
 
 from .. import _core
 from ..errors import ARGUMENT, InputError
+from .arguments import float_array
 from .converter import Converter
 from .steady import MODELS
 
@@ -31,15 +32,6 @@ COLUMNS: tuple[str, ...] = (
     "valid",
     "reason",
 )
-
-
-def _numbers(source: str, name: str, value) -> np.ndarray:
-    """``value`` as a float array, else an :class:`InputError` naming the argument (non-finite values
-    are allowed: those points are flagged ``non-finite-input``)."""
-    try:
-        return np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError(source, name, value, "numbers") from None
 
 
 def check_pump_speed_limit(source: str, field: str, limit_rad_s: float | None) -> float | None:
@@ -66,8 +58,8 @@ def _load(source: str, wt, torque, power) -> tuple[np.ndarray, np.ndarray, str]:
             )
         raise InputError(source, "turbine_torque_nm", None, "a turbine torque, or turbine_power_w (one of them)")
     name = "turbine_torque_nm" if torque is not None else "turbine_power_w"
-    speeds = _numbers(source, "turbine_speed_rad_s", wt)
-    load = _numbers(source, name, torque if torque is not None else power)
+    speeds = float_array("turbine_speed_rad_s", wt, "numbers")
+    load = float_array(name, torque if torque is not None else power, "numbers")
     try:
         speeds, load = np.broadcast_arrays(speeds, load)
     except ValueError:

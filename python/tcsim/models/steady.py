@@ -12,7 +12,6 @@ Each returns a :class:`pandas.DataFrame` with the columns of ``characteristic.cs
 
 from __future__ import annotations
 
-import numbers
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +20,7 @@ import pandas as pd
 from .. import _core
 from ..errors import ARGUMENT, InputError, core_value, from_core
 from ..units import DEFAULT_PUMP_SPEED_RPM, RAD_S_PER_RPM
+from .arguments import float_array, real_number, worker_count
 from .converter import Converter, load_converter
 from .plausibility import check_plausible, check_plausible_rpm
 
@@ -190,14 +190,13 @@ def hrovat_tobler_steady_state(
     so smaller batches run on fewer threads); the results do not depend on it.
     """
     names = _core.ht_parameter_names()
-    geometry = _numbers("geometry", geometry, 2)
-    wp = _numbers("pump_speed_rad_s", pump_speed_rad_s, 1)
-    wt = _numbers("turbine_speed_rad_s", turbine_speed_rad_s, 1)
+    geometry = np.ascontiguousarray(np.atleast_2d(float_array("geometry", geometry)))
+    wp = np.ascontiguousarray(float_array("pump_speed_rad_s", pump_speed_rad_s).reshape(-1))
+    wt = np.ascontiguousarray(float_array("turbine_speed_rad_s", turbine_speed_rad_s).reshape(-1))
     if geometry.shape[1] != len(names):
         expected = f"rows of the {len(names)} core parameters ({', '.join(names)})"
         raise InputError.argument("geometry", f"{geometry.shape[1]} columns", expected)
-    if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 0:
-        raise InputError.argument("threads", threads, "a whole number of workers, 0 for one per core")
+    threads = worker_count(threads)
     try:
         return _core.ht_steady_states(geometry, wp, wt, strict, threads)
     except _core.CoreInputError as e:  # a geometry the core refuses, a NaN speed
@@ -205,16 +204,6 @@ def hrovat_tobler_steady_state(
         if source == "converter":  # a parameter of the geometry: named in what is expected
             field, expected = "geometry", f"{field}: {expected}"
         raise InputError.argument(field, core_value(value), expected, core_source=source) from None
-
-
-def _numbers(name: str, values: object, ndim: int) -> np.ndarray:
-    """``values`` as a contiguous float array (``ndim`` 2: one row or rows; 1: flattened), else an
-    :class:`InputError` about the argument ``name``."""
-    try:
-        a = np.asarray(values, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError.argument(name, values, "numbers (an array, a list or a number)") from None
-    return np.ascontiguousarray(np.atleast_2d(a) if ndim == 2 else a.reshape(-1))
 
 
 def steady_torque_ratio(out: dict[str, np.ndarray]) -> np.ndarray:
@@ -367,12 +356,7 @@ def _finite_speeds(**speeds) -> tuple[np.ndarray, np.ndarray]:
     a finite number is an :class:`InputError` naming the argument and its index."""
     arrays = []
     for name, value in speeds.items():
-        try:
-            if value is None:  # np.asarray(None, dtype=float) is NaN: "pump_speed_rad_s = nan"
-                raise TypeError
-            a = np.asarray(value, dtype=float)
-        except (TypeError, ValueError):
-            raise InputError.argument(name, value, "numbers (rad/s)") from None
+        a = float_array(name, value, "numbers (rad/s)")
         if a.ndim == 0 and not np.isfinite(a):  # argwhere of a 0-d array finds nothing: a scalar NaN passed
             raise InputError.argument(name, float(a), "a finite speed in rad/s")
         bad = np.argwhere(~np.isfinite(a))
@@ -449,19 +433,9 @@ def characterise(
     conv.require(model)
     speed_ratio = _speed_ratio_argument(speed_ratio)
     if input_torque_nm is not None:
-        torque = _number_argument("input_torque_nm", input_torque_nm)
+        torque = real_number("input_torque_nm", input_torque_nm)
         return characterise_at_input_torque(conv, model, torque, speed_ratio, allow_implausible)
-    return CHARACTERISE[model](conv, _number_argument("pump_speed_rpm", pump_speed_rpm), speed_ratio, allow_implausible)
-
-
-def _number_argument(name: str, value: object) -> float:
-    """``value`` as a float when it is one real number (a Python or NumPy number, a 0-d array),
-    else an :class:`InputError` about the argument ``name`` (a string, a list, a bool)."""
-    if isinstance(value, np.ndarray) and value.ndim == 0:
-        value = value.item()
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise InputError.argument(name, value, "a number")
-    return float(value)
+    return CHARACTERISE[model](conv, real_number("pump_speed_rpm", pump_speed_rpm), speed_ratio, allow_implausible)
 
 
 def _speed_ratio_argument(speed_ratio: object) -> np.ndarray | None:
@@ -470,10 +444,7 @@ def _speed_ratio_argument(speed_ratio: object) -> np.ndarray | None:
     argument ``speed_ratio`` (NaN was blamed on the converter file's turbine speed)."""
     if speed_ratio is None:
         return None
-    try:
-        sr = np.atleast_1d(np.asarray(speed_ratio, dtype=float))
-    except (TypeError, ValueError):
-        raise InputError.argument("speed_ratio", speed_ratio, "speed ratios: a number, a list or a 1-D array") from None
+    sr = np.atleast_1d(float_array("speed_ratio", speed_ratio, "speed ratios: a number, a list or a 1-D array"))
     if sr.ndim != 1:
         raise InputError.argument("speed_ratio", f"{sr.ndim}-D array", "speed ratios: a number, a list or a 1-D array")
     bad = np.flatnonzero(~np.isfinite(sr))

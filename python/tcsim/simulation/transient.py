@@ -31,6 +31,7 @@ import pandas as pd
 
 from .. import _core
 from ..errors import ARGUMENT, InputError, core_input_error, from_core
+from ..models.arguments import worker_count
 from ..models.converter import Converter
 from ..models.drives import Drive
 from ..models.dynamic import DynamicModel, dynamic_model
@@ -433,8 +434,7 @@ def _check_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], thread
     if isinstance(drives, Sequence) and len(models) != len(drives) and 1 not in (len(models), len(drives)):
         expected = f"as many drives as models ({len(models)}), or one of either"
         raise InputError.argument("drives", f"{len(drives)} drives", expected)
-    if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or threads < 0:
-        raise InputError.argument("threads", threads, "a whole number of workers, 0 for one per core")
+    worker_count(threads)
 
 
 def _core_columns(models: Sequence[DynamicModel], columns: Sequence[str] | None) -> list[str] | None:
