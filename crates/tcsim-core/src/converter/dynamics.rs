@@ -51,6 +51,14 @@ pub trait ConverterDynamics: Sync {
     /// Internal forces `F(u)`. `flow_sign` is the sign of Q in the loss terms (eq 2.19), held as
     /// a discrete state by the engine: +1, −1, or 0 while the flow is held at zero.
     fn forces(&self, u: &Vec4, flow_sign: f64) -> Vec4;
+    /// [`Self::forces`] at each of `u` into `out` (as long): the same values. A model whose
+    /// forces are a chain of dependent operations computes them in one loop, where the chains of
+    /// successive points overlap (the engine's samples, [`crate::engine::segment::SAMPLE_BLOCK`]).
+    fn forces_many(&self, u: &[Vec4], flow_sign: f64, out: &mut [Vec4]) {
+        for (o, u) in out.iter_mut().zip(u) {
+            *o = self.forces(u, flow_sign);
+        }
+    }
     /// `∂F/∂u`, analytic.
     fn force_jacobian(&self, u: &Vec4, flow_sign: f64) -> Mat4;
     /// Torques transferred by the fluid at the pump and at the turbine (figure 3.15): the pump
@@ -511,6 +519,38 @@ impl HtDynamics {
             },
         }
     }
+
+    /// `F(u)` of [`ConverterDynamics::forces`]: σ = +1 and σ = 0 (held) use the thesis's
+    /// equations (the latter without the loss, which a held flow does not see); σ = −1 the
+    /// reverse-flow form (`ReverseConst`). Inlined into both `forces` and `forces_many`.
+    #[inline(always)]
+    fn ht_forces(&self, u: &Vec4, sigma: f64) -> Vec4 {
+        let k = &self.k;
+        if sigma < 0.0 {
+            return k.rev.forces(k, u);
+        }
+        let w = [u[PUMP], u[TURBINE], u[STATOR]];
+        let flow = u[FLOW];
+        let q = flow / k.area;
+        // angular momentum per unit mass flow leaving each element
+        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.radius_tan[i] * q);
+        let head = k.r2[0] * w[0] * w[0] + k.r2[1] * w[1] * w[1] + k.r2[2] * w[2] * w[2]
+            - k.r2[2] * w[0] * w[2]
+            - k.r2[0] * w[1] * w[0]
+            - k.r2[1] * w[2] * w[1];
+        let a =
+            [k.radius_tan[0] - k.radius_tan[2], k.radius_tan[1] - k.radius_tan[0], k.radius_tan[2] - k.radius_tan[1]];
+        let linear = q * (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]);
+        let v = shock_velocities(k, &w, q);
+        let loss =
+            sigma * 0.5 * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2] + k.friction * q * q);
+        [
+            -k.rho * (h[0] - h[2]) * flow,
+            -k.rho * (h[1] - h[0]) * flow,
+            -k.rho * (h[2] - h[1]) * flow,
+            k.rho * (head + linear - loss),
+        ]
+    }
 }
 
 /// The admissibility bound of the Hrovat & Tobler mass matrix on the shape effects (physics notes
@@ -664,34 +704,13 @@ impl ConverterDynamics for HtDynamics {
         m[FLOW][FLOW] = self.fluid_inertance();
         m
     }
-    /// σ = +1 and σ = 0 (held) use the thesis's equations (the latter without the loss, which a held
-    /// flow does not see); σ = −1 the reverse-flow form (`ReverseConst`).
     fn forces(&self, u: &Vec4, sigma: f64) -> Vec4 {
-        let k = &self.k;
-        if sigma < 0.0 {
-            return k.rev.forces(k, u);
+        self.ht_forces(u, sigma)
+    }
+    fn forces_many(&self, u: &[Vec4], sigma: f64, out: &mut [Vec4]) {
+        for (o, u) in out.iter_mut().zip(u) {
+            *o = self.ht_forces(u, sigma);
         }
-        let w = [u[PUMP], u[TURBINE], u[STATOR]];
-        let flow = u[FLOW];
-        let q = flow / k.area;
-        // angular momentum per unit mass flow leaving each element
-        let h: [f64; 3] = std::array::from_fn(|i| w[i] * k.r2[i] + k.radius_tan[i] * q);
-        let head = k.r2[0] * w[0] * w[0] + k.r2[1] * w[1] * w[1] + k.r2[2] * w[2] * w[2]
-            - k.r2[2] * w[0] * w[2]
-            - k.r2[0] * w[1] * w[0]
-            - k.r2[1] * w[2] * w[1];
-        let a =
-            [k.radius_tan[0] - k.radius_tan[2], k.radius_tan[1] - k.radius_tan[0], k.radius_tan[2] - k.radius_tan[1]];
-        let linear = q * (w[0] * a[0] + w[1] * a[1] + w[2] * a[2]);
-        let v = shock_velocities(k, &w, q);
-        let loss =
-            sigma * 0.5 * (k.c[0] * v[0] * v[0] + k.c[1] * v[1] * v[1] + k.c[2] * v[2] * v[2] + k.friction * q * q);
-        [
-            -k.rho * (h[0] - h[2]) * flow,
-            -k.rho * (h[1] - h[0]) * flow,
-            -k.rho * (h[2] - h[1]) * flow,
-            k.rho * (head + linear - loss),
-        ]
     }
     fn force_jacobian(&self, u: &Vec4, sigma: f64) -> Mat4 {
         let k = &self.k;
@@ -755,6 +774,9 @@ impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
     }
     fn forces(&self, u: &Vec4, s: f64) -> Vec4 {
         (**self).forces(u, s)
+    }
+    fn forces_many(&self, u: &[Vec4], s: f64, out: &mut [Vec4]) {
+        (**self).forces_many(u, s, out)
     }
     fn force_jacobian(&self, u: &Vec4, s: f64) -> Mat4 {
         (**self).force_jacobian(u, s)
@@ -861,6 +883,35 @@ pub(crate) mod tests {
                     "row {r} col {c} sigma {sigma}: analytic {} fd {fd}",
                     j[r][c]
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn forces_of_many_points_are_the_forces_of_each_bit_for_bit() {
+        // the engine samples through `forces_many` (H&T's own loop, the others' default): every
+        // quadrant, every flow sign, zero and huge values, a NaN that must stay in its own point
+        let table = TableDynamics { characteristic: c1().into(), inertia: inertia(), lag: None };
+        let (ht, qd, lagged, boxed) = (ht([0.001310, 0.002324, 0.001723]), qd(), lagged(c1(), 0.05), Box::new(qd()));
+        let models: [&dyn ConverterDynamics; 5] = [&ht, &qd, &table, &lagged, &boxed];
+        let mut points: Vec<Vec4> =
+            vec![[0.0; 4], [-0.0, 0.0, -0.0, 0.0], [1e12, -1e12, 1e6, -1.0], [f64::NAN, 1.0, 0.0, 0.01]];
+        for (i, wp) in [-300.0, -20.0, 0.0, 150.0, 400.0].into_iter().enumerate() {
+            for wt in [-200.0, 0.0, 90.0, 500.0] {
+                points.push([wp, wt, 0.3 * wt - 0.1 * wp, 0.004 * (i as f64 - 2.0)]);
+            }
+        }
+        for m in models {
+            for sigma in [1.0, 0.0, -1.0] {
+                let mut many = vec![[0.0; 4]; points.len()];
+                m.forces_many(&points, sigma, &mut many);
+                for (u, f) in points.iter().zip(&many) {
+                    let one = m.forces(u, sigma);
+                    assert!(
+                        one.iter().zip(f).all(|(a, b)| a.to_bits() == b.to_bits()),
+                        "{u:?} σ {sigma}: {one:?} vs {f:?}"
+                    );
+                }
             }
         }
     }

@@ -243,6 +243,7 @@ impl<'a> SampleConstants<'a> {
     /// `f = F(u)`: external torques with the converter's own mass, the transferred torques (with
     /// the stator reaction that balances them when the model has no stator), the loss power (none
     /// while the flow is held) and the stored kinetic energy.
+    #[inline(always)]
     pub fn sample(&self, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
         let model = self.model;
         let e = external_torques(&self.mass, &u_dot, &f);

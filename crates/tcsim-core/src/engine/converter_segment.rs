@@ -14,7 +14,7 @@ use crate::engine::converter_events::{self, ConverterRoot, EventKind, LockupSamp
 use crate::engine::drive::{Drive, TurbineLoad};
 use crate::engine::lockup::{self, ClutchMode, LockupCommand, LockupRoot};
 use crate::engine::options::{named_state, Hysteresis, NamedState, SolverOptions};
-use crate::engine::segment::SmoothSegment;
+use crate::engine::segment::{SmoothSegment, SAMPLE_BLOCK};
 use crate::engine::signal::Signal;
 
 /// A root function of an isolated run: the converter's or the lock-up clutch's.
@@ -54,6 +54,8 @@ pub(super) struct Segment<'a> {
     given: [Option<&'a Signal>; 4],
     /// Whether any coordinate is given (else every rate of `z(t)` is zero).
     any_given: bool,
+    /// Whether the state is the coordinates themselves (all four free: `P = I`, `z = 0`).
+    identity: bool,
     /// The pump torque, when the pump is free.
     pump_torque: Option<&'a Signal>,
     /// The load, when the turbine is free or linked.
@@ -148,6 +150,7 @@ impl<'a> Segment<'a> {
             roots,
             given,
             any_given: given.iter().any(Option::is_some),
+            identity: col == [Some(0), Some(1), Some(2), Some(3)],
             pump_torque,
             load,
             sampled: SampleConstants::new(model, mode),
@@ -161,6 +164,9 @@ impl<'a> Segment<'a> {
     }
 
     pub(super) fn full(&self, x: &[f64], t: f64) -> Vec4 {
+        if self.identity {
+            return [x[0], x[1], x[2], x[3]];
+        }
         std::array::from_fn(|c| match (self.col[c], self.given[c]) {
             (Some(i), _) => x[i],
             (None, Some(s)) => s.value(t),
@@ -209,6 +215,7 @@ impl<'a> Segment<'a> {
 
     /// External torques on the free coordinates (drive, load, slipping clutch), and their Jacobian
     /// into `jac` when asked (the right-hand side does not need it).
+    #[inline(always)]
     fn external(&self, u: &Vec4, t: f64, mut jac: Option<&mut Mat4>) -> Vec4 {
         let mut e = [0.0; 4];
         if let Some(s) = self.pump_torque {
@@ -237,25 +244,22 @@ impl<'a> Segment<'a> {
         e
     }
 
-    /// Right-hand side of the reduced system, `Pᵀ(F + T − M ż)`, given `u` and `f = F(u)`.
-    fn reduced_rhs(&self, u: &Vec4, f: &Vec4, t: f64, out: &mut [f64]) {
+    /// Right-hand side of the reduced system, `Pᵀ(F + T − M ż)`, given `u` and `f = F(u)`: its
+    /// `n` values first, zeros after. Each value is summed over its coordinates in a register:
+    /// summed in memory at the state's index, it stalled the vector loads that read it back
+    /// ([`Self::rates`]) on store forwarding.
+    #[inline(always)]
+    fn reduced_rhs(&self, u: &Vec4, f: &Vec4, t: f64) -> Vec4 {
         let e = self.external(u, t, None);
-        out.iter_mut().for_each(|o| *o = 0.0);
-        if !self.any_given {
-            for r in 0..4 {
-                if let Some(i) = self.col[r] {
-                    out[i] += f[r] + e[r];
-                }
-            }
-            return;
-        }
-        let zd = self.given_rates(t);
-        for r in 0..4 {
-            if let Some(i) = self.col[r] {
+        let mut g: Vec4 = std::array::from_fn(|r| f[r] + e[r]);
+        if self.any_given {
+            let zd = self.given_rates(t);
+            for (r, g) in g.iter_mut().enumerate() {
                 let coupling: f64 = (0..4).map(|c| self.dyn_mass[r][c] * zd[c]).sum();
-                out[i] += f[r] + e[r] - coupling;
+                *g -= coupling;
             }
         }
+        std::array::from_fn(|i| (0..4).filter(|&r| self.col[r] == Some(i)).fold(0.0, |sum, r| sum + g[r]))
     }
 
     fn rhs(&self, x: &[f64], t: f64, out: &mut [f64]) {
@@ -265,7 +269,10 @@ impl<'a> Segment<'a> {
         }
         let u = self.full(x, t);
         let f = self.model.forces(&u, self.mode.flow_sign);
-        self.reduced_rhs(&u, &f, t, out);
+        // element by element: `copy_from_slice` of a length known only at run time calls memmove
+        for (o, r) in out.iter_mut().zip(self.reduced_rhs(&u, &f, t)) {
+            *o = r;
+        }
     }
 
     fn jacobian_times(&self, x: &[f64], t: f64, v: &[f64], out: &mut [f64]) {
@@ -302,10 +309,14 @@ impl<'a> Segment<'a> {
     pub(super) fn kinematics(&self, x: &[f64], t: f64) -> (Vec4, Vec4, Vec4) {
         let u = self.full(x, t);
         let f = self.model.forces(&u, self.mode.flow_sign);
+        (u, self.rates(&u, &f, t), f)
+    }
+
+    /// The rates `u̇` at (u, t) given the forces `f = F(u)`.
+    fn rates(&self, u: &Vec4, f: &Vec4, t: f64) -> Vec4 {
         let mut ud = self.given_rates(t);
         if self.n > 0 {
-            let mut r = [0.0; 4];
-            self.reduced_rhs(&u, &f, t, &mut r[..self.n]);
+            let r = self.reduced_rhs(u, f, t);
             // over all 4 columns: `inv` and `r` are zero beyond the n states
             for (c, rate) in ud.iter_mut().enumerate() {
                 if let Some(i) = self.col[c] {
@@ -313,7 +324,7 @@ impl<'a> Segment<'a> {
                 }
             }
         }
-        (u, ud, f)
+        ud
     }
 
     /// `M u̇ − F` with the converter's own mass: the external torque on every coordinate, the
@@ -380,6 +391,31 @@ impl<'a> Segment<'a> {
 
     pub(super) fn sample(&self, x: &[f64], t: f64) -> Sample {
         let (u, ud, f) = self.kinematics(x, t);
+        self.sample_at(t, u, ud, f)
+    }
+
+    /// [`SmoothSegment::sample_block`] stage by stage: the coordinates, the forces of all
+    /// ([`ConverterDynamics::forces_many`]), the rates, the samples; each as [`Self::sample`]'s.
+    fn sample_block<const N: usize>(&self, xs: &[[f64; N]], n: usize, ts: &[f64], out: &mut Vec<Sample>) {
+        let m = xs.len();
+        let mut u = [[0.0; 4]; SAMPLE_BLOCK];
+        let mut f = [[0.0; 4]; SAMPLE_BLOCK];
+        let mut ud = [[0.0; 4]; SAMPLE_BLOCK];
+        for k in 0..m {
+            u[k] = self.full(&xs[k][..n], ts[k]);
+        }
+        self.model.forces_many(&u[..m], self.mode.flow_sign, &mut f[..m]);
+        for k in 0..m {
+            ud[k] = self.rates(&u[k], &f[k], ts[k]);
+        }
+        for k in 0..m {
+            out.push(self.sample_at(ts[k], u[k], ud[k], f[k]));
+        }
+    }
+
+    /// The sample at `t` from the coordinates, their rates and the forces.
+    #[inline(always)]
+    fn sample_at(&self, t: f64, u: Vec4, ud: Vec4, f: Vec4) -> Sample {
         let mut s = self.sampled.sample(t, u, ud, f);
         if let Some(cmd) = self.drive.lockup() {
             let torque = self.lockup_torque(&u, &ud, &f, t);
@@ -519,7 +555,73 @@ impl SmoothSegment for Segment<'_> {
     fn sample(&self, x: &[f64], t: f64) -> Sample {
         Segment::sample(self, x, t)
     }
+    fn sample_block<const N: usize>(&self, xs: &[[f64; N]], n: usize, ts: &[f64], out: &mut Vec<Sample>) {
+        Segment::sample_block(self, xs, n, ts, out)
+    }
     fn coordinates(&self, x: &[f64], t: f64) -> NamedState {
         named_state(Some(self.model), &self.full(x, t))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::converter::dynamics::{HtDynamics, Inertias};
+    use crate::converter::hrovat_tobler::HtGeometry;
+
+    fn signal(v: &[f64]) -> Signal {
+        Signal::new("s", vec![0.0, 0.5, 1.0, 3.0], v.to_vec(), 0.0).unwrap()
+    }
+
+    #[test]
+    fn a_block_of_samples_is_each_sample_bit_for_bit() {
+        // the engine samples in blocks (`sample_block`, stage by stage): each sample must be the
+        // one `sample` takes alone, in every drive, mode and clutch state, given speeds included
+        let model = HtDynamics::new(
+            HtGeometry::appendix_d(),
+            Inertias::new(0.109, 0.056, 0.01).unwrap(),
+            0.2914,
+            [0.001310, 0.002324, 0.001723],
+        )
+        .unwrap();
+        let clutch = || Some(LockupCommand::new(signal(&[0.0, 50.0, 400.0, 400.0]), 1.2).unwrap());
+        let load = TurbineLoad { torque_nm: signal(&[10.0, 12.0, 30.0, 5.0]), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 };
+        let pump = signal(&[40.0, 60.0, 250.0, 250.0]);
+        let speed = |v: f64| signal(&[v, 1.3 * v, 0.7 * v, v]);
+        let mut drives = vec![];
+        for lockup in [None, clutch()] {
+            drives.push(Drive::PumpTorqueLoad {
+                pump_torque_nm: pump.clone(),
+                load: load.clone(),
+                lockup: lockup.clone(),
+            });
+            drives.push(Drive::PumpTorqueTurbineSpeed {
+                pump_torque_nm: pump.clone(),
+                turbine_speed_rad_s: speed(80.0),
+                lockup: lockup.clone(),
+            });
+            drives.push(Drive::Speeds { pump_speed_rad_s: speed(200.0), turbine_speed_rad_s: speed(-90.0), lockup });
+        }
+        let clutch_modes = [ClutchMode::Armed, ClutchMode::Unarmed { since_s: 0.2 }, ClutchMode::Locked];
+        let ts: Vec<f64> = (0..SAMPLE_BLOCK).map(|k| 0.37 * k as f64).collect();
+        for drive in &drives {
+            for (stator_locked, flow_sign, lockup) in [false, true]
+                .into_iter()
+                .flat_map(|s| [1.0, 0.0, -1.0].map(|f| (s, f)))
+                .flat_map(|(s, f)| clutch_modes.map(|c| (s, f, c)))
+            {
+                let seg = Segment::new(&model, drive, Mode { stator_locked, flow_sign, lockup });
+                let n = seg.n_states();
+                let xs: Vec<[f64; 4]> = (0..SAMPLE_BLOCK)
+                    .map(|k| std::array::from_fn(|i| [150.0, -40.0, 7.0, 0.012][i] * (1.0 - 0.3 * k as f64)))
+                    .collect();
+                for m in [1, 3, SAMPLE_BLOCK] {
+                    let mut block = vec![];
+                    SmoothSegment::sample_block(&seg, &xs[..m], n, &ts[..m], &mut block);
+                    let alone: Vec<Sample> = (0..m).map(|k| seg.sample(&xs[k][..n], ts[k])).collect();
+                    assert_eq!(format!("{block:?}"), format!("{alone:?}"), "{drive:?} {:?}", seg.mode);
+                }
+            }
+        }
     }
 }

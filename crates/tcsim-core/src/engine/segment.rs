@@ -6,6 +6,9 @@ use crate::engine::bdf::roots::RootFinder;
 use crate::engine::bdf::{Bdf, EXACT_MAX, N_MAX};
 use crate::engine::options::{Hysteresis, NamedState, SolverOptions, TransientError, TransientResult};
 
+/// The most samples taken together ([`SmoothSegment::sample_block`]).
+pub const SAMPLE_BLOCK: usize = 8;
+
 /// A smooth system `M ẋ = f(x, t)` with event functions, as one mode of a piecewise-smooth model.
 pub trait SmoothSegment {
     type Root: Copy;
@@ -21,6 +24,15 @@ pub trait SmoothSegment {
     /// Event functions, positive while the mode holds.
     fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]);
     fn sample(&self, x: &[f64], t: f64) -> Self::Sample;
+    /// The samples at the times `ts` from the states `xs` (the first `n` values of row `k` are
+    /// the state at `ts[k]`; at most [`SAMPLE_BLOCK`] rows), pushed to `out`: each the same as
+    /// [`Self::sample`]'s. The default takes them one at a time; a segment whose sample is a long
+    /// chain of dependent operations takes them stage by stage, where the chains overlap.
+    fn sample_block<const N: usize>(&self, xs: &[[f64; N]], n: usize, ts: &[f64], out: &mut Vec<Self::Sample>) {
+        for (x, &t) in xs.iter().zip(ts) {
+            out.push(self.sample(&x[..n], t));
+        }
+    }
     /// The physical coordinates at (x, t), named, for error messages.
     fn coordinates(&self, x: &[f64], t: f64) -> NamedState;
 }
@@ -153,11 +165,7 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
             })
         };
         let upto = root.map_or(t_hi, |(t, _)| t);
-        while samples.len() < times_s.len() && times_s[samples.len()] <= upto {
-            let t = times_s[samples.len()];
-            bdf.interpolate(t, &mut x);
-            samples.push(seg.sample(&x[..n], t));
-        }
+        take_samples(&bdf, seg, n, times_s, upto, samples);
         if let Some((t, i)) = root {
             bdf.interpolate(t, &mut x);
             return Ok(Some((t, roots[i], x[..n].to_vec())));
@@ -165,5 +173,26 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
         if t_hi >= t_end {
             return Ok(None);
         }
+    }
+}
+
+/// Push the samples of the output times after the last sample up to `upto` (within the last step
+/// of `bdf`, of `n` states), in blocks of [`SAMPLE_BLOCK`] interpolated states.
+fn take_samples<S: SmoothSegment, const N: usize>(
+    bdf: &Bdf<'_, S, N>,
+    seg: &S,
+    n: usize,
+    times_s: &[f64],
+    upto: f64,
+    samples: &mut Vec<S::Sample>,
+) {
+    let first = samples.len();
+    let count = times_s[first..].iter().take_while(|&&t| t <= upto).count();
+    let mut xs = [[0.0; N]; SAMPLE_BLOCK];
+    for block in times_s[first..first + count].chunks(SAMPLE_BLOCK) {
+        for (x, &t) in xs.iter_mut().zip(block) {
+            bdf.interpolate(t, x);
+        }
+        seg.sample_block(&xs[..block.len()], n, block, samples);
     }
 }
