@@ -7,6 +7,7 @@ const SCAN_MAX: usize = 8;
 
 /// The segment `[x[i−1], x[i]]` of the sorted abscissae `x` (two or more) that holds `t`, clamped
 /// to the first or last segment, and the weight `w = (t − x[i−1])/(x[i] − x[i−1])` of `x[i]`.
+#[inline]
 pub fn segment(x: &[f64], t: f64) -> (usize, f64) {
     let n = x.len();
     // first index with x[i] > t, clamped so that [i-1, i] is a segment (a short table is scanned:
@@ -23,8 +24,9 @@ pub fn mix(y: &[f64], i: usize, w: f64) -> f64 {
 }
 
 /// `y(t)` linear between the points `(x, y)` (x strictly increasing), end values held outside;
-/// a single point is a constant.
-#[inline]
+/// a single point is a constant. Inlined: the engines call it for every input at every
+/// evaluation, most often on a constant or a short table.
+#[inline(always)]
 pub fn linear_held(x: &[f64], y: &[f64], t: f64) -> f64 {
     let n = x.len();
     if n == 1 || t <= x[0] {

@@ -295,11 +295,15 @@ def simulate_batch(
     ``speed_atol_rad_s``, ``flow_atol_m3_s``, ``first_step_s``, ``max_events`` and
     ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs, counting only the
     chosen columns, is refused above it before anything runs)."""
-    batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options, shaped=False)
+    batch = _run_batch(
+        models, drives, times_s, columns, initial, rtol, threads, files, solver_options, shaped=False, every_time=False
+    )
     try:
         batch.check()
     except InputError as e:
         if times_s is not None and e.core_source == "drive":  # the core names the output times the drive's
+            for d in drives:
+                _output_times(_drive_spec(d)["time_s"], times_s)  # a time outside a drive's span
             _check_increasing(_floats_1d(times_s))
         raise
     _warn_about_runs(batch)
@@ -320,26 +324,34 @@ def _warning_rows(batch: BatchColumns, i: int) -> dict[str, np.ndarray]:
     return {name: batch.rows(name, i) for name in _WARNING_COLUMNS}
 
 
-def _drive_specs(drives: Sequence[Drive], times_s: Sequence[float] | None) -> tuple[list[dict], np.ndarray | None]:
+def _drive_specs(
+    drives: Sequence[Drive], times_s: Sequence[float] | None, every_time: bool = True
+) -> tuple[list[dict], np.ndarray | None]:
     """The drives' dicts for the core (with ``output_time_s`` and ``output_skip`` for ``times_s``) and
-    the sample times every run shares, s (None when the drives' time stamps differ)."""
+    the sample times every run shares, s (None when the drives' time stamps differ). ``every_time``
+    as in :func:`_output_times`."""
     if isinstance(drives, str) or not isinstance(drives, Sequence) or not drives:
         raise InputError.argument("drives", drives, "a list of one or more drives")
     specs = []
     for i, d in enumerate(drives):
-        core_spec = getattr(d, "_core_spec", None)  # the series as arrays (a stand-in drive: its spec())
-        if core_spec is None and not callable(getattr(d, "spec", None)):
+        if not callable(getattr(d, "_core_spec", None)) and not callable(getattr(d, "spec", None)):
             expected = "a drive: tcsim.transient.PumpTorqueTurbineSpeed, Speeds or PumpTorqueLoad"
             raise InputError.argument("drive" if len(drives) == 1 else f"drives[{i}]", type(d).__name__, expected)
-        s = core_spec() if core_spec is not None else d.spec()
+        s = _drive_spec(d)
         if times_s is not None:
-            s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s)
+            s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s, every_time)
         specs.append(s)
     if times_s is not None:
         return specs, _floats_1d(times_s)
     first = np.asarray(specs[0]["time_s"], dtype=float)
     same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
     return specs, first if same else None
+
+
+def _drive_spec(d: Drive) -> dict[str, Any]:
+    """A drive's dict for the core: its series as arrays (a stand-in drive's ``spec()``)."""
+    core_spec = getattr(d, "_core_spec", None)
+    return core_spec() if core_spec is not None else d.spec()
 
 
 def simulate_columns(
@@ -395,12 +407,13 @@ def _run_batch(
     files: Mapping[str, str] | None,
     solver_options: dict[str, Any],
     shaped: bool = True,
+    every_time: bool = True,
 ) -> BatchColumns:
     """The one call of the core's ``transient_batch`` (:func:`simulate_columns`), with the columns
     the warnings read added for table models (:func:`_core_columns`); ``shaped`` as in
-    :func:`_batch_columns`."""
+    :func:`_batch_columns`, ``every_time`` as in :func:`_output_times`."""
     _check_batch(models, drives, threads)
-    specs, shared_time = _drive_specs(drives, times_s)
+    specs, shared_time = _drive_specs(drives, times_s, every_time)
     try:
         raw = _core.transient_batch(
             [m.spec for m in models],
@@ -510,8 +523,14 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
     return t.tolist(), skip
 
 
-def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]) -> tuple[np.ndarray, int]:
-    """:func:`output_times` with the times as a float64 array (what the runs pass to the core)."""
+def _output_times(
+    drive_time_s: Sequence[float] | float, times_s: Sequence[float], every_time: bool = True
+) -> tuple[np.ndarray, int]:
+    """:func:`output_times` with the times as a float64 array (what the runs pass to the core).
+    Without ``every_time``, only the first and the last time are checked against the drive's span: enough
+    for times that increase, which the core checks on every run; a caller that passes False looks
+    at the whole of ``times_s`` again once the core has refused them (:func:`simulate_batch`; the
+    two reductions over the times were 1.7 µs of a 140 µs :func:`simulate`)."""
     try:
         t = _floats_1d(times_s)
     except (TypeError, ValueError):
@@ -520,7 +539,8 @@ def _output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float
     start, end = float(span[0]), float(span[-1])
     if t.ndim != 1 or t.size < 1:
         raise InputError.argument("times_s", f"shape {t.shape}", "a one-dimensional sequence of output times")
-    if not (start <= t.min() and t.max() <= end):  # a time outside the span or NaN (or a NaN span)
+    ends_inside = not every_time and start <= t[0] and t[-1] <= end
+    if not ends_inside and not (start <= t.min() and t.max() <= end):  # a time outside the span or NaN
         outside = np.flatnonzero(~np.isfinite(t) | (t < start) | (t > end))
         if outside.size:
             i = int(outside[0])

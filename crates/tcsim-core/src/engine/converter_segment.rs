@@ -163,15 +163,20 @@ impl<'a> Segment<'a> {
         self.n.max(1)
     }
 
+    #[inline(always)]
     pub(super) fn full(&self, x: &[f64], t: f64) -> Vec4 {
         if self.identity {
             return [x[0], x[1], x[2], x[3]];
         }
-        std::array::from_fn(|c| match (self.col[c], self.given[c]) {
-            (Some(i), _) => x[i],
-            (None, Some(s)) => s.value(t),
-            (None, None) => 0.0,
-        })
+        let mut u = [0.0; 4];
+        for (c, u) in u.iter_mut().enumerate() {
+            *u = match (self.col[c], self.given[c]) {
+                (Some(i), _) => x[i],
+                (None, Some(s)) => s.value(t),
+                (None, None) => 0.0,
+            };
+        }
+        u
     }
 
     pub(super) fn state(&self, u: &Vec4) -> Vec<f64> {
@@ -251,7 +256,11 @@ impl<'a> Segment<'a> {
     #[inline(always)]
     fn reduced_rhs(&self, u: &Vec4, f: &Vec4, t: f64) -> Vec4 {
         let e = self.external(u, t, None);
-        let mut g: Vec4 = std::array::from_fn(|r| f[r] + e[r]);
+        // loops, not `array::from_fn`: its closure was not inlined in the engine's hot paths
+        let mut g = [0.0; 4];
+        for r in 0..4 {
+            g[r] = f[r] + e[r];
+        }
         if self.any_given {
             let zd = self.given_rates(t);
             for (r, g) in g.iter_mut().enumerate() {
@@ -259,7 +268,11 @@ impl<'a> Segment<'a> {
                 *g -= coupling;
             }
         }
-        std::array::from_fn(|i| (0..4).filter(|&r| self.col[r] == Some(i)).fold(0.0, |sum, r| sum + g[r]))
+        let mut out = [0.0; 4];
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = (0..4).filter(|&r| self.col[r] == Some(i)).fold(0.0, |sum, r| sum + g[r]);
+        }
+        out
     }
 
     fn rhs(&self, x: &[f64], t: f64, out: &mut [f64]) {
@@ -312,7 +325,9 @@ impl<'a> Segment<'a> {
         (u, self.rates(&u, &f, t), f)
     }
 
-    /// The rates `u̇` at (u, t) given the forces `f = F(u)`.
+    /// The rates `u̇` at (u, t) given the forces `f = F(u)`. Inlined: returned through memory,
+    /// its scalar stores stalled the vector loads of the copy that followed (store forwarding).
+    #[inline(always)]
     fn rates(&self, u: &Vec4, f: &Vec4, t: f64) -> Vec4 {
         let mut ud = self.given_rates(t);
         if self.n > 0 {
