@@ -858,6 +858,12 @@ pub(crate) mod tests {
         HtDynamics::new(HtGeometry::appendix_d(), inertia(), 0.2914, shape).unwrap()
     }
 
+    /// The bundled `li-sunden-2016` converter's Hrovat & Tobler model (Table D.1, its derived
+    /// fluid length and shape effects): the engine's tests' take-off model.
+    pub(crate) fn bundled_ht() -> HtDynamics {
+        ht([0.001310, 0.002324, 0.001723])
+    }
+
     fn qd() -> QuasiDynamics {
         qd_with(c1().into())
     }
@@ -892,7 +898,7 @@ pub(crate) mod tests {
         // the engine samples through `forces_many` (H&T's own loop, the others' default): every
         // quadrant, every flow sign, zero and huge values, a NaN that must stay in its own point
         let table = TableDynamics { characteristic: c1().into(), inertia: inertia(), lag: None };
-        let (ht, qd, lagged, boxed) = (ht([0.001310, 0.002324, 0.001723]), qd(), lagged(c1(), 0.05), Box::new(qd()));
+        let (ht, qd, lagged, boxed) = (bundled_ht(), qd(), lagged(c1(), 0.05), Box::new(qd()));
         let models: [&dyn ConverterDynamics; 5] = [&ht, &qd, &table, &lagged, &boxed];
         let mut points: Vec<Vec4> =
             vec![[0.0; 4], [-0.0, 0.0, -0.0, 0.0], [1e12, -1e12, 1e6, -1.0], [f64::NAN, 1.0, 0.0, 0.01]];

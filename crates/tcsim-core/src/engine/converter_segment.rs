@@ -581,8 +581,6 @@ impl SmoothSegment for Segment<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::converter::dynamics::{HtDynamics, Inertias};
-    use crate::converter::hrovat_tobler::HtGeometry;
 
     fn signal(v: &[f64]) -> Signal {
         Signal::new("s", vec![0.0, 0.5, 1.0, 3.0], v.to_vec(), 0.0).unwrap()
@@ -592,13 +590,7 @@ mod tests {
     fn a_block_of_samples_is_each_sample_bit_for_bit() {
         // the engine samples in blocks (`sample_block`, stage by stage): each sample must be the
         // one `sample` takes alone, in every drive, mode and clutch state, given speeds included
-        let model = HtDynamics::new(
-            HtGeometry::appendix_d(),
-            Inertias::new(0.109, 0.056, 0.01).unwrap(),
-            0.2914,
-            [0.001310, 0.002324, 0.001723],
-        )
-        .unwrap();
+        let model = crate::converter::dynamics::tests::bundled_ht();
         let clutch = || Some(LockupCommand::new(signal(&[0.0, 50.0, 400.0, 400.0]), 1.2).unwrap());
         let load = TurbineLoad { torque_nm: signal(&[10.0, 12.0, 30.0, 5.0]), inertia_kg_m2: 1.2, drag_nm_s2: 0.002 };
         let pump = signal(&[40.0, 60.0, 250.0, 250.0]);

@@ -452,8 +452,7 @@ pub fn columns(model: &dyn ConverterDynamics, traj: &Trajectory) -> TransientRes
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::converter::dynamics::{HtDynamics, Inertias};
-    use crate::converter::hrovat_tobler::HtGeometry;
+    use crate::converter::dynamics::HtDynamics;
     use crate::engine::isolated::{simulate, Drive, InitialState, TurbineLoad};
     use crate::engine::lockup::LockupCommand;
     use crate::engine::signal::Signal;
@@ -523,13 +522,7 @@ mod tests {
     }
 
     fn takeoff(lockup: bool) -> (HtDynamics, Drive) {
-        let model = HtDynamics::new(
-            HtGeometry::appendix_d(),
-            Inertias::new(0.109, 0.056, 0.01).unwrap(),
-            0.2914,
-            [0.001310, 0.002324, 0.001723],
-        )
-        .unwrap();
+        let model = crate::converter::dynamics::tests::bundled_ht();
         let torque = Signal::new("pump_torque_nm", vec![0.0, 0.1, 0.3, 10.0], vec![40.0, 40.0, 250.0, 250.0], 0.0);
         let capacity = Signal::new("lockup_capacity_nm", vec![0.0, 3.0, 3.5, 10.0], vec![0.0, 0.0, 600.0, 600.0], 0.0);
         let drive = Drive::PumpTorqueLoad {
