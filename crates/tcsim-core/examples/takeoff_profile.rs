@@ -13,7 +13,9 @@
 //! prints the wall time and the process's CPU time (user + system, from `/proc/self/stat`) per run,
 //! and the speed-up over the first thread count. `... -- columns RUNS SAMPLES THREADS...` does the
 //! same through [`run_transient_columns`] with all 33 columns (the columnar batch of
-//! `simulate_columns`: one buffer per column for all runs, written by the workers).
+//! `simulate_columns`: one buffer per column for all runs, written by the workers). `... -- peer RUNS
+//! SAMPLES` times one take-off per call with the 9 columns of the C + CVODE peer, the core of
+//! Python's `simulate(..., columns=...)` without the binding.
 use std::time::Instant;
 
 use tcsim_core::batch::{run_transient_columns, run_transient_jobs, TransientJob};
@@ -90,10 +92,48 @@ fn batch(runs: usize, samples: usize, threads: &[usize], columnar: bool) {
     }
 }
 
+/// The 9 columns the C + CVODE peer of `bench/` writes (`bench/cvode_peer.py`).
+const PEER_COLUMNS: [&str; 9] = [
+    "time_s",
+    "pump_speed_rad_s",
+    "turbine_speed_rad_s",
+    "stator_speed_rad_s",
+    "flow_m3_s",
+    "pump_torque_nm",
+    "turbine_torque_nm",
+    "stator_torque_nm",
+    "torque_ratio",
+];
+
+/// One take-off per call of [`run_transient_columns`] with the peer's columns, as Python's
+/// `simulate(..., columns=...)` runs it without the binding: the median wall time per call.
+fn peer(runs: usize, samples: usize) {
+    let (model, drive) = takeoff();
+    let t: Vec<f64> = (0..samples).map(|i| 10.0 * i as f64 / (samples - 1) as f64).collect();
+    let selection = Selection::from_names(&PEER_COLUMNS).expect("known columns");
+    let never = std::sync::atomic::AtomicBool::new(false);
+    let mut wall = Vec::with_capacity(runs);
+    for _ in 0..runs {
+        let job = TransientJob {
+            model: Box::new(model.clone()),
+            drive: drive.clone(),
+            times_s: t.clone(),
+            init: InitialState::default(),
+            options: SolverOptions::default(),
+        };
+        let start = Instant::now();
+        let out = run_transient_columns(std::slice::from_ref(&job), &[0], &selection, 1, &never);
+        wall.push(start.elapsed().as_secs_f64());
+        assert!(out.is_ok_and(|o| o.is_some_and(|o| o.failures.is_empty())));
+    }
+    println!("{runs} runs, {samples} samples, the peer's 9 columns: median {:.1} µs per run", median(&mut wall) * 1e6);
+}
+
 fn main() {
     let words: Vec<String> = std::env::args().skip(1).collect();
     let columnar = words.first().is_some_and(|w| w == "columns");
-    let is_batch = columnar || words.first().is_some_and(|w| w == "batch");
+    let is_peer = words.first().is_some_and(|w| w == "peer");
+    let is_batch = columnar || is_peer || words.first().is_some_and(|w| w == "batch");
     let args: Vec<usize> = words
         .iter()
         .skip(usize::from(is_batch))
@@ -101,6 +141,9 @@ fn main() {
         .collect();
     let runs = args.first().copied().unwrap_or(200).max(1);
     let samples = args.get(1).copied().unwrap_or(1001).max(2);
+    if is_peer {
+        return peer(runs, samples);
+    }
     if is_batch {
         let threads = if args.len() > 2 { args[2..].to_vec() } else { vec![1, 2] };
         return batch(runs, samples, &threads, columnar);

@@ -14,7 +14,7 @@
 
 use crate::converter::dynamics::{quadratic_energy_j, ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::lockup::ClutchMode;
-use crate::engine::options::Hysteresis;
+use crate::engine::options::{Hysteresis, Sampled};
 
 /// Discrete state of the piecewise-smooth converter.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -138,6 +138,15 @@ pub fn roots(model: &dyn ConverterDynamics, mode: Mode) -> Vec<ConverterRoot> {
     roots
 }
 
+/// Whether [`root_value`] of `root` calls its `stator_torque` or `held_flow` (which need the
+/// plant's rates and forces).
+pub fn root_needs_rates(root: ConverterRoot) -> bool {
+    match root {
+        ConverterRoot::StatorTorque | ConverterRoot::FlowStartsPositive | ConverterRoot::FlowStartsNegative => true,
+        ConverterRoot::StatorSpeed | ConverterRoot::Flow => false,
+    }
+}
+
 /// The value of `root`, positive while the mode holds (with the hysteresis `h`). `u` holds the
 /// converter's coordinates first; `stator_torque` is the constraint torque on the stator and
 /// `held_flow` the held-flow balance `(d⁺, d⁻)` ([`held_flow_balance`]) of the plant.
@@ -216,13 +225,19 @@ pub fn switch<const LEN: usize>(
 }
 
 /// `M u̇ − F` with the converter's own mass `mass`: the external torque on every coordinate.
+/// Inlined, with a loop rather than `array::from_fn` (whose closure was a call per sample).
+#[inline(always)]
 pub fn external_torques(mass: &Mat4, u_dot: &Vec4, f: &Vec4) -> Vec4 {
-    std::array::from_fn(|r| (0..4).map(|c| mass[r][c] * u_dot[c]).sum::<f64>() - f[r])
+    let mut e = [0.0; 4];
+    for r in 0..4 {
+        e[r] = (0..4).map(|c| mass[r][c] * u_dot[c]).sum::<f64>() - f[r];
+    }
+    e
 }
 
 /// What a model's samples need that is the same at every sample, kept once per segment: its mass
 /// matrix, its stored energy's matrix ([`ConverterDynamics::energy_mass`]), whether it has a stator
-/// coordinate and whether the mode holds its flow.
+/// coordinate, whether the mode holds its flow, and which optional quantities are wanted.
 pub struct SampleConstants<'a> {
     model: &'a dyn ConverterDynamics,
     mode: Mode,
@@ -230,13 +245,20 @@ pub struct SampleConstants<'a> {
     energy_mass: Option<Mat4>,
     stator: bool,
     flow_held: bool,
+    wanted: Sampled,
 }
 
 impl<'a> SampleConstants<'a> {
+    /// The constants of `model` in `mode`, with every quantity wanted.
     pub fn new(model: &'a dyn ConverterDynamics, mode: Mode) -> Self {
         let (mass, energy_mass) = (model.mass(), model.energy_mass());
         let (stator, flow_held) = (model.coordinates()[STATOR], flow_held(model, mode));
-        Self { model, mode, mass, energy_mass, stator, flow_held }
+        Self { model, mode, mass, energy_mass, stator, flow_held, wanted: Sampled::ALL }
+    }
+
+    /// The same, with only the quantities `wanted` computed.
+    pub fn wanting(self, wanted: Sampled) -> Self {
+        Self { wanted, ..self }
     }
 
     /// The converter's sample at time `t` from its coordinates `u`, rates `u_dot` and forces
@@ -246,18 +268,24 @@ impl<'a> SampleConstants<'a> {
     #[inline(always)]
     pub fn sample(&self, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
         let model = self.model;
+        let (wanted, not) = (self.wanted, f64::NAN);
         let e = external_torques(&self.mass, &u_dot, &f);
         let stored = match &self.energy_mass {
+            _ if !wanted.stored_energy => not,
             Some(m) => quadratic_energy_j(m, &u),
             None => model.stored_energy_j(&u),
         };
         let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
-        let transferred = model.transferred(&f);
+        let transferred = if wanted.transferred || !self.stator { model.transferred(&f) } else { (not, not) };
         if !self.stator {
             // the reaction that balances the transferred torques
             torque[2] = transferred.1 - transferred.0;
         }
-        let loss = if self.flow_held { 0.0 } else { model.loss_power_w(&u, &f) };
+        let loss = match () {
+            _ if !wanted.loss_power => not,
+            _ if self.flow_held => 0.0,
+            _ => model.loss_power_w(&u, &f),
+        };
         let (mode, lockup) = (self.mode, LockupSample::default());
         Sample { time_s: t, u, u_dot, torque, transferred, mode, loss_power_w: loss, stored_energy_j: stored, lockup }
     }
@@ -266,4 +294,46 @@ impl<'a> SampleConstants<'a> {
 /// The converter's sample at time `t` in `mode` ([`SampleConstants::sample`]).
 pub fn sample(model: &dyn ConverterDynamics, mode: Mode, t: f64, u: Vec4, u_dot: Vec4, f: Vec4) -> Sample {
     SampleConstants::new(model, mode).sample(t, u, u_dot, f)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::Cell;
+
+    /// The segments compute the rates before the root functions only when a root needs them
+    /// ([`root_needs_rates`]): it must say so exactly for the roots whose value calls for the
+    /// stator's torque or the held flow's balance, in every mode.
+    #[test]
+    fn a_root_needs_the_rates_exactly_when_its_value_reads_them() {
+        let roots = [
+            ConverterRoot::StatorTorque,
+            ConverterRoot::StatorSpeed,
+            ConverterRoot::Flow,
+            ConverterRoot::FlowStartsPositive,
+            ConverterRoot::FlowStartsNegative,
+        ];
+        let h = crate::engine::options::SolverOptions::default().hysteresis;
+        for root in roots {
+            for (stator_locked, flow_sign) in [(false, 1.0), (true, -1.0), (true, 0.0)] {
+                let mode = Mode { stator_locked, flow_sign, ..Mode::default() };
+                let read = Cell::new(false);
+                root_value(
+                    root,
+                    mode,
+                    &[1.0, 0.5, -0.1, 0.01],
+                    &h,
+                    || {
+                        read.set(true);
+                        3.0
+                    },
+                    || {
+                        read.set(true);
+                        (1.0, -1.0)
+                    },
+                );
+                assert_eq!(read.get(), root_needs_rates(root), "{root:?} in {mode:?}");
+            }
+        }
+    }
 }

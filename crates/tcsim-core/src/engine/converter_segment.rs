@@ -13,7 +13,7 @@ use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STAT
 use crate::engine::converter_events::{self, ConverterRoot, EventKind, LockupSample, Mode, Sample, SampleConstants};
 use crate::engine::drive::{Drive, TurbineLoad};
 use crate::engine::lockup::{self, ClutchMode, LockupCommand, LockupRoot};
-use crate::engine::options::{named_state, Hysteresis, NamedState, SolverOptions};
+use crate::engine::options::{named_state, Hysteresis, NamedState, Sampled, SolverOptions};
 use crate::engine::segment::{SmoothSegment, SAMPLE_BLOCK};
 use crate::engine::signal::Signal;
 
@@ -64,6 +64,18 @@ pub(super) struct Segment<'a> {
     sampled: SampleConstants<'a>,
     /// Dissipation and impulse work of the lock events before this segment, J (cumulative).
     pub(super) lock_energy_j: (f64, f64),
+    /// Whether a root function reads the rates and forces ([`needs_rates`]).
+    roots_need_rates: bool,
+}
+
+/// Whether the root function `root` reads the rates and forces: the stator's holding torque, a
+/// held flow's balance and the clutch's breakaway do; the stator's speed, the flow and the
+/// clutch's slip need the coordinates alone.
+fn needs_rates(root: Root) -> bool {
+    match root {
+        Root::Converter(r) => converter_events::root_needs_rates(r),
+        Root::Lockup(r) => r == LockupRoot::Breakaway,
+    }
 }
 
 /// The roles of the coordinates of `model` under `drive` in `mode`, and whether the pump follows
@@ -131,6 +143,7 @@ impl<'a> Segment<'a> {
         }
         let inv = invert(n, &reduced).expect("the reduced mass matrix of a positive-definite M is invertible");
         let roots = roots(model, drive, mode);
+        let roots_need_rates = roots.iter().any(|r| needs_rates(*r));
         let given_signal =
             |c: usize| if c == PUMP && pump_follows_turbine { drive.given(TURBINE) } else { drive.given(c) };
         let given = std::array::from_fn(|c| if role[c] == Role::Given { given_signal(c) } else { None });
@@ -155,7 +168,13 @@ impl<'a> Segment<'a> {
             load,
             sampled: SampleConstants::new(model, mode),
             lock_energy_j: (0.0, 0.0),
+            roots_need_rates,
         }
+    }
+
+    /// The segment with only the optional quantities `wanted` in its samples.
+    pub(super) fn sampling(self, wanted: Sampled) -> Self {
+        Self { sampled: self.sampled.wanting(wanted), ..self }
     }
 
     /// Number of ODE states (one dummy state when every coordinate is given or held).
@@ -373,8 +392,14 @@ impl<'a> Segment<'a> {
     /// held flow's balance, the clutch's breakaway): the stator's speed and the flow need `u` alone.
     pub(super) fn root_values(&self, x: &[f64], t: f64, h: &Hysteresis, out: &mut [f64]) {
         let u = self.full(x, t);
-        let kinematics = std::cell::OnceCell::new();
-        let rates = || *kinematics.get_or_init(|| self.kinematics(x, t));
+        // computed before the roots when one of them needs them (a lazy cell's initialiser was a
+        // call that was not inlined, with the three vectors copied out of it)
+        let kinematics =
+            if self.roots_need_rates { self.kinematics(x, t) } else { ([f64::NAN; 4], [f64::NAN; 4], [f64::NAN; 4]) };
+        let rates = || {
+            debug_assert!(self.roots_need_rates, "a root that needs the rates is marked so in `new`");
+            kinematics
+        };
         let slip = u[PUMP] - u[TURBINE];
         let cap = self.drive.lockup().map_or(0.0, |c| c.capacity(t));
         for (k, root) in self.roots.iter().enumerate() {

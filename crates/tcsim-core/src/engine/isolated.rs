@@ -409,7 +409,7 @@ pub fn simulate(
     let t0 = times_s[0];
     let u0 = initial_state(model, drive, t0, init)?;
     let mode = initial_mode(model, drive, &u0, t0);
-    simulate_from(model, drive, times_s, u0, mode, options)
+    run_from(model, drive, times_s, u0, mode, options)
 }
 
 /// At least two finite, increasing output times; a run's own (`resolution`) also no closer than the
@@ -447,6 +447,18 @@ pub fn simulate_from(
     options: &SolverOptions,
 ) -> TransientResult<Trajectory> {
     check_times(times_s, false)?;
+    run_from(model, drive, times_s, u0, mode0, options)
+}
+
+/// [`simulate_from`] with `times_s` checked ([`check_times`]).
+fn run_from(
+    model: &dyn ConverterDynamics,
+    drive: &Drive,
+    times_s: &[f64],
+    u0: Vec4,
+    mode0: Mode,
+    options: &SolverOptions,
+) -> TransientResult<Trajectory> {
     let t_end = *times_s.last().unwrap_or(&0.0);
     let mut traj = Trajectory::default();
     crate::engine::options::try_reserve(&mut traj.samples, times_s.len())?;
@@ -454,7 +466,7 @@ pub fn simulate_from(
     let mut lock_energy_j = (0.0, 0.0);
     let stops = drive.breakpoints();
     loop {
-        let mut seg = Segment::new(model, drive, mode);
+        let mut seg = Segment::new(model, drive, mode).sampling(options.sampled);
         seg.lock_energy_j = lock_energy_j;
         let integrated = t < t_end;
         match run_segment(&seg, &u, t, t_end, &stops, times_s, options, &mut traj)? {

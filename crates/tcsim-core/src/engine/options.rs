@@ -22,6 +22,46 @@ pub struct SolverOptions {
     /// The most memory a batch's outputs may take, bytes ([`DEFAULT_MAX_OUTPUT_BYTES`]): the
     /// estimate of [`check_output_size`] is compared with it before anything runs.
     pub max_output_bytes: f64,
+    /// The optional quantities the samples compute (default all): a batch asks only for those its
+    /// columns read ([`crate::engine::outputs::Selection::sampled`]).
+    pub sampled: Sampled,
+}
+
+/// The quantities of a sample ([`crate::engine::converter_events::Sample`]) that only some output
+/// columns read
+/// ([`crate::engine::outputs::Selection::sampled`]): each is computed only when wanted, and is NaN
+/// in the sample otherwise. The default is all of them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Sampled {
+    /// The fluid's loss power (`Sample::loss_power_w`).
+    pub loss_power: bool,
+    /// The stored energy (`Sample::stored_energy_j`).
+    pub stored_energy: bool,
+    /// The transferred torques (`Sample::transferred`; always computed for a model without a stator coordinate, whose
+    /// stator torque is their balance).
+    pub transferred: bool,
+}
+
+impl Sampled {
+    /// Every quantity.
+    pub const ALL: Self = Self { loss_power: true, stored_energy: true, transferred: true };
+    /// None of them.
+    pub const NONE: Self = Self { loss_power: false, stored_energy: false, transferred: false };
+
+    /// The quantities wanted by either.
+    pub fn or(self, other: Self) -> Self {
+        Self {
+            loss_power: self.loss_power || other.loss_power,
+            stored_energy: self.stored_energy || other.stored_energy,
+            transferred: self.transferred || other.transferred,
+        }
+    }
+}
+
+impl Default for Sampled {
+    fn default() -> Self {
+        Self::ALL
+    }
 }
 
 /// Default of [`SolverOptions::max_output_bytes`]: 2 GB. A launch of 30 s sampled every 10 ms takes
@@ -101,6 +141,7 @@ impl Default for SolverOptions {
             max_steps: 2_000_000,
             hysteresis: Hysteresis { flow_m3_s: 1e-7, stator_speed_rad_s: 1e-4, stator_torque_nm: 1e-6, head_pa: 1e-3 },
             max_output_bytes: DEFAULT_MAX_OUTPUT_BYTES,
+            sampled: Sampled::ALL,
         }
     }
 }

@@ -22,7 +22,7 @@
 use crate::converter::dynamics::{ConverterDynamics, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::Sample;
 use crate::engine::isolated::Trajectory;
-use crate::engine::options::{try_reserve, OutputSize, SolverOptions, TransientResult};
+use crate::engine::options::{try_reserve, OutputSize, Sampled, SolverOptions, TransientResult};
 use crate::error::{CoreError, CoreResult, InputSource};
 
 /// Index in [`COLUMNS`] of the first lock-up clutch column (the clutch's columns come last).
@@ -113,13 +113,13 @@ impl Selection {
         let mut indices = Vec::with_capacity(names.len());
         for (i, name) in names.iter().enumerate() {
             let name = name.as_ref();
-            let field = format!("columns[{i}]");
+            let field = || format!("columns[{i}]");
             let Some(c) = COLUMNS.iter().position(|&n| n == name) else {
                 let expected = format!("an output column name, one of {}", COLUMNS.join(", "));
-                return Err(CoreError::of(InputSource::Options, field, name, expected));
+                return Err(CoreError::of(InputSource::Options, field(), name, expected));
             };
             if indices.contains(&c) {
-                return Err(CoreError::of(InputSource::Options, field, name, "each column named once"));
+                return Err(CoreError::of(InputSource::Options, field(), name, "each column named once"));
             }
             indices.push(c);
         }
@@ -134,6 +134,11 @@ impl Selection {
     /// The names, in the selection's order.
     pub fn names(&self) -> Vec<&'static str> {
         self.indices.iter().map(|&c| COLUMNS[c]).collect()
+    }
+
+    /// The optional quantities of a sample the chosen columns read ([`column_reads`]).
+    pub fn sampled(&self) -> Sampled {
+        self.indices.iter().fold(Sampled::NONE, |w, &c| w.or(column_reads(c)))
     }
 
     /// The number of columns chosen.
@@ -252,6 +257,12 @@ impl RunConstants {
             _ => panic!("output column {c} of {}", COLUMNS.len()),
         }
     }
+}
+
+/// The optional quantities of a sample ([`Sampled`]) that column `c` of [`COLUMNS`] reads in
+/// [`RunConstants::value`]: the transferred torques, the fluid's loss power, the stored energy.
+pub fn column_reads(c: usize) -> Sampled {
+    Sampled { transferred: matches!(c, 17 | 20), loss_power: c == 24, stored_energy: c == 25 }
 }
 
 /// One sample as a row in the order of [`COLUMNS`]. Coordinates the model lacks are NaN, and so

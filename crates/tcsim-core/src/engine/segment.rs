@@ -190,9 +190,7 @@ fn take_samples<S: SmoothSegment, const N: usize>(
     let count = times_s[first..].iter().take_while(|&&t| t <= upto).count();
     let mut xs = [[0.0; N]; SAMPLE_BLOCK];
     for block in times_s[first..first + count].chunks(SAMPLE_BLOCK) {
-        for (x, &t) in xs.iter_mut().zip(block) {
-            bdf.interpolate(t, x);
-        }
+        bdf.interpolate_many(block, &mut xs);
         seg.sample_block(&xs[..block.len()], n, block, samples);
     }
 }

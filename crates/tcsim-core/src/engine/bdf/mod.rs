@@ -286,6 +286,36 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
         }
     }
 
+    /// [`Self::interpolate`] at each of `ts` into the rows of `out` (as many as `ts`), the same
+    /// arithmetic with the order a constant: the loop over the differences unrolled, without a
+    /// branch and an integer conversion per difference.
+    pub fn interpolate_many(&self, ts: &[f64], out: &mut [Vector<N>]) {
+        match self.order {
+            1 => self.interpolate_order::<1>(ts, out),
+            2 => self.interpolate_order::<2>(ts, out),
+            3 => self.interpolate_order::<3>(ts, out),
+            4 => self.interpolate_order::<4>(ts, out),
+            _ => self.interpolate_order::<MAX_ORDER>(ts, out),
+        }
+    }
+
+    /// [`Self::interpolate_many`] at the order `K` (the current one).
+    #[inline(always)]
+    fn interpolate_order<const K: usize>(&self, ts: &[f64], out: &mut [Vector<N>]) {
+        debug_assert!(self.order == K);
+        let (n, h) = (self.n(), self.h);
+        for (o, &t) in out.iter_mut().zip(ts) {
+            o[..n].copy_from_slice(&self.d[0][..n]);
+            let (s, mut p) = ((t - self.t) / h, 1.0);
+            for j in 1..=K {
+                p *= (s + (j - 1) as f64) * RECIPROCALS[j];
+                for (o, v) in o[..n].iter_mut().zip(&self.d[j][..n]) {
+                    *o += p * v;
+                }
+            }
+        }
+    }
+
     fn error(&self, message: String) -> TransientError {
         TransientError::Solver { time_s: self.t, state: self.seg.coordinates(self.x(), self.t), message }
     }
@@ -530,9 +560,9 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
         let down = if k > 1 { norm_of(k, ERROR_CONST[k - 1]) } else { f64::INFINITY };
         let up = if k < MAX_ORDER { norm_of(k + 2, ERROR_CONST[k + 1]) } else { f64::INFINITY };
         let factors = [
-            down.powf(-1.0 / k as f64),
-            self.last_error.powf(-1.0 / (k as f64 + 1.0)),
-            up.powf(-1.0 / (k as f64 + 2.0)),
+            step_factor(down, k as f64),
+            step_factor(self.last_error, k as f64 + 1.0),
+            step_factor(up, k as f64 + 2.0),
         ];
         let mut best = 1;
         for (i, f) in factors.iter().enumerate() {
@@ -545,6 +575,17 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
             self.order = k + best - 1;
             self.rescale(factor);
         }
+    }
+}
+
+/// The step factor `norm^(−1/p)` an error estimate `norm` of order `p − 1` allows: exactly 0 for an
+/// order that does not exist (`norm` infinite), without the call of `powf` that gives it.
+#[inline(always)]
+fn step_factor(norm: f64, p: f64) -> f64 {
+    if norm == f64::INFINITY {
+        0.0
+    } else {
+        norm.powf(-1.0 / p)
     }
 }
 
