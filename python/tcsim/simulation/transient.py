@@ -102,6 +102,8 @@ EVENT_KINDS: tuple[str, ...] = tuple(_core.transient_event_kinds())
 RUN_OK, RUN_INPUT_ERROR, RUN_SOLVER_ERROR, RUN_OVERFLOW = 0, 1, 2, 3
 #: The event arrays of :attr:`BatchColumns.events` and their keys in ``transient_batch``'s result.
 _EVENT_KEYS = tuple((k, f"event_{k}") for k in ("run", "time_s", "kind", "stator_locked", "flow_direction"))
+#: The models of characteristic tables: their runs are looked at for warnings.
+_TABLE_MODELS = ("table", "quasi-dynamic")
 #: Columns the table models' extension warning reads (:meth:`DynamicModel.warn_if_extended`).
 _WARNING_COLUMNS = ("pump_speed_rad_s", "turbine_speed_rad_s")
 
@@ -302,8 +304,9 @@ def simulate_batch(
         batch.check()
     except InputError as e:
         if times_s is not None and e.core_source == "drive":  # the core names the output times the drive's
-            for d in drives:
-                _output_times(_drive_spec(d)["time_s"], times_s)  # a time outside a drive's span
+            for spec in map(_drive_spec, drives):
+                if spec is not None:  # (each is: the run got this far) a time outside its span
+                    _output_times(spec["time_s"], times_s)
             _check_increasing(_floats_1d(times_s))
         raise
     _warn_about_runs(batch)
@@ -330,28 +333,45 @@ def _drive_specs(
     """The drives' dicts for the core (with ``output_time_s`` and ``output_skip`` for ``times_s``) and
     the sample times every run shares, s (None when the drives' time stamps differ). ``every_time``
     as in :func:`_output_times`."""
-    if isinstance(drives, str) or not isinstance(drives, Sequence) or not drives:
+    if not _is_list(drives):
         raise InputError.argument("drives", drives, "a list of one or more drives")
     specs = []
     for i, d in enumerate(drives):
-        if not callable(getattr(d, "_core_spec", None)) and not callable(getattr(d, "spec", None)):
+        s = _drive_spec(d)
+        if s is None:
             expected = "a drive: tcsim.transient.PumpTorqueTurbineSpeed, Speeds or PumpTorqueLoad"
             raise InputError.argument("drive" if len(drives) == 1 else f"drives[{i}]", type(d).__name__, expected)
-        s = _drive_spec(d)
         if times_s is not None:
             s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s, every_time)
         specs.append(s)
     if times_s is not None:
-        return specs, _floats_1d(times_s)
+        out = specs[0]["output_time_s"]
+        return specs, out[specs[0]["output_skip"] :] if len(specs) == 1 else _floats_1d(times_s)
     first = np.asarray(specs[0]["time_s"], dtype=float)
     same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
     return specs, first if same else None
 
 
-def _drive_spec(d: Drive) -> dict[str, Any]:
-    """A drive's dict for the core: its series as arrays (a stand-in drive's ``spec()``)."""
-    core_spec = getattr(d, "_core_spec", None)
-    return core_spec() if core_spec is not None else d.spec()
+def _drive_spec(d: Drive) -> dict[str, Any] | None:
+    """A drive's dict for the core: its series as arrays (a stand-in drive's ``spec()``); None for
+    an object that is no drive."""
+    spec = getattr(d, "_core_spec", None)
+    if spec is None or not callable(spec):
+        spec = getattr(d, "spec", None)
+        if spec is None or not callable(spec):
+            return None
+    return spec()
+
+
+def _is_sequence(x: Any) -> bool:
+    """``isinstance(x, Sequence)``, a list or a tuple tested first (the abstract class's test costs
+    more than the rest of a batch's checks of its arguments)."""
+    return type(x) is list or type(x) is tuple or isinstance(x, Sequence)
+
+
+def _is_list(x: Any) -> bool:
+    """``x`` is a non-empty sequence other than a string."""
+    return _is_sequence(x) and not isinstance(x, str) and len(x) > 0
 
 
 def simulate_columns(
@@ -436,7 +456,7 @@ def _check_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], thread
     r"""The arguments of a batch that the core would refuse as a bare ``ValueError`` or an
     ``OverflowError``, or that fail before it (a converter's name among the models), as
     :class:`InputError` about them."""
-    if isinstance(models, str) or not isinstance(models, Sequence) or not models:
+    if not _is_list(models):
         raise InputError.argument(
             "models", models, "a list of one or more models (tcsim.dynamic_model(converter, name))"
         )
@@ -444,7 +464,7 @@ def _check_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], thread
         if not isinstance(m, DynamicModel):
             expected = "a DynamicModel (tcsim.dynamic_model(converter, name); simulate() also takes a name)"
             raise InputError.argument(f"models[{i}]", type(m).__name__, expected)
-    if isinstance(drives, Sequence) and len(models) != len(drives) and 1 not in (len(models), len(drives)):
+    if len(models) != 1 and _is_sequence(drives) and len(models) != len(drives) and len(drives) != 1:
         expected = f"as many drives as models ({len(models)}), or one of either"
         raise InputError.argument("drives", f"{len(drives)} drives", expected)
     worker_count(threads)
@@ -457,8 +477,9 @@ def _core_columns(models: Sequence[DynamicModel], columns: Sequence[str] | None)
     if isinstance(columns, str):
         raise InputError.argument("columns", columns, "a list of output column names (one name: [name])")
     chosen = [str(c) for c in columns]
-    if any(m.name in ("table", "quasi-dynamic") for m in models):
-        chosen += [c for c in _WARNING_COLUMNS if c not in chosen]
+    for m in models:
+        if m.name in _TABLE_MODELS:
+            return chosen + [c for c in _WARNING_COLUMNS if c not in chosen]
     return chosen
 
 
@@ -498,13 +519,16 @@ def _warn_about_runs(batch: BatchColumns) -> None:
     :meth:`DynamicModel.warn_if_extended`): only the table
     models have any about a run's values, so only their runs are looked at."""
     n = len(batch)
-    for m in {id(m): m for m in batch.models if m.name == "quasi-dynamic"}.values():
+    models = batch.models
+    if len(models) == 1 and models[0].name not in _TABLE_MODELS:  # one run of Hrovat & Tobler
+        return
+    for m in {id(m): m for m in models if m.name == "quasi-dynamic"}.values():
         m.warn_if_fragile_near_coupling()
-    if not any(m.name in ("table", "quasi-dynamic") for m in batch.models):
+    if not any(m.name in _TABLE_MODELS for m in models):
         return
     for i in np.flatnonzero(batch.status == RUN_OK).tolist():
         m = batch._model(i)
-        if m.name in ("table", "quasi-dynamic"):
+        if m.name in _TABLE_MODELS:
             m.warn_if_extended(_warning_rows(batch, i), "the run" + _where(i, n))
 
 
