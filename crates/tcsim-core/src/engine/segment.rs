@@ -7,7 +7,7 @@ use crate::engine::bdf::{Bdf, EXACT_MAX, N_MAX};
 use crate::engine::options::{Hysteresis, NamedState, SolverOptions, TransientError, TransientResult};
 
 /// The most samples taken together ([`SmoothSegment::sample_block`]).
-pub const SAMPLE_BLOCK: usize = 8;
+pub const SAMPLE_BLOCK: usize = 16;
 
 /// A smooth system `M ẋ = f(x, t)` with event functions, as one mode of a piecewise-smooth model.
 pub trait SmoothSegment {
@@ -134,6 +134,7 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
     });
     let mut x = [0.0; N];
     let mut next_stop = 0;
+    let mut pending = Pending::<N>::new();
     loop {
         if *steps >= o.max_steps {
             let (t, x) = (bdf.t(), bdf.x());
@@ -165,32 +166,66 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
             })
         };
         let upto = root.map_or(t_hi, |(t, _)| t);
-        take_samples(&bdf, seg, n, times_s, upto, samples);
+        pending.take(&bdf, seg, n, times_s, upto, samples);
         if let Some((t, i)) = root {
+            pending.flush(seg, n, samples);
             bdf.interpolate(t, &mut x);
             return Ok(Some((t, roots[i], x[..n].to_vec())));
         }
         if t_hi >= t_end {
+            pending.flush(seg, n, samples);
             return Ok(None);
         }
     }
 }
 
-/// Push the samples of the output times after the last sample up to `upto` (within the last step
-/// of `bdf`, of `n` states), in blocks of [`SAMPLE_BLOCK`] interpolated states.
-fn take_samples<S: SmoothSegment, const N: usize>(
-    bdf: &Bdf<'_, S, N>,
-    seg: &S,
-    n: usize,
-    times_s: &[f64],
-    upto: f64,
-    samples: &mut Vec<S::Sample>,
-) {
-    let first = samples.len();
-    let count = times_s[first..].iter().take_while(|&&t| t <= upto).count();
-    let mut xs = [[0.0; N]; SAMPLE_BLOCK];
-    for block in times_s[first..first + count].chunks(SAMPLE_BLOCK) {
-        bdf.interpolate_many(block, &mut xs);
-        seg.sample_block(&xs[..block.len()], n, block, samples);
+/// The interpolated states of output times not yet sampled: the samples are taken in full blocks
+/// of [`SAMPLE_BLOCK`] across the steps of a segment (a step holds about 4 output times of a
+/// take-off sampled every 10 ms), so that their chains of dependent operations overlap
+/// ([`SmoothSegment::sample_block`]). Each state is interpolated in its own step, and the segment's
+/// samples depend on nothing else: the samples are those taken step by step, bit for bit.
+struct Pending<const N: usize> {
+    xs: [[f64; N]; SAMPLE_BLOCK],
+    ts: [f64; SAMPLE_BLOCK],
+    len: usize,
+}
+
+impl<const N: usize> Pending<N> {
+    fn new() -> Self {
+        Self { xs: [[0.0; N]; SAMPLE_BLOCK], ts: [0.0; SAMPLE_BLOCK], len: 0 }
+    }
+
+    /// Interpolate the output times after the last one taken up to `upto` (within the last step of
+    /// `bdf`, of `n` states), sampling each full block.
+    fn take<S: SmoothSegment>(
+        &mut self,
+        bdf: &Bdf<'_, S, N>,
+        seg: &S,
+        n: usize,
+        times_s: &[f64],
+        upto: f64,
+        samples: &mut Vec<S::Sample>,
+    ) {
+        let mut first = samples.len() + self.len;
+        let count = times_s[first..].iter().take_while(|&&t| t <= upto).count();
+        let end = first + count;
+        while first < end {
+            let room = (SAMPLE_BLOCK - self.len).min(end - first);
+            let (ts, xs) = (&mut self.ts[self.len..self.len + room], &mut self.xs[self.len..self.len + room]);
+            ts.copy_from_slice(&times_s[first..first + room]);
+            bdf.interpolate_many(ts, xs);
+            (self.len, first) = (self.len + room, first + room);
+            if self.len == SAMPLE_BLOCK {
+                self.flush(seg, n, samples);
+            }
+        }
+    }
+
+    /// Sample the states held.
+    fn flush<S: SmoothSegment>(&mut self, seg: &S, n: usize, samples: &mut Vec<S::Sample>) {
+        if self.len > 0 {
+            seg.sample_block(&self.xs[..self.len], n, &self.ts[..self.len], samples);
+            self.len = 0;
+        }
     }
 }

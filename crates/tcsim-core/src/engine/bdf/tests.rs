@@ -384,3 +384,37 @@ fn a_span_shorter_than_the_smallest_step_is_no_step() {
     assert!(end.unwrap().is_none() && steps > 0);
     assert!((samples[1].1[0] - 0.5 * (-2.0f64).exp()).abs() < 1e-6, "{samples:?}");
 }
+
+/// The samples are taken in blocks across the steps of a segment (`segment::Pending`), and the
+/// output times never change the steps: a sample is the same whatever the other output times.
+/// Every third time of a dense grid gives the samples of a run at those times alone, bit for bit,
+/// up to an event that ends the segment and up to the end time.
+#[test]
+fn a_sample_does_not_depend_on_the_other_output_times() {
+    let mut a = [[0.0; N_MAX]; N_MAX];
+    a[0][1] = 1.0;
+    a[1][0] = -4.0; // x'' = −4x from x = 1: cos 2t, down to −0.5 at t = π/3
+    let free = Linear::new(2, identity(), a);
+    let mut ended = Linear::new(2, identity(), a);
+    ended.roots = vec![0];
+    ended.g = Some(|x, _t, out| out[0] = x[0] + 0.5);
+    let dense: Vec<f64> = (0..=1000).map(|i| i as f64 * 0.004).collect();
+    let sparse: Vec<f64> = dense.iter().step_by(3).copied().collect();
+    let o = options(1e-8);
+    for seg in [&free, &ended] {
+        let sampled = |times: &[f64]| {
+            let (mut samples, mut steps) = (vec![], 0);
+            let end = run_segment(seg, vec![1.0, 0.0], 0.0, 4.0, times, &o, &mut samples, &mut steps).unwrap();
+            (samples, end.map(|(t, _, _)| t))
+        };
+        let ((all, end_all), (some, end_some)) = (sampled(&dense), sampled(&sparse));
+        assert_eq!(end_all, end_some);
+        let every_third: Vec<_> = all.iter().step_by(3).cloned().collect();
+        assert!(some.len() > 80, "{} samples", some.len()); // 88 up to the event, 334 to the end
+        assert_eq!(every_third, some);
+        if let Some(t) = end_all {
+            assert!((t - std::f64::consts::FRAC_PI_3).abs() < 1e-6, "the event at {t}");
+            assert_eq!(all.len(), dense.iter().take_while(|&&s| s <= t).count());
+        }
+    }
+}
