@@ -345,8 +345,7 @@ def _drive_specs(
             s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s, every_time)
         specs.append(s)
     if times_s is not None:
-        out = specs[0]["output_time_s"]
-        return specs, out[specs[0]["output_skip"] :] if len(specs) == 1 else _floats_1d(times_s)
+        return specs, _floats_1d(times_s)
     first = np.asarray(specs[0]["time_s"], dtype=float)
     same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
     return specs, first if same else None
@@ -519,13 +518,11 @@ def _warn_about_runs(batch: BatchColumns) -> None:
     :meth:`DynamicModel.warn_if_extended`): only the table
     models have any about a run's values, so only their runs are looked at."""
     n = len(batch)
-    models = batch.models
-    if len(models) == 1 and models[0].name not in _TABLE_MODELS:  # one run of Hrovat & Tobler
+    tables = [m for m in batch.models if m.name in _TABLE_MODELS]
+    if not tables:
         return
-    for m in {id(m): m for m in models if m.name == "quasi-dynamic"}.values():
+    for m in {id(m): m for m in tables if m.name == "quasi-dynamic"}.values():
         m.warn_if_fragile_near_coupling()
-    if not any(m.name in _TABLE_MODELS for m in models):
-        return
     for i in np.flatnonzero(batch.status == RUN_OK).tolist():
         m = batch._model(i)
         if m.name in _TABLE_MODELS:

@@ -270,10 +270,12 @@ impl<'a> SampleConstants<'a> {
         let model = self.model;
         let (wanted, not) = (self.wanted, f64::NAN);
         let e = external_torques(&self.mass, &u_dot, &f);
-        let stored = match &self.energy_mass {
-            _ if !wanted.stored_energy => not,
-            Some(m) => quadratic_energy_j(m, &u),
-            None => model.stored_energy_j(&u),
+        let stored = if !wanted.stored_energy {
+            not
+        } else if let Some(m) = &self.energy_mass {
+            quadratic_energy_j(m, &u)
+        } else {
+            model.stored_energy_j(&u)
         };
         let mut torque = [e[PUMP], e[TURBINE], e[STATOR]];
         let transferred = if wanted.transferred || !self.stator { model.transferred(&f) } else { (not, not) };
@@ -281,10 +283,12 @@ impl<'a> SampleConstants<'a> {
             // the reaction that balances the transferred torques
             torque[2] = transferred.1 - transferred.0;
         }
-        let loss = match () {
-            _ if !wanted.loss_power => not,
-            _ if self.flow_held => 0.0,
-            _ => model.loss_power_w(&u, &f),
+        let loss = if !wanted.loss_power {
+            not
+        } else if self.flow_held {
+            0.0
+        } else {
+            model.loss_power_w(&u, &f)
         };
         let (mode, lockup) = (self.mode, LockupSample::default());
         Sample { time_s: t, u, u_dot, torque, transferred, mode, loss_power_w: loss, stored_energy_j: stored, lockup }

@@ -28,17 +28,16 @@ pub struct SolverOptions {
 }
 
 /// The quantities of a sample ([`crate::engine::converter_events::Sample`]) that only some output
-/// columns read
-/// ([`crate::engine::outputs::Selection::sampled`]): each is computed only when wanted, and is NaN
-/// in the sample otherwise. The default is all of them.
+/// columns read ([`crate::engine::outputs::Selection::sampled`]): each is computed only when
+/// wanted, and is NaN in the sample otherwise. The default is all of them.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Sampled {
     /// The fluid's loss power (`Sample::loss_power_w`).
     pub loss_power: bool,
     /// The stored energy (`Sample::stored_energy_j`).
     pub stored_energy: bool,
-    /// The transferred torques (`Sample::transferred`; always computed for a model without a stator coordinate, whose
-    /// stator torque is their balance).
+    /// The transferred torques (`Sample::transferred`; always computed for a model without a
+    /// stator coordinate, whose stator torque is their balance).
     pub transferred: bool,
 }
 

@@ -273,22 +273,15 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
     /// The state at `t` from the last step's interpolating polynomial (for `t` in that step; exact
     /// at its end), into `out[..n]`.
     pub fn interpolate(&self, t: f64, out: &mut [f64]) {
-        let (n, h) = (self.n(), self.h);
-        let out = &mut out[..n];
-        out.copy_from_slice(&self.d[0][..n]);
-        let (s, mut p) = ((t - self.t) / h, 1.0);
-        for j in 1..=self.order {
-            // Π_{m<j} (t − (t_n − m h)) / ((m + 1) h) = Π_{m<j} (s + m)/(m + 1), without a chain of divisions
-            p *= (s + (j - 1) as f64) * RECIPROCALS[j];
-            for (o, v) in out.iter_mut().zip(&self.d[j][..n]) {
-                *o += p * v;
-            }
-        }
+        let n = self.n();
+        let mut x = [[0.0; N]; 1];
+        self.interpolate_many(&[t], &mut x);
+        out[..n].copy_from_slice(&x[0][..n]);
     }
 
-    /// [`Self::interpolate`] at each of `ts` into the rows of `out` (as many as `ts`), the same
-    /// arithmetic with the order a constant: the loop over the differences unrolled, without a
-    /// branch and an integer conversion per difference.
+    /// [`Self::interpolate`] at each of `ts` into the rows of `out` (as many as `ts`), with the
+    /// order a constant: the loop over the differences unrolled, without a branch and an integer
+    /// conversion per difference.
     pub fn interpolate_many(&self, ts: &[f64], out: &mut [Vector<N>]) {
         match self.order {
             1 => self.interpolate_order::<1>(ts, out),
@@ -308,6 +301,7 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
             o[..n].copy_from_slice(&self.d[0][..n]);
             let (s, mut p) = ((t - self.t) / h, 1.0);
             for j in 1..=K {
+                // Π_{m<j} (t − (t_n − m h)) / ((m + 1) h) = Π_{m<j} (s + m)/(m + 1), without a chain of divisions
                 p *= (s + (j - 1) as f64) * RECIPROCALS[j];
                 for (o, v) in o[..n].iter_mut().zip(&self.d[j][..n]) {
                     *o += p * v;
