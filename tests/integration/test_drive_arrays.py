@@ -130,6 +130,40 @@ def test_the_binding_gives_an_array_the_errors_of_its_list(key, value):
     assert outcomes[1] == outcomes[0] and outcomes[2] == outcomes[0]
 
 
+@pytest.mark.parametrize("kind", ["load", "speed", "speeds", "clutch"])
+def test_each_signal_is_read_against_the_one_reading_of_the_time_stamps(kind):
+    """The binding reads a drive's ``time_s`` once for all its signals: a drive without time stamps
+    is refused for them even when its signals are constants, a bad ``time_s`` is named before any
+    signal, and two drives that differ only in a signal's values run as themselves."""
+    m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
+    drive = {
+        "load": tr.PumpTorqueLoad(T4, TORQUE, 1.2, load_torque_nm=10.0),
+        "speed": tr.PumpTorqueTurbineSpeed(T4, TORQUE, 50.0),
+        "speeds": tr.Speeds(T4, 200.0, [0.0, 10.0, 60.0, 150.0]),
+        "clutch": tr.PumpTorqueTurbineSpeed(T4, TORQUE, 50.0, lockup_capacity_nm=[0.0, 0.0, 50.0, 300.0]),
+    }[kind]
+    spec = {**drive.spec(), "output_time_s": [0.0, 0.2, 10.0]}  # (else the output times read time_s)
+    signals = [k for k in spec if k.endswith(("_nm", "_rad_s")) and k != "load_torque_nm"]
+    constants = {**spec, **{k: 100.0 for k in signals}}
+    del constants["time_s"]
+    with pytest.raises(ValueError, match="time_s"):
+        _core.transient_batch([m.spec], [constants], None, {}, 1, ["time_s"])
+    with pytest.raises(_core.CoreInputError) as e:  # a bad signal too: the time stamps come first
+        _core.transient_batch([m.spec], [{**spec, "time_s": "t", signals[-1]: "x"}], None, {}, 1, None)
+    assert e.value.args[1] == "time_s"
+    given = signals[0]  # a given input is an output column: the pump's torque or speed
+    runs = [spec, {**spec, given: [2.0 * v for v in np.broadcast_to(spec[given], (4,))]}]
+    raw = _core.transient_batch([m.spec], runs, None, {}, 2, [given, "turbine_speed_rad_s"])
+    assert not raw["failures"] and raw["names"] == [given, "turbine_speed_rad_s"]
+    for i, r in enumerate(runs):
+        one = _core.transient_batch([m.spec], [r], None, {}, 1, raw["names"])
+        rows = slice(raw["offsets"][i], raw["offsets"][i + 1])
+        for name in raw["names"]:
+            assert np.array_equal(_bits(raw["columns"][name][rows]), _bits(one["columns"][name])), (i, name)
+    first, second = np.split(raw["columns"][given], raw["offsets"][1:-1])
+    assert np.allclose(second, 2.0 * first, rtol=1e-12, atol=0.0)  # (a torque column is computed: M u̇ − F)
+
+
 def test_a_drive_series_of_another_shape_is_refused_as_its_nested_list_is():
     m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
     errors = set()

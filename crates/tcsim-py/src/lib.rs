@@ -19,7 +19,7 @@ use std::time::Duration;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyArrayMethods, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyString};
 
 use tcsim_core::batch::{
     ht_ratio_gradients as core_ratio_gradients, ht_steady_states_cancellable as core_steady_states,
@@ -790,8 +790,34 @@ fn field_error(key: &str, e: impl Into<PyErr>) -> PyErr {
     PyValueError::new_err(format!("{key}: {}", e.into()))
 }
 
+thread_local! {
+    /// The Python strings of the dict keys [`key`] was asked for on this thread, made once each and
+    /// never dropped. Only the binding's own names are asked for (the keys it reads, the columns'
+    /// and the result's names), never a caller's text: a few dozen strings per thread at most.
+    static KEYS: std::mem::ManuallyDrop<std::cell::RefCell<std::collections::HashMap<String, Py<PyString>>>> =
+        Default::default();
+}
+
+/// The Python string of a dict key, made once per thread with its hash (making and hashing the
+/// strings at every lookup was most of the cost of reading a model or a drive dict).
+fn key<'py>(py: Python<'py>, key: &str) -> Bound<'py, PyString> {
+    KEYS.with(|keys| {
+        let mut keys = keys.borrow_mut();
+        match keys.get(key) {
+            Some(k) => k.clone_ref(py),
+            None => keys.entry(key.to_owned()).or_insert_with(|| PyString::intern(py, key).unbind()).clone_ref(py),
+        }
+    })
+    .into_bound(py)
+}
+
+/// `d[key]`, None when absent ([`key`]).
+fn get<'py>(d: &Bound<'py, PyDict>, k: &str) -> PyResult<Option<Bound<'py, PyAny>>> {
+    d.get_item(key(d.py(), k))
+}
+
 fn present<'py>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Bound<'py, PyAny>> {
-    d.get_item(key)?.ok_or_else(|| PyValueError::new_err(format!("missing key {key:?}")))
+    get(d, key)?.ok_or_else(|| PyValueError::new_err(format!("missing key {key:?}")))
 }
 
 fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<T> {
@@ -799,7 +825,7 @@ fn item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> Py
 }
 
 fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -> PyResult<Option<T>> {
-    match d.get_item(key)? {
+    match get(d, key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
         Some(v) => v.extract::<T>().map(Some).map_err(|e| field_error(key, e)),
@@ -810,11 +836,10 @@ fn opt_item<'py, T: FromPyObjectOwned<'py>>(d: &Bound<'py, PyDict>, key: &str) -
 /// float64 NumPy array is copied in one go (strided too); anything else is extracted as a sequence
 /// of floats, as before arrays were taken (a list, a tuple, an array of another dtype or order).
 fn numbers(v: &Bound<'_, PyAny>) -> PyResult<Vec<f64>> {
-    if let Some(ro) = v.cast::<PyArray1<f64>>().ok().and_then(|a| a.try_readonly().ok()) {
-        return Ok(match ro.as_slice() {
-            Ok(s) => s.to_vec(),
-            Err(_) => ro.as_array().to_vec(),
-        });
+    if let Ok(a) = v.cast::<PyArray1<f64>>() {
+        // copied at once under the GIL: no borrow of the array is held (its bookkeeping was a
+        // third of reading a drive)
+        return Ok(a.to_vec().unwrap_or_else(|_| a.to_owned_array().to_vec()));
     }
     v.extract::<Vec<f64>>()
 }
@@ -839,7 +864,7 @@ fn shown(v: &Bound<'_, PyAny>) -> String {
 
 /// [`opt_item`] for a series ([`numbers`]), with its messages.
 fn opt_numbers_item(d: &Bound<'_, PyDict>, key: &str) -> PyResult<Option<Vec<f64>>> {
-    match d.get_item(key)? {
+    match get(d, key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
         Some(v) => numbers(&v).map(Some).map_err(|_| not_numbers(key, &v)),
@@ -854,7 +879,7 @@ impl tcsim_core::converter::spec::ModelSpec for DictSpec<'_, '_> {
         item::<String>(self.0, "kind").map_err(|e| CoreError::new("kind", e, "a model kind"))
     }
     fn numbers(&self, key: &str) -> Option<Vec<f64>> {
-        let v = self.0.get_item(key).ok()??;
+        let v = get(self.0, key).ok()??;
         if v.is_instance_of::<PyList>() {
             // a list is never a number: read it at once, without building the error of a failed
             // `f64` first (which was most of the cost of reading a model, once per run of a batch)
@@ -863,7 +888,7 @@ impl tcsim_core::converter::spec::ModelSpec for DictSpec<'_, '_> {
         v.extract::<f64>().map(|x| vec![x]).or_else(|_| v.extract::<Vec<f64>>()).ok()
     }
     fn text(&self, key: &str) -> Option<String> {
-        self.0.get_item(key).ok()??.extract::<String>().ok()
+        get(self.0, key).ok()??.extract::<String>().ok()
     }
 }
 
@@ -871,28 +896,51 @@ fn model_from(d: &Bound<'_, PyDict>) -> PyResult<Box<dyn ConverterDynamics + Sen
     tcsim_core::converter::spec::build_model(&DictSpec(d)).map_err(input_error)
 }
 
-/// The drive's signal `key`: a constant when a number (a float, a 0-d array), else one value per
-/// time stamp ([`numbers`]; a 1-D float64 array is a series even of one value).
-fn signal_from(d: &Bound<'_, PyDict>, key: &str, window: f64) -> PyResult<Signal> {
-    let t = numbers_item(d, "time_s")?;
-    match d.get_item(key)? {
-        Some(v) if v.cast::<PyArray1<f64>>().is_err() && v.extract::<f64>().is_ok() => {
-            Signal::constant_named(key, v.extract::<f64>()?).map_err(|e| input_error(e.about(InputSource::Drive)))
+/// A drive dict's time stamps (`time_s`), read once by the first of its signals ([`Self::signal`]).
+struct DriveDict<'a, 'py> {
+    d: &'a Bound<'py, PyDict>,
+    window: f64,
+    time_s: Option<Vec<f64>>,
+}
+
+impl DriveDict<'_, '_> {
+    /// The time stamps, read (and checked to be numbers) at the first call.
+    fn time_s(&mut self) -> PyResult<&Vec<f64>> {
+        let t = match self.time_s.take() {
+            Some(t) => t,
+            None => numbers_item(self.d, "time_s")?,
+        };
+        Ok(self.time_s.insert(t))
+    }
+
+    /// The drive's signal `key`: a constant when a number (a float, a 0-d array), else one value
+    /// per time stamp ([`numbers`]; a 1-D float64 array is a series even of one value). The time
+    /// stamps are read first, whichever it is: a drive without them is refused for them.
+    fn signal(&mut self, key: &str) -> PyResult<Signal> {
+        let window = self.window;
+        let t = self.time_s()?.clone();
+        let drive_error = |e: CoreError| input_error(e.about(InputSource::Drive));
+        let v = present(self.d, key)?;
+        if v.cast::<PyArray1<f64>>().is_err() {
+            if let Ok(x) = v.extract::<f64>() {
+                return Signal::constant_named(key, x).map_err(drive_error);
+            }
         }
-        _ => Signal::new(key, t, numbers_item(d, key)?, window).map_err(|e| input_error(e.about(InputSource::Drive))),
+        let values = numbers(&v).map_err(|_| not_numbers(key, &v))?;
+        Signal::new(key, t, values, window).map_err(drive_error)
     }
 }
 
 /// The lock-up clutch's command of a drive dict: `lockup_capacity_nm` (a constant or one value per
 /// time, N·m, checked by [`LockupCommand::new`]) and `lockup_static_to_kinetic` (≥ 1, default
 /// [`tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC`]); None without a capacity.
-fn lockup_from(d: &Bound<'_, PyDict>, window: f64) -> PyResult<Option<LockupCommand>> {
-    if d.get_item("lockup_capacity_nm")?.is_none() {
+fn lockup_from(dd: &mut DriveDict<'_, '_>) -> PyResult<Option<LockupCommand>> {
+    if get(dd.d, "lockup_capacity_nm")?.is_none() {
         return Ok(None);
     }
-    let capacity_nm = signal_from(d, "lockup_capacity_nm", window)?;
+    let capacity_nm = dd.signal("lockup_capacity_nm")?;
     let static_to_kinetic: f64 =
-        opt_item(d, "lockup_static_to_kinetic")?.unwrap_or(tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC);
+        opt_item(dd.d, "lockup_static_to_kinetic")?.unwrap_or(tcsim_core::engine::lockup::DEFAULT_STATIC_TO_KINETIC);
     LockupCommand::new(capacity_nm, static_to_kinetic).map(Some).map_err(input_error)
 }
 
@@ -900,24 +948,25 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
     let kind: String = item(d, "kind")?;
     let window: f64 =
         opt_item(d, "derivative_window_s")?.unwrap_or(tcsim_core::engine::signal::DEFAULT_DERIVATIVE_WINDOW_S);
+    let mut dd = DriveDict { d, window, time_s: None };
     let out = match opt_numbers_item(d, "output_time_s")? {
         Some(t) => t,
-        None => numbers_item(d, "time_s")?,
+        None => dd.time_s()?.clone(),
     };
     let drive = match kind.as_str() {
         "pump-torque-turbine-speed" => Drive::PumpTorqueTurbineSpeed {
-            pump_torque_nm: signal_from(d, "pump_torque_nm", window)?,
-            turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)?,
-            lockup: lockup_from(d, window)?,
+            pump_torque_nm: dd.signal("pump_torque_nm")?,
+            turbine_speed_rad_s: dd.signal("turbine_speed_rad_s")?,
+            lockup: lockup_from(&mut dd)?,
         },
         "speeds" => Drive::Speeds {
-            pump_speed_rad_s: signal_from(d, "pump_speed_rad_s", window)?,
-            turbine_speed_rad_s: signal_from(d, "turbine_speed_rad_s", window)?,
-            lockup: lockup_from(d, window)?,
+            pump_speed_rad_s: dd.signal("pump_speed_rad_s")?,
+            turbine_speed_rad_s: dd.signal("turbine_speed_rad_s")?,
+            lockup: lockup_from(&mut dd)?,
         },
         "pump-torque-load" => {
             let load = TurbineLoad {
-                torque_nm: signal_from(d, "load_torque_nm", window)?,
+                torque_nm: dd.signal("load_torque_nm")?,
                 inertia_kg_m2: item(d, "load_inertia_kg_m2")?,
                 drag_nm_s2: opt_item(d, "load_drag_nm_s2")?.unwrap_or(0.0),
             };
@@ -937,11 +986,7 @@ fn drive_from(d: &Bound<'_, PyDict>) -> PyResult<(Drive, Vec<f64>)> {
                     "a finite drag coefficient of zero or more",
                 )));
             }
-            Drive::PumpTorqueLoad {
-                pump_torque_nm: signal_from(d, "pump_torque_nm", window)?,
-                load,
-                lockup: lockup_from(d, window)?,
-            }
+            Drive::PumpTorqueLoad { pump_torque_nm: dd.signal("pump_torque_nm")?, load, lockup: lockup_from(&mut dd)? }
         }
         other => return Err(PyValueError::new_err(format!("unknown drive kind {other:?}"))),
     };
@@ -976,7 +1021,7 @@ fn opt_input<'py, T: FromPyObjectOwned<'py>>(
     key: &str,
     expected: &str,
 ) -> PyResult<Option<T>> {
-    match d.get_item(key)? {
+    match get(d, key)? {
         None => Ok(None),
         Some(v) if v.is_none() => Ok(None),
         Some(v) => v.extract::<T>().map(Some).map_err(|_| input_error(CoreError::of(source, key, shown(&v), expected))),
@@ -1124,31 +1169,34 @@ fn failure_dict<'py>(py: Python<'py>, run: usize, f: RunFailure) -> PyResult<Bou
     Ok(d)
 }
 
+/// `d[name]` = a NumPy array of `values`, copied into NumPy's own memory (for the small arrays of a
+/// batch's result, cheaper than handing over a `Vec`).
+fn small_array<T: numpy::Element>(d: &Bound<'_, PyDict>, name: &str, values: &[T]) -> PyResult<()> {
+    d.set_item(key(d.py(), name), PyArray1::from_slice(d.py(), values))
+}
+
 /// The dict `transient_batch` returns (see there), moving the buffers into NumPy without a copy.
 fn batch_dict<'py>(py: Python<'py>, b: BatchColumns) -> PyResult<Bound<'py, PyDict>> {
     let d = PyDict::new(py);
-    let names = b.selection.names();
-    d.set_item("names", &names)?;
+    let names: Vec<Bound<'py, PyString>> = b.selection.names().into_iter().map(|name| key(py, name)).collect();
     let cols = PyDict::new(py);
     for (name, col) in names.iter().zip(b.columns) {
-        cols.set_item(*name, col.into_pyarray(py))?;
+        cols.set_item(name, col.into_pyarray(py))?;
     }
-    d.set_item("columns", cols)?;
+    d.set_item(key(py, "names"), PyList::new(py, names)?)?;
+    d.set_item(key(py, "columns"), cols)?;
     let offsets: Vec<i64> = b.offsets.iter().map(|&o| o as i64).collect();
-    d.set_item("offsets", offsets.into_pyarray(py))?;
-    d.set_item("status", b.status.into_pyarray(py))?;
+    small_array(&d, "offsets", &offsets)?;
+    small_array(&d, "status", &b.status)?;
     let ev = &b.events;
     let code = |k: EventKind| EVENT_KINDS.iter().position(|&c| c == k).unwrap_or(usize::MAX) as u8;
-    d.set_item("event_run", ev.iter().map(|(i, _)| *i as i64).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("event_time_s", ev.iter().map(|(_, e)| e.time_s).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item("event_kind", ev.iter().map(|(_, e)| code(e.kind)).collect::<Vec<_>>().into_pyarray(py))?;
-    d.set_item(
-        "event_stator_locked",
-        ev.iter().map(|(_, e)| e.mode.stator_locked).collect::<Vec<_>>().into_pyarray(py),
-    )?;
-    d.set_item("event_flow_direction", ev.iter().map(|(_, e)| e.mode.flow_sign).collect::<Vec<_>>().into_pyarray(py))?;
+    small_array(&d, "event_run", &ev.iter().map(|(i, _)| *i as i64).collect::<Vec<_>>())?;
+    small_array(&d, "event_time_s", &ev.iter().map(|(_, e)| e.time_s).collect::<Vec<_>>())?;
+    small_array(&d, "event_kind", &ev.iter().map(|(_, e)| code(e.kind)).collect::<Vec<_>>())?;
+    small_array(&d, "event_stator_locked", &ev.iter().map(|(_, e)| e.mode.stator_locked).collect::<Vec<_>>())?;
+    small_array(&d, "event_flow_direction", &ev.iter().map(|(_, e)| e.mode.flow_sign).collect::<Vec<_>>())?;
     let failures = b.failures.into_iter().map(|(i, f)| failure_dict(py, i, f)).collect::<PyResult<Vec<_>>>()?;
-    d.set_item("failures", PyList::new(py, failures)?)?;
+    d.set_item(key(py, "failures"), PyList::new(py, failures)?)?;
     Ok(d)
 }
 
@@ -1182,13 +1230,16 @@ fn transient_jobs(
         parsed.push((drive, times));
         skips.push(skip);
     }
-    let jobs = (0..n)
-        .map(|i| {
-            let (drive, times) = &parsed[if parsed.len() == 1 { 0 } else { i }];
-            let model = model_from(&models[if models.len() == 1 { 0 } else { i }])?;
-            Ok(TransientJob { model, drive: drive.clone(), times_s: times.clone(), init, options })
-        })
-        .collect::<PyResult<Vec<_>>>()?;
+    let job = |i: usize, (drive, times_s): (Drive, Vec<f64>)| -> PyResult<TransientJob> {
+        let model = model_from(&models[if models.len() == 1 { 0 } else { i }])?;
+        Ok(TransientJob { model, drive, times_s, init, options })
+    };
+    // each run's drive moved into its job; one drive for all runs copied into each
+    let jobs = if parsed.len() == n {
+        parsed.into_iter().enumerate().map(|(i, p)| job(i, p)).collect::<PyResult<Vec<_>>>()?
+    } else {
+        (0..n).map(|i| job(i, parsed[0].clone())).collect::<PyResult<Vec<_>>>()?
+    };
     Ok((jobs, skips))
 }
 
