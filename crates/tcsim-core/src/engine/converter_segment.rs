@@ -141,7 +141,8 @@ impl<'a> Segment<'a> {
                 }
             }
         }
-        let inv = invert(n, &reduced).expect("the reduced mass matrix of a positive-definite M is invertible");
+        let inv = crate::linalg::invert_leading(n, &reduced)
+            .expect("the reduced mass matrix of a positive-definite M is invertible");
         let roots = roots(model, drive, mode);
         let roots_need_rates = roots.iter().any(|r| needs_rates(*r));
         let given_signal =
@@ -481,17 +482,6 @@ impl<'a> Segment<'a> {
         }
         a
     }
-}
-
-/// Inverse of the leading n×n block.
-fn invert(n: usize, a: &Mat4) -> Option<Mat4> {
-    let block: Vec<Vec<f64>> = a.iter().take(n).map(|row| row[..n].to_vec()).collect();
-    let inv = crate::linalg::invert(&block)?;
-    let mut out = [[0.0; 4]; 4];
-    for (r, row) in inv.iter().enumerate() {
-        out[r][..n].copy_from_slice(row);
-    }
-    Some(out)
 }
 
 /// Sign of the flow that starts from Q = 0 in `mode` ([`converter_events::flow_sign_from_balance`]).

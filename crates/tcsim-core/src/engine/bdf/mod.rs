@@ -178,8 +178,9 @@ impl<'s, S: SmoothSegment, const N: usize> Bdf<'s, S, N> {
     /// Start at `(x0, t0)` with the step `o.first_step_s` (at most `t_end − t0`), order 1.
     pub fn new(seg: &'s S, x0: &[f64], t0: f64, t_end: f64, o: &SolverOptions) -> TransientResult<Self> {
         let n = seg.n_states();
-        let state = if x0.len() == n { seg.coordinates(x0, t0) } else { named_state(None, x0) };
-        let fail = |m: String| TransientError::Solver { time_s: t0, state: state.clone(), message: m };
+        // the state named only for an error (naming it was two allocations of every segment)
+        let state = || if x0.len() == n { seg.coordinates(x0, t0) } else { named_state(None, x0) };
+        let fail = |m: String| TransientError::Solver { time_s: t0, state: state(), message: m };
         if n == 0 || n > N || x0.len() != n {
             return Err(fail(format!("{n} states ({} given): the solver takes 1 to {N}", x0.len())));
         }
