@@ -790,23 +790,51 @@ fn field_error(key: &str, e: impl Into<PyErr>) -> PyErr {
     PyValueError::new_err(format!("{key}: {}", e.into()))
 }
 
+/// A [`std::hash::Hasher`] of a Rust string's address ([`key`]): one multiplication, where SipHash
+/// over the text was most of a lookup.
+#[derive(Default)]
+struct AddressHasher(u64);
+
+impl std::hash::Hasher for AddressHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        bytes.iter().for_each(|&b| self.write_u64(u64::from(b)));
+    }
+    fn write_u64(&mut self, n: u64) {
+        let x = (self.0 ^ n).wrapping_mul(0x9E37_79B9_7F4A_7C15);
+        self.0 = x ^ (x >> 29);
+    }
+    fn write_usize(&mut self, n: usize) {
+        self.write_u64(n as u64);
+    }
+}
+
+/// The key strings of [`key`] by the address of the Rust string, with its text.
+type KeyStrings =
+    std::collections::HashMap<usize, (Box<str>, Py<PyString>), std::hash::BuildHasherDefault<AddressHasher>>;
+
 thread_local! {
     /// The Python strings of the dict keys [`key`] was asked for on this thread, made once each and
     /// never dropped. Only the binding's own names are asked for (the keys it reads, the columns'
     /// and the result's names), never a caller's text: a few dozen strings per thread at most.
-    static KEYS: std::mem::ManuallyDrop<std::cell::RefCell<std::collections::HashMap<String, Py<PyString>>>> =
-        Default::default();
+    static KEYS: std::mem::ManuallyDrop<std::cell::RefCell<KeyStrings>> = Default::default();
 }
 
 /// The Python string of a dict key, made once per thread with its hash (making and hashing the
-/// strings at every lookup was most of the cost of reading a model or a drive dict).
+/// strings at every lookup was most of the cost of reading a model or a drive dict). The names are
+/// string constants, found by their address; the text is compared too (a string at the address of
+/// another that was dropped).
 fn key<'py>(py: Python<'py>, key: &str) -> Bound<'py, PyString> {
     KEYS.with(|keys| {
         let mut keys = keys.borrow_mut();
-        match keys.get(key) {
-            Some(k) => k.clone_ref(py),
-            None => keys.entry(key.to_owned()).or_insert_with(|| PyString::intern(py, key).unbind()).clone_ref(py),
+        let entry =
+            keys.entry(key.as_ptr() as usize).or_insert_with(|| (key.into(), PyString::intern(py, key).unbind()));
+        if *entry.0 != *key {
+            *entry = (key.into(), PyString::intern(py, key).unbind());
         }
+        entry.1.clone_ref(py)
     })
     .into_bound(py)
 }
@@ -1043,7 +1071,7 @@ fn init_from(d: Option<&Bound<'_, PyDict>>) -> PyResult<InitialState> {
 /// The solver options of `d`; its other keys must be among `extra` (the caller's own options).
 fn options_from(d: Option<&Bound<'_, PyDict>>, extra: &[&str]) -> PyResult<SolverOptions> {
     let mut o = SolverOptions::default();
-    if let Some(d) = d {
+    if let Some(d) = d.filter(|d| !d.is_empty()) {
         known_keys(d, InputSource::Options, &[&OPTION_KEYS[..], extra].concat())?;
         let number = |key: &str| opt_input::<f64>(d, InputSource::Options, key, "a number");
         o.rtol = number("rtol")?.unwrap_or(o.rtol);
