@@ -21,7 +21,7 @@
 //! Sign conventions follow docs/physics.md §2: `T_ext` holds the external torques on pump, turbine
 //! and stator; the torque delivered to the transmission is `−T_ext[TURBINE]`.
 
-use super::hrovat_tobler::{steady_state, HtGeometry, HtParam};
+use super::hrovat_tobler::{steady_state_with, HtConstants, HtGeometry, HtParam};
 use super::torque_capacity::TorqueCharacteristic;
 use crate::error::{CoreError, CoreResult};
 
@@ -328,6 +328,9 @@ pub struct HtDynamics {
     /// Shape effects of pump, turbine and stator, m² (eqs 2.16–2.18).
     pub shape_effect_m2: [f64; 3],
     k: HtConst,
+    /// The geometry's constants of the steady state (its six tangents computed once, not at every
+    /// initial state).
+    steady: HtConstants<f64>,
 }
 
 const SHAPE_KEYS: [&str; 3] =
@@ -394,7 +397,8 @@ impl HtDynamics {
                 return Err(CoreError::new(*k, s, "a finite shape effect in m²"));
             }
         }
-        let d = Self { k: Self::constants(&geometry), geometry, inertia, fluid_length_m, shape_effect_m2 };
+        let (k, steady) = (Self::constants(&geometry), HtConstants::new(&geometry));
+        let d = Self { k, steady, geometry, inertia, fluid_length_m, shape_effect_m2 };
         d.check_mass_matrix()?;
         Ok(d)
     }
@@ -755,7 +759,7 @@ impl ConverterDynamics for HtDynamics {
         j
     }
     fn steady_point(&self, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {
-        let s = steady_state(&self.geometry, wp, wt)?;
+        let s = steady_state_with(&self.steady, wp, wt)?;
         Ok(SteadyPoint { u: [wp, wt, s.stator_speed_rad_s, s.flow_m3_s], pump_torque_nm: s.pump_torque_nm })
     }
     fn zero_flow_head(&self, u: &Vec4) -> (f64, f64) {
@@ -813,6 +817,7 @@ impl<T: ConverterDynamics + ?Sized> ConverterDynamics for Box<T> {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
+    use crate::converter::hrovat_tobler::steady_state;
     use crate::converter::quasi_dynamic::QuasiDynamics;
     use crate::converter::table::Characteristic;
 
@@ -862,6 +867,27 @@ pub(crate) mod tests {
     /// fluid length and shape effects): the engine's tests' take-off model.
     pub(crate) fn bundled_ht() -> HtDynamics {
         ht([0.001310, 0.002324, 0.001723])
+    }
+
+    #[test]
+    fn the_steady_point_is_the_steady_state_of_the_geometry_bit_for_bit() {
+        // the model keeps its geometry's steady-state constants (computed once): its steady point
+        // must be `steady_state` of its geometry, every sign of the speeds, failures alike
+        let m = bundled_ht();
+        for wp in [0.0, 1e-3, 50.0, 209.4, 400.0, -150.0, 1e5] {
+            for sr in [0.0, 0.3, 0.87, 1.0, 1.4, -0.5] {
+                let (point, state) = (m.steady_point(wp, sr * wp), steady_state(&m.geometry, wp, sr * wp));
+                match (point, state) {
+                    (Ok(p), Ok(s)) => {
+                        let want = [wp, sr * wp, s.stator_speed_rad_s, s.flow_m3_s, s.pump_torque_nm];
+                        let got = [p.u[0], p.u[1], p.u[2], p.u[3], p.pump_torque_nm];
+                        assert_eq!(got.map(f64::to_bits), want.map(f64::to_bits), "{wp} rad/s, SR {sr}");
+                    }
+                    (Err(a), Err(b)) => assert_eq!(a.to_string(), b.to_string()),
+                    (a, b) => panic!("{wp} rad/s, SR {sr}: {a:?} against {b:?}"),
+                }
+            }
+        }
     }
 
     fn qd() -> QuasiDynamics {

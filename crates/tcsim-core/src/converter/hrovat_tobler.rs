@@ -146,8 +146,8 @@ impl HtGeometry<f64> {
             }
         }
         let g = Self { values };
-        g.check_finite()?;
         let k = HtConstants::new(&g);
+        g.check_finite(&k)?;
         let dissipation = k.dissipation_coefficient();
         if dissipation <= 0.0 {
             return Err(CoreError::new(
@@ -169,13 +169,14 @@ impl HtGeometry<f64> {
     /// The steady states at the reference pump speed (stall and SR 0.5) must be finite: parameters
     /// that overflow them (a density of 1e300 kg/m³, radii of 1e100 m) are refused, naming the one
     /// farthest outside its plausible range ([`crate::plausibility`]).
-    fn check_finite(&self) -> CoreResult<()> {
+    /// `k` are the geometry's constants.
+    fn check_finite(&self, k: &HtConstants<f64>) -> CoreResult<()> {
         let wp = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
-        let finite = [0.0, 0.5].iter().all(|&sr| match steady_state(self, wp, sr * wp) {
+        let finite = [0.0, 0.5].iter().all(|&sr| match steady_state_with(k, wp, sr * wp) {
             Ok(s) => s.is_finite(),
             Err(e) => e.source != InputSource::Drive, // no steady state is the dissipation check's
         });
-        if finite && HtConstants::new(self).dissipation_coefficient().is_finite() {
+        if finite && k.dissipation_coefficient().is_finite() {
             return Ok(());
         }
         let quantity = |p: HtParam| match p {
