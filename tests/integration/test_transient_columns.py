@@ -239,3 +239,16 @@ def test_a_batch_of_one_run_is_its_columnar_run_with_the_same_warnings_and_error
         with pytest.raises(tr.SolverError) as e:
             call([ht], [solver_fails], times_s=t)
         assert str(e.value) == str(expected)
+
+
+def test_a_single_runs_columns_keep_each_ones_layout():
+    """``BatchColumns.runs()`` of one run takes each column as its layout gives it (the whole of a
+    flat column, the one row of a (1, S) one), also when a caller mixed the two."""
+    m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
+    t = np.linspace(0.0, 10.0, 11)
+    b = tr.simulate_columns([m], [tr.isolated_takeoff()], times_s=t, columns=["time_s", "pump_speed_rad_s"])
+    assert b.columns["time_s"].shape == (1, 11)
+    b.columns = {"flat": np.arange(11.0), **b.columns, "also_flat": np.arange(11.0) + 1.0}
+    run = b.runs()[0]
+    assert {k: v.shape for k, v in run.columns.items()} == {k: (11,) for k in b.columns}
+    assert np.array_equal(run["time_s"], t) and np.array_equal(run["also_flat"], np.arange(11.0) + 1.0)

@@ -816,10 +816,11 @@ type KeyStrings =
     std::collections::HashMap<usize, (Box<str>, Py<PyString>), std::hash::BuildHasherDefault<AddressHasher>>;
 
 thread_local! {
-    /// The Python strings of the dict keys [`key`] was asked for on this thread, made once each and
-    /// never dropped. Only the binding's own names are asked for (the keys it reads, the columns'
-    /// and the result's names), never a caller's text: a few dozen strings per thread at most.
-    static KEYS: std::mem::ManuallyDrop<std::cell::RefCell<KeyStrings>> = Default::default();
+    /// The Python strings of the dict keys [`key`] was asked for on this thread, made once each.
+    /// Only the binding's own names are asked for (the keys it reads, the columns' and the
+    /// result's names), never a caller's text: a few dozen strings per thread at most, released
+    /// when the thread ends (PyO3 defers the references it drops there, without the interpreter).
+    static KEYS: std::cell::RefCell<KeyStrings> = Default::default();
 }
 
 /// The Python string of a dict key, made once per thread with its hash (making and hashing the
@@ -945,8 +946,7 @@ impl DriveDict<'_, '_> {
     /// per time stamp ([`numbers`]; a 1-D float64 array is a series even of one value). The time
     /// stamps are read first, whichever it is: a drive without them is refused for them.
     fn signal(&mut self, key: &str) -> PyResult<Signal> {
-        let window = self.window;
-        let t = self.time_s()?.clone();
+        self.time_s()?;
         let drive_error = |e: CoreError| input_error(e.about(InputSource::Drive));
         let v = present(self.d, key)?;
         if v.cast::<PyArray1<f64>>().is_err() {
@@ -955,7 +955,7 @@ impl DriveDict<'_, '_> {
             }
         }
         let values = numbers(&v).map_err(|_| not_numbers(key, &v))?;
-        Signal::new(key, t, values, window).map_err(drive_error)
+        Signal::new(key, self.time_s()?.clone(), values, self.window).map_err(drive_error)
     }
 }
 

@@ -219,9 +219,8 @@ class BatchColumns:
         ev = self.events
         fields = [ev[k].tolist() for k in ("time_s", "kind", "stator_locked", "flow_direction")]
         events = [Event(t, EVENT_KINDS[k], locked, flow) for t, k, locked, flow in zip(*fields)]
-        if n == 1:  # a single run: the whole of flat columns, the one row of (1, S) ones
-            flat = next(iter(self.columns.values()), self.offsets).ndim == 1  # (one layout for all)
-            cols = dict(self.columns) if flat else {name: c[0] for name, c in self.columns.items()}
+        if n == 1:  # a single run: the whole of a flat column, the one row of an (1, S) one
+            cols = {name: c if c.ndim == 1 else c[0] for name, c in self.columns.items()}
             return [TransientResult(self._model(0).name, cols, events)]
         names = list(self.columns)
         rows = [list(c) if c.ndim == 2 else np.split(c, self.offsets[1:-1]) for c in self.columns.values()]
