@@ -38,16 +38,19 @@ use crate::units::REFERENCE_PUMP_SPEED_RAD_S;
 /// slope of CF, so a slope that jumps at a row (5× at the coupling point of Table C.1) steps the
 /// fluid torques `ρS Q̇` and rings the driveline (docs/models.md, "Steady flow: a C¹ interpolation of CF").
 /// The torques stay the table's; at steady state nothing changes.
+///
+/// Its parameters are private: the constants derived from them at [`QuasiDynamics::new`] (and the
+/// checks made there) would not follow a change.
 #[derive(Debug, Clone)]
 pub struct QuasiDynamics {
     /// One table, or several measured at different input torques (the pump torque solved).
-    pub characteristic: TorqueCharacteristic,
-    pub inertia: Inertias,
-    pub fluid_density_kg_m3: f64,
-    pub pump_radius_m: f64,
-    pub pump_shape_effect_m2: f64,
-    pub turbine_shape_effect_m2: f64,
-    pub flow_time_constant_s: f64,
+    characteristic: TorqueCharacteristic,
+    inertia: Inertias,
+    fluid_density_kg_m3: f64,
+    pump_radius_m: f64,
+    pump_shape_effect_m2: f64,
+    turbine_shape_effect_m2: f64,
+    flow_time_constant_s: f64,
     /// Derived by [`QuasiDynamics::new`]: `1/(τ_Q·k_ref)` with `k = P_tr/(Q_ss² + ε²)` at the
     /// reference point, 1/(s·W/(m³/s)²); the stall flow per unit pump speed, m³/s per rad/s; and
     /// the floor of ε², (m³/s)².
