@@ -18,8 +18,7 @@ pub fn invert_leading(n: usize, a: &[[f64; 4]; 4]) -> Option<[[f64; 4]; 4]> {
         m[i][..n].copy_from_slice(&a[i][..n]);
         inv[i][i] = 1.0;
     }
-    let (m, inv_rows) = (&mut m[..n], &mut inv[..n]);
-    gauss_jordan(m, inv_rows)?;
+    gauss_jordan(&mut m[..n], &mut inv[..n])?;
     Some(inv)
 }
 

@@ -168,8 +168,7 @@ impl HtGeometry<f64> {
 
     /// The steady states at the reference pump speed (stall and SR 0.5) must be finite: parameters
     /// that overflow them (a density of 1e300 kg/m³, radii of 1e100 m) are refused, naming the one
-    /// farthest outside its plausible range ([`crate::plausibility`]).
-    /// `k` are the geometry's constants.
+    /// farthest outside its plausible range ([`crate::plausibility`]). `k` are its constants.
     fn check_finite(&self, k: &HtConstants<f64>) -> CoreResult<()> {
         let wp = crate::units::REFERENCE_PUMP_SPEED_RAD_S;
         let finite = [0.0, 0.5].iter().all(|&sr| match steady_state_with(k, wp, sr * wp) {
