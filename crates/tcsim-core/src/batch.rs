@@ -110,8 +110,7 @@ pub fn ht_steady_states_cancellable(
         turbine_speed_rad_s.len() == n && (geometry.len() == 1 || geometry.len() == n),
         "batch shapes are checked by the caller"
     );
-    let cores = if threads == 0 { std::thread::available_parallelism().map_or(1, |c| c.get()) } else { threads };
-    let workers = cores.min(n / STEADY_POINTS_PER_THREAD).max(1);
+    let workers = worker_threads(threads, n / STEADY_POINTS_PER_THREAD);
     let mut out = HtSteadyColumns::zeros(n);
     let len = n.div_ceil(workers).max(1);
     let pieces = out.pieces(len);
@@ -294,6 +293,15 @@ pub fn run_transient_job(job: &TransientJob) -> crate::engine::options::Transien
     })
 }
 
+/// The worker threads of a batch asked for `threads` (0: one per core) with work for at most `most`:
+/// at least one. The number of cores is read once per process: the standard library reads it from
+/// the cgroup files each time, which cost about 25 µs, more than a short run.
+pub fn worker_threads(threads: usize, most: usize) -> usize {
+    static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
+    let cores = || *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |c| c.get()));
+    if threads == 0 { cores() } else { threads }.min(most).max(1)
+}
+
 /// `f` over `jobs` on `threads` worker threads (0: one per core), results in job order.
 pub fn parallel_map<J: Sync, R: Send>(jobs: &[J], threads: usize, f: impl Fn(&J) -> R + Sync) -> Vec<R> {
     let never = AtomicBool::new(false);
@@ -310,9 +318,7 @@ pub fn parallel_map_cancellable<J: Sync, R: Send>(
 ) -> Vec<Option<R>> {
     use std::sync::atomic::AtomicUsize;
     use std::sync::Mutex;
-    let threads = if threads == 0 { std::thread::available_parallelism().map_or(1, |n| n.get()) } else { threads }
-        .min(jobs.len())
-        .max(1);
+    let threads = worker_threads(threads, jobs.len());
     if threads == 1 {
         return jobs.iter().map(|j| if cancel.load(Ordering::Relaxed) { None } else { Some(f(j)) }).collect();
     }
@@ -444,8 +450,7 @@ pub fn run_transient_columns(
         columns.push(c);
     }
     let mut status = vec![RUN_OK; n];
-    let cores = if threads == 0 { std::thread::available_parallelism().map_or(1, |c| c.get()) } else { threads };
-    let workers = cores.min(n).max(1);
+    let workers = worker_threads(threads, n);
     let per_piece = (n / (16 * workers)).clamp(1, MAX_RUNS_PER_PIECE);
     let pieces = run_rows(&mut columns, &mut status, &offsets, per_piece);
     let piece_count = pieces.len();
@@ -609,6 +614,18 @@ mod tests {
         // overrun has a steady state now (reverse flow)
         let coast = ht_steady_states(&[g], &[200.0], &[260.0], true).unwrap();
         assert!(coast.flow_m3_s[0] < 0.0 && coast.pump_torque_nm[0] < 0.0);
+    }
+
+    #[test]
+    fn a_batch_has_at_least_one_worker_and_never_more_than_its_work_or_the_cores() {
+        let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+        for most in [0, 1, 2, 7, usize::MAX] {
+            assert_eq!(worker_threads(0, most), cores.min(most).max(1), "0 threads, {most} jobs");
+            assert_eq!(worker_threads(0, most), worker_threads(0, most), "read once, the same after");
+            for threads in [1, 3, 64] {
+                assert_eq!(worker_threads(threads, most), threads.min(most).max(1), "{threads} threads, {most} jobs");
+            }
+        }
     }
 
     /// The bits of every column, NaN included.
