@@ -11,6 +11,8 @@ overflow rule lives in the core; the memory estimate counts only the chosen colu
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -252,3 +254,27 @@ def test_a_single_runs_columns_keep_each_ones_layout():
     run = b.runs()[0]
     assert {k: v.shape for k, v in run.columns.items()} == {k: (11,) for k in b.columns}
     assert np.array_equal(run["time_s"], t) and np.array_equal(run["also_flat"], np.arange(11.0) + 1.0)
+
+
+def test_a_batchs_events_are_the_events_event_makes_and_as_frozen():
+    # the events are made with their fields set at once (`_event_list`), not through the frozen
+    # dataclass's __init__: each must be the Event(...) of its fields, equal, hashed, shown and
+    # frozen alike, the same from runs() and from run_events(i), in time order within each run
+    m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
+    drives = [_lockup_takeoff(), tr.isolated_takeoff(tip_out=True), _lockup_takeoff()]
+    batch = tr.simulate_columns([m], drives, times_s=TIMES, threads=2)
+    runs = batch.runs()
+    assert [len(r.events) for r in runs][0] >= 2 and sum(len(r.events) for r in runs) >= 5
+    for i, r in enumerate(runs):
+        assert r.events == batch.run_events(i)
+        times = [e.time_s for e in r.events]
+        assert times == sorted(times)
+        for e in r.events:
+            made = tr.Event(e.time_s, e.kind, e.stator_locked, e.flow_direction)
+            assert (e == made, hash(e) == hash(made), repr(e) == repr(made)) == (True, True, True)
+            assert [type(getattr(e, f.name)) for f in dataclasses.fields(e)] == [float, str, bool, float]
+            assert e.kind in tr.EVENT_KINDS
+            with pytest.raises(dataclasses.FrozenInstanceError):
+                e.kind = "flow-zero"  # type: ignore[misc]
+    empty = tr.simulate_columns([m], [tr.isolated_takeoff()], times_s=np.array([0.0, 0.01]), threads=1)
+    assert empty.runs()[0].events == [] and empty.run_events(0) == []

@@ -178,15 +178,8 @@ class BatchColumns:
 
     def run_events(self, i: int) -> list[Event]:
         """The events of run ``i``."""
-        ev = self.events
-        a, b = np.searchsorted(ev["run"], [i, i + 1])
-        kinds = ev["kind"][a:b].tolist()
-        return [
-            Event(t, EVENT_KINDS[k], locked, flow)
-            for t, k, locked, flow in zip(
-                ev["time_s"][a:b].tolist(), kinds, ev["stator_locked"][a:b].tolist(), ev["flow_direction"][a:b].tolist()
-            )
-        ]
+        a, b = np.searchsorted(self.events["run"], [i, i + 1])
+        return _event_list(self.events, slice(a, b))
 
     def check(self) -> None:
         """Raise the error of the first run that failed with an error (input or solver), else of the
@@ -217,8 +210,7 @@ class BatchColumns:
         self.check()
         n = len(self)
         ev = self.events
-        fields = [ev[k].tolist() for k in ("time_s", "kind", "stator_locked", "flow_direction")]
-        events = [Event(t, EVENT_KINDS[k], locked, flow) for t, k, locked, flow in zip(*fields)]
+        events = _event_list(ev)
         if n == 1:  # a single run: the whole of a flat column, the one row of an (1, S) one
             cols = {name: c if c.ndim == 1 else c[0] for name, c in self.columns.items()}
             return [TransientResult(self._model(0).name, cols, events)]
@@ -229,6 +221,23 @@ class BatchColumns:
             TransientResult(self._model(i).name, dict(zip(names, values)), events[bounds[i] : bounds[i + 1]])
             for i, values in enumerate(zip(*rows) if names else iter([()] * n))
         ]
+
+
+def _event_list(events: dict[str, np.ndarray], rows: slice | None = None) -> list[Event]:
+    """The :class:`Event` of each of the ``rows`` (default all) of a batch's ``events`` arrays, in
+    order. Each is made as ``Event(...)`` would make it, its fields set at once (a frozen
+    dataclass's ``__init__`` sets them one by one through ``object.__setattr__``)."""
+    times = events["time_s"]
+    if not times.size:
+        return []
+    names = ("time_s", "kind", "stator_locked", "flow_direction")
+    fields = [events[k].tolist() if rows is None else events[k][rows].tolist() for k in names]
+    made = []
+    for t, k, locked, flow in zip(*fields):
+        e = object.__new__(Event)
+        e.__dict__.update(time_s=t, kind=EVENT_KINDS[k], stator_locked=locked, flow_direction=flow)
+        made.append(e)
+    return made
 
 
 #: The model :func:`simulate` runs of a converter when none is named.
@@ -269,9 +278,8 @@ def simulate(
             raise InputError.argument("model", model, f"none, or the DynamicModel's own ({m.name!r})")
     else:
         m = dynamic_model(converter, DEFAULT_MODEL if model is None else model)
-    return simulate_batch(
-        [m], [drive], times_s, initial, rtol, threads=1, files=files, columns=columns, **solver_options
-    )[0]
+    # (the batch's arguments are this function's own: not checked again, :func:`_check_batch`)
+    return _results([m], [drive], times_s, initial, rtol, 1, files, columns, solver_options, checked=True)[0]
 
 
 def simulate_batch(
@@ -297,8 +305,24 @@ def simulate_batch(
     ``speed_atol_rad_s``, ``flow_atol_m3_s``, ``first_step_s``, ``max_events`` and
     ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs, counting only the
     chosen columns, is refused above it before anything runs)."""
+    return _results(models, drives, times_s, initial, rtol, threads, files, columns, solver_options)
+
+
+def _results(
+    models: Sequence[DynamicModel],
+    drives: Sequence[Drive],
+    times_s: Sequence[float] | None,
+    initial: dict[str, float] | None,
+    rtol: float | None,
+    threads: int,
+    files: Mapping[str, str] | None,
+    columns: Sequence[str] | None,
+    solver_options: dict[str, Any],
+    checked: bool = False,
+) -> list[TransientResult]:
+    """:func:`simulate_batch`; ``checked`` as in :func:`_run_batch`."""
     batch = _run_batch(
-        models, drives, times_s, columns, initial, rtol, threads, files, solver_options, shaped=False, every_time=False
+        models, drives, times_s, columns, initial, rtol, threads, files, solver_options, False, False, checked
     )
     try:
         batch.check()
@@ -427,11 +451,15 @@ def _run_batch(
     solver_options: dict[str, Any],
     shaped: bool = True,
     every_time: bool = True,
+    checked: bool = False,
 ) -> BatchColumns:
     """The one call of the core's ``transient_batch`` (:func:`simulate_columns`), with the columns
     the warnings read added for table models (:func:`_core_columns`); ``shaped`` as in
-    :func:`_batch_columns`, ``every_time`` as in :func:`_output_times`."""
-    _check_batch(models, drives, threads)
+    :func:`_batch_columns`, ``every_time`` as in :func:`_output_times`. ``checked``: the caller made
+    ``models`` (a list of DynamicModel) and ``threads`` itself (:func:`simulate`), which
+    :func:`_check_batch` would look at again."""
+    if not checked:
+        _check_batch(models, drives, threads)
     specs, shared_time = _drive_specs(drives, times_s, every_time)
     try:
         raw = _core.transient_batch(
