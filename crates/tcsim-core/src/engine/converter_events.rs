@@ -122,20 +122,20 @@ pub fn flow_held(model: &dyn ConverterDynamics, mode: Mode) -> bool {
     model.has_flow_sign() && mode.flow_sign == 0.0
 }
 
-/// The converter's root functions in `mode`.
-pub fn roots(model: &dyn ConverterDynamics, mode: Mode) -> Vec<ConverterRoot> {
-    let mut roots = Vec::new();
-    if model.has_stator_clutch() && model.coordinates()[STATOR] {
-        roots.push(if mode.stator_locked { ConverterRoot::StatorTorque } else { ConverterRoot::StatorSpeed });
-    }
-    if model.has_flow_sign() {
-        if mode.flow_sign == 0.0 {
-            roots.extend([ConverterRoot::FlowStartsPositive, ConverterRoot::FlowStartsNegative]);
-        } else {
-            roots.push(ConverterRoot::Flow);
-        }
-    }
-    roots
+/// The converter's root functions in `mode` (at most three), in order: the stator's, then the
+/// flow's. An iterator: the segments collect them with their own, in one allocation.
+pub fn roots(model: &dyn ConverterDynamics, mode: Mode) -> impl Iterator<Item = ConverterRoot> {
+    let stator = (model.has_stator_clutch() && model.coordinates()[STATOR]).then_some(if mode.stator_locked {
+        ConverterRoot::StatorTorque
+    } else {
+        ConverterRoot::StatorSpeed
+    });
+    let flow = match (model.has_flow_sign(), mode.flow_sign == 0.0) {
+        (false, _) => [None, None],
+        (true, true) => [Some(ConverterRoot::FlowStartsPositive), Some(ConverterRoot::FlowStartsNegative)],
+        (true, false) => [Some(ConverterRoot::Flow), None],
+    };
+    stator.into_iter().chain(flow.into_iter().flatten())
 }
 
 /// Whether [`root_value`] of `root` calls its `stator_torque` or `held_flow` (which need the

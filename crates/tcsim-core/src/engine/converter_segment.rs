@@ -105,7 +105,8 @@ fn roles(model: &dyn ConverterDynamics, drive: &Drive, mode: Mode) -> ([Role; 4]
 /// The roots of an isolated run in `mode`: the converter's, then the clutch's (not in drive b,
 /// where both speeds are given and the clutch can only slip).
 fn roots(model: &dyn ConverterDynamics, drive: &Drive, mode: Mode) -> Vec<Root> {
-    let mut roots: Vec<Root> = converter_events::roots(model, mode).into_iter().map(Root::Converter).collect();
+    let mut roots = Vec::with_capacity(4);
+    roots.extend(converter_events::roots(model, mode).map(Root::Converter));
     if drive.lockup().is_some_and(LockupCommand::engages) && !matches!(drive, Drive::Speeds { .. }) {
         roots.push(Root::Lockup(match mode.lockup {
             ClutchMode::Armed => LockupRoot::Lock,

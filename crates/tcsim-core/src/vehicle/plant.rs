@@ -9,6 +9,7 @@ use super::parameters::{Scenario, Vehicle};
 use super::shift::{shift_inertia_form, InertiaPhase};
 use super::{FRONT, GEARBOX_OUT, N_COORDS, REAR, SPEED, TORQUE_BOOST, TORQUE_FAST, TWIST_F, TWIST_R};
 use crate::converter::dynamics::{ConverterDynamics, Vec4, FLOW, PUMP, STATOR, TURBINE};
+use crate::engine::bdf::roots::MAX_ROOTS;
 use crate::engine::converter_events::{self, Sample as ConverterSample};
 use crate::engine::lockup;
 use crate::engine::options::{Hysteresis, SolverOptions};
@@ -124,8 +125,8 @@ fn links(model: &dyn ConverterDynamics, v: &Vehicle, mode: VehicleMode) -> ([Lin
 /// The root functions of `mode`: the converter's, then the brake's, the shift's, the lock-up's
 /// and the stop speed.
 fn roots(model: &dyn ConverterDynamics, v: &Vehicle, sc: &Scenario, mode: VehicleMode) -> Vec<Root> {
-    let mut roots: Vec<Root> =
-        converter_events::roots(model, mode.converter).into_iter().map(Root::Converter).collect();
+    let mut roots = Vec::with_capacity(MAX_ROOTS);
+    roots.extend(converter_events::roots(model, mode.converter).map(Root::Converter));
     roots.push(if mode.wheels_held { Root::BrakeRelease } else { Root::BrakeHold });
     match mode.shift {
         Some(s) => roots.push(if s.handed_over { Root::ShiftSync } else { Root::ShiftHandover }),
@@ -650,4 +651,57 @@ pub(super) fn kinetic_energy(plant: &Plant, u: &Coords) -> f64 {
     let uc: Vec4 = [u[0], u[1], u[2], u[3]];
     quadratic(&|r, c| plant.mass[r][c], SPEED + 1) - quadratic(&|r, c| converter_mass[r][c], 4)
         + plant.model.stored_energy_j(&uc)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::engine::converter_events::Mode as ConverterMode;
+    use crate::engine::signal::Signal;
+    use crate::vehicle::modes::Shift;
+
+    /// A segment's event functions live in fixed arrays of [`MAX_ROOTS`] (`RootFinder`): every
+    /// mode of a vehicle must have no more, the converter's in every mode of its own included.
+    #[test]
+    fn every_vehicle_mode_has_at_most_max_roots_event_functions() {
+        let text = include_str!("../../tests/data/sedan.toml");
+        let mut v = crate::vehicle::file::read_vehicle(text).unwrap_or_else(|e| panic!("{e}")).vehicle;
+        v.lockup.min_gear = 0; // the lock-up may engage in every gear: its root in every mode
+        let model = crate::converter::dynamics::tests::bundled_ht();
+        let pedal = Signal::constant(0.5);
+        let gears = v.gearbox.ratios.len();
+        let shift = |handed_over| Shift { from: 1, to: 2, since_s: 0.0, handed_over, start_input_nm: 0.0 };
+        let lockups = [
+            LockupState::Open,
+            LockupState::Engaging { since_s: 0.0, ramped: false, armed: false },
+            LockupState::Engaging { since_s: 0.0, ramped: true, armed: false },
+            LockupState::Engaging { since_s: 0.0, ramped: true, armed: true },
+            LockupState::Locked,
+        ];
+        let mut most = 0;
+        for stop_speed_m_s in [None, Some(0.5)] {
+            let sc = Scenario {
+                accelerator_pedal: pedal.clone(),
+                brake_pedal: pedal.clone(),
+                end_time_s: 1.0,
+                stop_speed_m_s,
+                engine_torque_nm: None,
+                shift_pedal: None,
+            };
+            for (stator_locked, flow_sign) in [false, true].into_iter().flat_map(|s| [1.0, 0.0, -1.0].map(|f| (s, f))) {
+                let converter = ConverterMode { stator_locked, flow_sign, ..ConverterMode::default() };
+                for (gear, shift, lockup, wheels_held) in (0..gears)
+                    .flat_map(|g| [None, Some(shift(false)), Some(shift(true))].map(|s| (g, s)))
+                    .flat_map(|(g, s)| lockups.map(|l| (g, s, l)))
+                    .flat_map(|(g, s, l)| [false, true].map(|w| (g, s, l, w)))
+                {
+                    let mode = VehicleMode { converter, gear, shift, lockup, wheels_held };
+                    most = most.max(roots(&model, &v, &sc, mode).len());
+                }
+            }
+        }
+        // the stator's and the held flow's two, the brake's, both shifts', the clutch's two, the stop's
+        assert_eq!(most, 9);
+        assert!(most <= MAX_ROOTS);
+    }
 }

@@ -7,11 +7,17 @@
 //! `100 ε (|t_hi| + |t_hi − t_lo|)`. The upper end of the bracket is returned (its `g ≤ 0`), so the
 //! event has always happened at the time given.
 
-/// Work arrays for the event functions of one segment (allocated once per segment).
+/// The most event functions a segment has (a vehicle's segment has at most 9: the converter's 3,
+/// the brake's, 2 of the shift's, 2 of the lock-up's and the stop speed's).
+pub const MAX_ROOTS: usize = 16;
+
+/// Work arrays for the event functions of one segment (on the stack: they were four of the few
+/// heap allocations left in a run's segments).
 pub struct RootFinder {
-    lo: Vec<f64>,
-    hi: Vec<f64>,
-    mid: Vec<f64>,
+    n: usize,
+    lo: [f64; MAX_ROOTS],
+    hi: [f64; MAX_ROOTS],
+    mid: [f64; MAX_ROOTS],
 }
 
 /// The event function crossed furthest from `lo` (> 0) to `hi` (≤ 0), if any.
@@ -29,19 +35,23 @@ fn crossing(lo: &[f64], hi: &[f64]) -> Option<usize> {
 }
 
 impl RootFinder {
-    /// Start from the event functions `g0` at the segment's start.
-    pub fn new(g0: Vec<f64>) -> Self {
-        let count = g0.len();
-        Self { lo: g0, hi: vec![0.0; count], mid: vec![0.0; count] }
+    /// Start from the event functions `g0` at the segment's start (at most [`MAX_ROOTS`]).
+    pub fn new(g0: &[f64]) -> Self {
+        let n = g0.len();
+        assert!(n <= MAX_ROOTS, "{n} event functions: a segment has at most {MAX_ROOTS}");
+        let mut lo = [0.0; MAX_ROOTS];
+        lo[..n].copy_from_slice(g0);
+        Self { n, lo, hi: [0.0; MAX_ROOTS], mid: [0.0; MAX_ROOTS] }
     }
 
     /// After a step from `t_lo` to `t_hi`: `g_at(t, out)` gives the event functions on the step's
     /// interpolant. Returns the first root `(t, index)` in `(t_lo, t_hi]`, or None (and then the end
     /// of this step becomes the start of the next).
     pub fn check(&mut self, t_lo: f64, t_hi: f64, mut g_at: impl FnMut(f64, &mut [f64])) -> Option<(f64, usize)> {
-        g_at(t_hi, &mut self.hi);
-        let Some(mut imax) = crossing(&self.lo, &self.hi) else {
-            std::mem::swap(&mut self.lo, &mut self.hi);
+        let n = self.n;
+        g_at(t_hi, &mut self.hi[..n]);
+        let Some(mut imax) = crossing(&self.lo[..n], &self.hi[..n]) else {
+            self.lo[..n].swap_with_slice(&mut self.hi[..n]);
             return None;
         };
         let (mut t0, mut t1) = (t_lo, t_hi);
@@ -49,7 +59,7 @@ impl RootFinder {
         let (mut alpha, mut last_two) = (1.0, [false, true]);
         let mut i = 0usize;
         // a copy of the lower end: the bracket moves, the next step starts from g(t_hi)
-        let mut lo = self.lo.clone();
+        let mut lo = self.lo;
         while (t1 - t0).abs() > tol {
             let (g1, g0) = (self.hi[imax], lo[imax]);
             let mut t = t1 - (t1 - t0) * g1 / (g1 - alpha * g0);
@@ -60,15 +70,15 @@ impl RootFinder {
             if (t1 - t).abs() < 0.5 * tol {
                 t = t1 - fraction * (t1 - t0);
             }
-            g_at(t, &mut self.mid);
-            let lower = crossing(&lo, &self.mid);
+            g_at(t, &mut self.mid[..n]);
+            let lower = crossing(&lo[..n], &self.mid[..n]);
             if let Some(j) = lower {
                 t1 = t;
                 imax = j;
-                std::mem::swap(&mut self.hi, &mut self.mid);
+                self.hi[..n].swap_with_slice(&mut self.mid[..n]);
             } else {
                 t0 = t;
-                lo.copy_from_slice(&self.mid);
+                lo[..n].copy_from_slice(&self.mid[..n]);
             }
             last_two[i % 2] = lower.is_some();
             if i >= 2 {

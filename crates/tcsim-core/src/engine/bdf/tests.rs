@@ -231,7 +231,7 @@ fn the_first_of_two_roots_in_one_step_is_found() {
     };
     let mut g0 = vec![0.0; 2];
     g(0.0, &mut g0);
-    let mut finder = RootFinder::new(g0);
+    let mut finder = RootFinder::new(&g0);
     let (t, i) = finder.check(0.0, 1.0, g).expect("a root");
     assert_eq!(i, 1);
     assert!((t - 0.3).abs() < 1e-13, "{t}");
@@ -248,7 +248,7 @@ fn the_first_of_two_roots_in_one_step_is_found() {
     // no crossing: the step's end becomes the start of the next
     let mut g0 = vec![0.0; 2];
     g(0.0, &mut g0);
-    let mut finder = RootFinder::new(g0);
+    let mut finder = RootFinder::new(&g0);
     assert!(finder.check(0.0, 0.2, g).is_none());
     assert!(finder.check(0.2, 0.305, g).is_some_and(|(t, i)| i == 1 && (t - 0.3).abs() < 1e-13));
 }
@@ -417,4 +417,24 @@ fn a_sample_does_not_depend_on_the_other_output_times() {
             assert_eq!(all.len(), dense.iter().take_while(|&&s| s <= t).count());
         }
     }
+}
+
+#[test]
+fn a_root_finder_takes_max_roots_event_functions_and_refuses_more() {
+    // its work arrays are fixed: all MAX_ROOTS functions are looked at (the last one crossing is
+    // found), one more is refused rather than cut off
+    use super::roots::MAX_ROOTS;
+    let g = |t: f64, out: &mut [f64]| {
+        let last = out.len() - 1;
+        for (i, o) in out.iter_mut().enumerate() {
+            *o = if i == last { 0.5 - t } else { 1.0 + i as f64 };
+        }
+    };
+    let mut g0 = [0.0; MAX_ROOTS];
+    g(0.0, &mut g0);
+    let (t, i) = RootFinder::new(&g0).check(0.0, 1.0, g).expect("the last function's root");
+    assert_eq!(i, MAX_ROOTS - 1);
+    assert!((t - 0.5).abs() < 1e-13, "{t}");
+    let more = std::panic::catch_unwind(|| RootFinder::new(&[1.0; MAX_ROOTS + 1]));
+    assert!(more.is_err());
 }
