@@ -19,7 +19,7 @@
 //! checks every closed-form root: each root is polished by a Newton step on the forward torques.
 //!
 //! **Hrovat & Tobler** at steady state: the same monotone pieces, found on a grid of speed ratios,
-//! each solved by Brent's method on [`steady_state`]; a piece across which the steady state jumps
+//! each solved by Brent's method on [`steady_state_with`]; a piece across which the steady state jumps
 //! (a change of flow direction or stator mode) holds no root and is skipped.
 //!
 //! **Which root.** The pump is the engine's: it turns forwards (`ω_p ≥ 0`) whichever way the
@@ -31,7 +31,7 @@
 
 use std::sync::atomic::AtomicBool;
 
-use super::hrovat_tobler::{steady_state, steady_torque_ratio, HtGeometry};
+use super::hrovat_tobler::{steady_state_with, steady_torque_ratio, HtConstants, HtGeometry};
 use super::table::{Characteristic, Interpolation};
 use crate::batch::parallel_map_cancellable;
 use crate::error::{CoreError, CoreResult, InputSource};
@@ -133,7 +133,9 @@ struct Piece {
 #[derive(Debug, Clone)]
 enum Model {
     Table(Characteristic),
-    HrovatTobler(HtGeometry<f64>),
+    /// The geometry's steady-state constants, computed once ([`steady_state_with`]; they were
+    /// computed at each of the thousands of steady states a backward model is built from).
+    HrovatTobler(HtConstants<f64>),
 }
 
 /// Forward steady state at one point: delivered torque, pump torque and torque ratio.
@@ -158,8 +160,8 @@ impl Model {
                     slope: Some(t.d_delivered[0]),
                 })
             }
-            Self::HrovatTobler(g) => {
-                let s = steady_state(g, wp, wt).ok()?;
+            Self::HrovatTobler(k) => {
+                let s = steady_state_with(k, wp, wt).ok()?;
                 Some(Forward {
                     delivered_nm: s.turbine_torque_nm,
                     pump_nm: s.pump_torque_nm,
@@ -213,7 +215,7 @@ impl Backward {
         Self { model, pieces }
     }
 
-    /// The Hrovat & Tobler model at steady state ([`steady_state`]).
+    /// The Hrovat & Tobler model at steady state ([`steady_state_with`], its constants computed once).
     pub fn hrovat_tobler(g: &HtGeometry<f64>) -> Self {
         let mut knots = vec![0.0, 1.0, -1.0];
         for i in 1..=150 {
@@ -223,7 +225,7 @@ impl Backward {
                 knots.extend([sr, -sr]);
             }
         }
-        let model = Model::HrovatTobler(*g);
+        let model = Model::HrovatTobler(HtConstants::new(g));
         let pieces = [1.0, -1.0].map(|s| pieces_of(&model, s, &knots));
         Self { model, pieces }
     }
@@ -599,8 +601,8 @@ fn closed_form(model: &Model, s: f64, lo: f64, hi: f64) -> Option<[f64; 3]> {
     ok.then_some(q)
 }
 
-/// Points of a batch between two looks at the cancel flag.
-const CHUNK: usize = 16_384;
+/// Points of a batch between two looks at the cancel flag (a worker takes them at once).
+pub const POINTS_PER_CHUNK: usize = 16_384;
 
 /// Columns of a batch of backward operating points.
 #[derive(Debug, Clone, Default)]
@@ -671,7 +673,8 @@ pub fn backward_points(
             format!("{n} points, as many as turbine_speed_rad_s"),
         ));
     }
-    let chunks: Vec<(usize, usize)> = (0..n).step_by(CHUNK).map(|i| (i, (i + CHUNK).min(n))).collect();
+    let chunks: Vec<(usize, usize)> =
+        (0..n).step_by(POINTS_PER_CHUNK).map(|i| (i, (i + POINTS_PER_CHUNK).min(n))).collect();
     let done = parallel_map_cancellable(&chunks, threads, cancel, |&(i, j)| {
         let one = |k: usize| match load_torque(load, turbine_speed_rad_s[k], load_values[k]) {
             Ok(t) => (t, b.point(turbine_speed_rad_s[k], t, pump_speed_limit_rad_s)),
@@ -699,6 +702,7 @@ pub fn backward_points(
 mod tests {
     use super::*;
     use crate::converter::dynamics::tests::c1;
+    use crate::converter::hrovat_tobler::steady_state;
 
     /// JAMBE/TRAMI 9AT: coast rows up to SR 2.1, CF not monotone in coast.
     fn jambe() -> Characteristic {
