@@ -117,3 +117,39 @@ def test_unit_constants_are_the_core_ones_and_the_plain_values():
     assert units.KM_H == _core.unit_constants()["m_s_per_km_h"] == 1.0 / 3.6
     assert units.LBF_FT_IN_NM == _core.unit_constants()["nm_per_lbf_ft"] == 1.3558179483314004
     assert 2000.0 * units.RAD_S_PER_RPM == pytest.approx(units.DEFAULT_PUMP_SPEED_RAD_S, rel=1e-15)
+
+
+#: The points a worker of the core's steady-state and backward batches takes at once
+#: (``STEADY_POINTS_PER_THREAD``, ``POINTS_PER_CHUNK``): a batch of no more runs on the calling thread.
+ONE_PIECE = 16_384
+
+
+def _bits(d: dict) -> dict:
+    return {k: np.asarray(v).view(np.uint8).tobytes() for k, v in d.items()}
+
+
+def test_a_batch_of_one_piece_is_the_longer_batchs_points_bit_for_bit_and_fails_alike():
+    # a batch that one worker takes whole runs on the calling thread, without the cancellable
+    # helper thread; it must give the points and the errors of the same points in a batch one point
+    # longer, which takes the helper thread
+    rng = np.random.default_rng(16)
+    conv = load_converter("li-sunden-2016")
+    g = conv.core_geometry()
+    wp = rng.uniform(-300.0, 400.0, ONE_PIECE + 1)
+    wt = rng.uniform(-300.0, 400.0, ONE_PIECE + 1)
+    torque = rng.uniform(-200.0, 300.0, ONE_PIECE + 1)
+    for threads in (0, 1, 2):
+        one, two = (_core.ht_steady_states(g, wp[:n], wt[:n], False, threads) for n in (ONE_PIECE, ONE_PIECE + 1))
+        assert _bits(one) == _bits({k: v[:ONE_PIECE] for k, v in two.items()}), threads
+        one, two = (
+            _core.ht_operating_points(g, wt[:n], torque[:n], threads=threads) for n in (ONE_PIECE, ONE_PIECE + 1)
+        )
+        assert _bits(one) == _bits({k: v[:ONE_PIECE] for k, v in two.items()}), threads
+    bad = wt.copy()
+    bad[7] = np.nan
+    messages = []
+    for n in (1 + 7, ONE_PIECE, ONE_PIECE + 1):
+        with pytest.raises(Exception) as e:
+            _core.ht_steady_states(g, wp[:n], bad[:n], True, 0)
+        messages.append((type(e.value), str(e.value)))
+    assert messages[0] == messages[1] == messages[2] and "point 7" in messages[0][1]

@@ -126,16 +126,27 @@ fn cancellable<R: Send>(py: Python<'_>, work: impl FnOnce(&AtomicBool) -> Option
     })
 }
 
-/// [`cancellable`] for a batch of `runs` runs. A single run is not cancelled part-way in either
-/// form (the flag stops a batch between runs), so it runs on this thread with the GIL released,
-/// without the helper thread's start and hand-over (about a third of a short take-off's time
-/// through Python); a signal that arrived meanwhile raises right after it.
+/// [`cancellable`] for a batch of `runs` runs ([`cancellable_unless_one_piece`]: a single run is
+/// not cancelled part-way in either form, the flag stops a batch between runs).
 fn cancellable_runs<R: Send>(
     py: Python<'_>,
     runs: usize,
     work: impl FnOnce(&AtomicBool) -> Option<R> + Send,
 ) -> PyResult<R> {
-    if runs > 1 {
+    cancellable_unless_one_piece(py, runs <= 1, work)
+}
+
+/// [`cancellable`], unless the work is `one_piece`, which the cancel flag could not stop part-way
+/// (one run, or no more points than a worker takes at once): that runs on this thread with the GIL
+/// released, without the helper thread's start and hand-over (about 25 µs, a third of a short
+/// take-off's time through Python and most of a steady state's of a few points); a signal that
+/// arrived meanwhile raises right after it.
+fn cancellable_unless_one_piece<R: Send>(
+    py: Python<'_>,
+    one_piece: bool,
+    work: impl FnOnce(&AtomicBool) -> Option<R> + Send,
+) -> PyResult<R> {
+    if !one_piece {
         return cancellable(py, work);
     }
     let result = py.detach(|| work(&AtomicBool::new(false)));
@@ -252,9 +263,12 @@ fn ht_steady_states<'py>(
                 "pump and turbine speeds need equal lengths, and geometry one row or one row per point",
             ));
         }
-        let cols = cancellable(py, |cancel| match core_steady_states(&g, wp, wt, strict, threads, cancel) {
-            Ok(cols) => cols.map(Ok),
-            Err(e) => Some(Err(e)),
+        let one_piece = wp.len() <= tcsim_core::batch::STEADY_POINTS_PER_THREAD;
+        let cols = cancellable_unless_one_piece(py, one_piece, |cancel| {
+            match core_steady_states(&g, wp, wt, strict, threads, cancel) {
+                Ok(cols) => cols.map(Ok),
+                Err(e) => Some(Err(e)),
+            }
         })?
         .map_err(|e| input_error(CoreError { field: format!("{} (point {})", e.error.field, e.index), ..e.error }))?;
         let d = PyDict::new(py);
@@ -514,9 +528,12 @@ fn backward_dict<'py>(
         _ => return Err(PyValueError::new_err("give either turbine_torque_nm or turbine_power_w")),
     };
     let limit = limit.unwrap_or(f64::INFINITY);
-    let cols = cancellable(py, |cancel| match backward_points(b, wt, values, load, limit, threads, cancel) {
-        Ok(cols) => cols.map(Ok),
-        Err(e) => Some(Err(e)),
+    let one_piece = wt.len() <= tcsim_core::converter::backward::POINTS_PER_CHUNK;
+    let cols = cancellable_unless_one_piece(py, one_piece, |cancel| {
+        match backward_points(b, wt, values, load, limit, threads, cancel) {
+            Ok(cols) => cols.map(Ok),
+            Err(e) => Some(Err(e)),
+        }
     })?
     .map_err(input_error)?;
     let valid: Vec<bool> = cols.reason.iter().map(|&r| Reason::ALL[usize::from(r)].valid()).collect();
