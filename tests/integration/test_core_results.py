@@ -107,6 +107,9 @@ def test_initial_state_errors_name_the_initial_state():
         (dict(speed_atol=1e-3), "speed_atol", 1e-3, "a known name, one of rtol, speed_atol_rad_s"),
         (dict(rtol="a"), "rtol", "'a'", "a number"),
         (dict(max_events=1.5), "max_events", 1.5, "a whole number"),
+        # simulate_batch's arguments are not simulate's: a run is on one thread
+        (dict(threads=2), "threads", 2, "a known name, one of rtol, speed_atol_rad_s"),
+        (dict(drives=[]), "drives", "[]", "a known name, one of rtol, speed_atol_rad_s"),
     ],
 )
 def test_a_misspelt_or_mistyped_solver_option_is_refused(options, field, value, expected):

@@ -11,7 +11,9 @@ overflow rule lives in the core; the memory estimate counts only the chosen colu
 
 from __future__ import annotations
 
+import copy
 import dataclasses
+import pickle
 
 import numpy as np
 import pytest
@@ -258,22 +260,30 @@ def test_a_single_runs_columns_keep_each_ones_layout():
 
 def test_a_batchs_events_are_the_events_event_makes_and_as_frozen():
     # the events are made with their fields set at once (`_event_list`), not through the frozen
-    # dataclass's __init__: each must be the Event(...) of its fields, equal, hashed, shown and
-    # frozen alike, the same from runs() and from run_events(i), in time order within each run
+    # dataclass's __init__: each must hold its row of the batch's event arrays, and be the
+    # Event(...) of its fields, equal, hashed, shown, copied, pickled, replaced and frozen alike
     m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
     drives = [_lockup_takeoff(), tr.isolated_takeoff(tip_out=True), _lockup_takeoff()]
     batch = tr.simulate_columns([m], drives, times_s=TIMES, threads=2)
+    ev = batch.events
     runs = batch.runs()
-    assert [len(r.events) for r in runs][0] >= 2 and sum(len(r.events) for r in runs) >= 5
+    assert len(runs[0].events) >= 2 and sum(len(r.events) for r in runs) == len(ev["time_s"]) >= 5
+    k = 0
     for i, r in enumerate(runs):
         assert r.events == batch.run_events(i)
-        times = [e.time_s for e in r.events]
-        assert times == sorted(times)
         for e in r.events:
+            assert ev["run"][k] == i
+            row = (float(ev["time_s"][k]), tr.EVENT_KINDS[ev["kind"][k]], bool(ev["stator_locked"][k]))
+            assert (e.time_s, e.kind, e.stator_locked, e.flow_direction) == (*row, float(ev["flow_direction"][k]))
+            k += 1
             made = tr.Event(e.time_s, e.kind, e.stator_locked, e.flow_direction)
             assert (e == made, hash(e) == hash(made), repr(e) == repr(made)) == (True, True, True)
             assert [type(getattr(e, f.name)) for f in dataclasses.fields(e)] == [float, str, bool, float]
-            assert e.kind in tr.EVENT_KINDS
+            assert pickle.loads(pickle.dumps(e)) == e and copy.deepcopy(e) == e
+            assert dataclasses.asdict(e) == dataclasses.asdict(made)
+            assert dataclasses.replace(e, kind="flow-zero") == tr.Event(
+                e.time_s, "flow-zero", e.stator_locked, e.flow_direction
+            )
             with pytest.raises(dataclasses.FrozenInstanceError):
                 e.kind = "flow-zero"  # type: ignore[misc]
     empty = tr.simulate_columns([m], [tr.isolated_takeoff()], times_s=np.array([0.0, 0.01]), threads=1)

@@ -119,9 +119,10 @@ def test_unit_constants_are_the_core_ones_and_the_plain_values():
     assert 2000.0 * units.RAD_S_PER_RPM == pytest.approx(units.DEFAULT_PUMP_SPEED_RAD_S, rel=1e-15)
 
 
-#: The points a worker of the core's steady-state and backward batches takes at once
-#: (``STEADY_POINTS_PER_THREAD``, ``POINTS_PER_CHUNK``): a batch of no more runs on the calling thread.
-ONE_PIECE = 16_384
+#: The most points the core's steady-state and backward batches compute between two looks at the
+#: cancel flag (``CANCEL_CHECK_POINTS``, ``POINTS_PER_CHUNK``): a batch of no more runs on the
+#: calling thread, one of more on the cancellable helper thread.
+STEADY_PIECE, BACKWARD_PIECE = 4096, 16_384
 
 
 def _bits(d: dict) -> dict:
@@ -129,27 +130,31 @@ def _bits(d: dict) -> dict:
 
 
 def test_a_batch_of_one_piece_is_the_longer_batchs_points_bit_for_bit_and_fails_alike():
-    # a batch that one worker takes whole runs on the calling thread, without the cancellable
-    # helper thread; it must give the points and the errors of the same points in a batch one point
-    # longer, which takes the helper thread
+    # a batch that the core computes without looking at the cancel flag runs on the calling thread,
+    # without the cancellable helper thread; it must give the points and the errors of the same
+    # points in a batch one point longer, which takes the helper thread
     rng = np.random.default_rng(16)
-    conv = load_converter("li-sunden-2016")
-    g = conv.core_geometry()
-    wp = rng.uniform(-300.0, 400.0, ONE_PIECE + 1)
-    wt = rng.uniform(-300.0, 400.0, ONE_PIECE + 1)
-    torque = rng.uniform(-200.0, 300.0, ONE_PIECE + 1)
+    g = load_converter("li-sunden-2016").core_geometry()
+    wp, wt = rng.uniform(-300.0, 400.0, (2, BACKWARD_PIECE + 1))
+    torque = rng.uniform(-200.0, 300.0, BACKWARD_PIECE + 1)
     for threads in (0, 1, 2):
-        one, two = (_core.ht_steady_states(g, wp[:n], wt[:n], False, threads) for n in (ONE_PIECE, ONE_PIECE + 1))
-        assert _bits(one) == _bits({k: v[:ONE_PIECE] for k, v in two.items()}), threads
-        one, two = (
-            _core.ht_operating_points(g, wt[:n], torque[:n], threads=threads) for n in (ONE_PIECE, ONE_PIECE + 1)
-        )
-        assert _bits(one) == _bits({k: v[:ONE_PIECE] for k, v in two.items()}), threads
+        for m in (STEADY_PIECE, BACKWARD_PIECE):
+            one, two = (_core.ht_steady_states(g, wp[:n], wt[:n], False, threads) for n in (m, m + 1))
+            assert _bits(one) == _bits({k: v[:m] for k, v in two.items()}), (threads, m)
+        m = BACKWARD_PIECE
+        one, two = (_core.ht_operating_points(g, wt[:n], torque[:n], threads=threads) for n in (m, m + 1))
+        assert _bits(one) == _bits({k: v[:m] for k, v in two.items()}), threads
     bad = wt.copy()
     bad[7] = np.nan
-    messages = []
-    for n in (1 + 7, ONE_PIECE, ONE_PIECE + 1):
+    steady = []
+    for n in (1 + 7, STEADY_PIECE, STEADY_PIECE + 1):
         with pytest.raises(Exception) as e:
             _core.ht_steady_states(g, wp[:n], bad[:n], True, 0)
-        messages.append((type(e.value), str(e.value)))
-    assert messages[0] == messages[1] == messages[2] and "point 7" in messages[0][1]
+        steady.append((type(e.value), str(e.value)))
+    assert steady[0] == steady[1] == steady[2] and "point 7" in steady[0][1]
+    backward = []
+    for n in (8, BACKWARD_PIECE, BACKWARD_PIECE + 1):
+        with pytest.raises(Exception) as e:
+            _core.ht_operating_points(g, wt[:n], torque[: n - 1])
+        backward.append((type(e.value), str(e.value).replace(str(n), "N").replace(str(n - 1), "N-1")))
+    assert backward[0] == backward[1] == backward[2] and "turbine_torque_nm" in backward[0][1]

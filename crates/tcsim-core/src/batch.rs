@@ -87,7 +87,7 @@ pub fn ht_steady_states(
 }
 
 /// Points between two looks at the cancel flag of [`ht_steady_states_cancellable`].
-const CANCEL_CHECK_POINTS: usize = 4096;
+pub const CANCEL_CHECK_POINTS: usize = 4096;
 
 /// The fewest points a worker thread of [`ht_steady_states_cancellable`] is given: smaller batches
 /// run on fewer threads (a thread costs tens of µs to start; 16 384 points take about 1 ms).
@@ -294,8 +294,10 @@ pub fn run_transient_job(job: &TransientJob) -> crate::engine::options::Transien
 }
 
 /// The worker threads of a batch asked for `threads` (0: one per core) with work for at most `most`:
-/// at least one. The number of cores is read once per process: the standard library reads it from
-/// the cgroup files each time, which cost about 25 µs, more than a short run.
+/// at least one. The number of cores is read once per process, at the first batch: the standard
+/// library reads it from the cgroup files each time, which cost about 25 µs, more than a short run.
+/// A later change of the process's CPU affinity or quota (or a forked child's) is not seen: give
+/// `threads` then.
 pub fn worker_threads(threads: usize, most: usize) -> usize {
     static CORES: std::sync::OnceLock<usize> = std::sync::OnceLock::new();
     let cores = || *CORES.get_or_init(|| std::thread::available_parallelism().map_or(1, |c| c.get()));

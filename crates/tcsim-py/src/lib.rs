@@ -137,10 +137,10 @@ fn cancellable_runs<R: Send>(
 }
 
 /// [`cancellable`], unless the work is `one_piece`, which the cancel flag could not stop part-way
-/// (one run, or no more points than a worker takes at once): that runs on this thread with the GIL
-/// released, without the helper thread's start and hand-over (about 25 µs, a third of a short
-/// take-off's time through Python and most of a steady state's of a few points); a signal that
-/// arrived meanwhile raises right after it.
+/// (one run, or no more points than the core takes between two looks at the flag): that runs on
+/// this thread with the GIL released, without the helper thread's start and hand-over (about 25 µs,
+/// a third of a short take-off's time through Python and most of a steady state's of a few
+/// points); a signal that arrived meanwhile raises right after it.
 fn cancellable_unless_one_piece<R: Send>(
     py: Python<'_>,
     one_piece: bool,
@@ -263,7 +263,7 @@ fn ht_steady_states<'py>(
                 "pump and turbine speeds need equal lengths, and geometry one row or one row per point",
             ));
         }
-        let one_piece = wp.len() <= tcsim_core::batch::STEADY_POINTS_PER_THREAD;
+        let one_piece = wp.len() <= tcsim_core::batch::CANCEL_CHECK_POINTS;
         let cols = cancellable_unless_one_piece(py, one_piece, |cancel| {
             match core_steady_states(&g, wp, wt, strict, threads, cancel) {
                 Ok(cols) => cols.map(Ok),

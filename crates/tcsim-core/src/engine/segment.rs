@@ -125,6 +125,7 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
     let mut bdf = Bdf::<S, N>::new(seg, &x0, t0, t_end, o)?;
     let n = x0.len();
     let roots = seg.roots();
+    assert!(roots.len() <= MAX_ROOTS, "{} event functions: a segment has at most {MAX_ROOTS}", roots.len());
     let mut g0 = [0.0; MAX_ROOTS];
     let g0 = &mut g0[..roots.len()];
     if !roots.is_empty() {
