@@ -322,7 +322,18 @@ def _results(
 ) -> list[TransientResult]:
     """:func:`simulate_batch`; ``checked`` as in :func:`_run_batch`."""
     batch = _run_batch(
-        models, drives, times_s, columns, initial, rtol, threads, files, solver_options, False, False, checked
+        models,
+        drives,
+        times_s,
+        columns,
+        initial,
+        rtol,
+        threads,
+        files,
+        solver_options,
+        shaped=False,
+        every_time=False,
+        checked=checked,
     )
     try:
         batch.check()

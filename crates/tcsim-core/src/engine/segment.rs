@@ -2,7 +2,7 @@
 //! system, from a state to the first root of its event functions (or the end time), on the
 //! fixed-size NDF/BDF integrator of [`crate::engine::bdf`].
 
-use crate::engine::bdf::roots::{RootFinder, MAX_ROOTS};
+use crate::engine::bdf::roots::RootFinder;
 use crate::engine::bdf::{Bdf, EXACT_MAX, N_MAX};
 use crate::engine::options::{Hysteresis, NamedState, SolverOptions, TransientError, TransientResult};
 
@@ -125,13 +125,7 @@ fn run_segment_on<S: SmoothSegment, const N: usize>(
     let mut bdf = Bdf::<S, N>::new(seg, &x0, t0, t_end, o)?;
     let n = x0.len();
     let roots = seg.roots();
-    assert!(roots.len() <= MAX_ROOTS, "{} event functions: a segment has at most {MAX_ROOTS}", roots.len());
-    let mut g0 = [0.0; MAX_ROOTS];
-    let g0 = &mut g0[..roots.len()];
-    if !roots.is_empty() {
-        seg.root_values(&x0, t0, &o.hysteresis, g0);
-    }
-    let mut finder = RootFinder::new(g0);
+    let mut finder = RootFinder::new(roots.len(), |g0| seg.root_values(&x0, t0, &o.hysteresis, g0));
     let mut x = [0.0; N];
     let mut next_stop = 0;
     let mut pending = Pending::<N>::new();

@@ -35,12 +35,14 @@ fn crossing(lo: &[f64], hi: &[f64]) -> Option<usize> {
 }
 
 impl RootFinder {
-    /// Start from the event functions `g0` at the segment's start (at most [`MAX_ROOTS`]).
-    pub fn new(g0: &[f64]) -> Self {
-        let n = g0.len();
+    /// Start from the `n` event functions (at most [`MAX_ROOTS`]) at the segment's start, which
+    /// `g0` writes into the slice it is given (not called when there are none).
+    pub fn new(n: usize, g0: impl FnOnce(&mut [f64])) -> Self {
         assert!(n <= MAX_ROOTS, "{n} event functions: a segment has at most {MAX_ROOTS}");
         let mut lo = [0.0; MAX_ROOTS];
-        lo[..n].copy_from_slice(g0);
+        if n > 0 {
+            g0(&mut lo[..n]);
+        }
         Self { n, lo, hi: [0.0; MAX_ROOTS], mid: [0.0; MAX_ROOTS] }
     }
 

@@ -229,9 +229,7 @@ fn the_first_of_two_roots_in_one_step_is_found() {
         out[0] = 0.31 * 0.31 - t * t;
         out[1] = 0.3 - t;
     };
-    let mut g0 = vec![0.0; 2];
-    g(0.0, &mut g0);
-    let mut finder = RootFinder::new(&g0);
+    let mut finder = RootFinder::new(2, |g0| g(0.0, g0));
     let (t, i) = finder.check(0.0, 1.0, g).expect("a root");
     assert_eq!(i, 1);
     assert!((t - 0.3).abs() < 1e-13, "{t}");
@@ -246,9 +244,7 @@ fn the_first_of_two_roots_in_one_step_is_found() {
     assert_eq!(root, 1);
     assert!((t - 0.3).abs() < 1e-12, "{t}");
     // no crossing: the step's end becomes the start of the next
-    let mut g0 = vec![0.0; 2];
-    g(0.0, &mut g0);
-    let mut finder = RootFinder::new(&g0);
+    let mut finder = RootFinder::new(2, |g0| g(0.0, g0));
     assert!(finder.check(0.0, 0.2, g).is_none());
     assert!(finder.check(0.2, 0.305, g).is_some_and(|(t, i)| i == 1 && (t - 0.3).abs() < 1e-13));
 }
@@ -430,11 +426,12 @@ fn a_root_finder_takes_max_roots_event_functions_and_refuses_more() {
             *o = if i == last { 0.5 - t } else { 1.0 + i as f64 };
         }
     };
-    let mut g0 = [0.0; MAX_ROOTS];
-    g(0.0, &mut g0);
-    let (t, i) = RootFinder::new(&g0).check(0.0, 1.0, g).expect("the last function's root");
+    let (t, i) = RootFinder::new(MAX_ROOTS, |g0| g(0.0, g0)).check(0.0, 1.0, g).expect("the last function's root");
     assert_eq!(i, MAX_ROOTS - 1);
     assert!((t - 0.5).abs() < 1e-13, "{t}");
-    let more = std::panic::catch_unwind(|| RootFinder::new(&[1.0; MAX_ROOTS + 1]));
+    let more = std::panic::catch_unwind(|| RootFinder::new(MAX_ROOTS + 1, |g0| g0.fill(1.0)));
     assert!(more.is_err());
+    // no event functions: none evaluated, and no root in any step
+    let mut none = RootFinder::new(0, |_| panic!("nothing to evaluate"));
+    assert!(none.check(0.0, 1.0, |_, g| assert!(g.is_empty())).is_none());
 }
