@@ -423,7 +423,7 @@ const MAX_RUNS_PER_PIECE: usize = 32;
 /// Run `jobs` on `threads` workers (0: one per core) and write the `selection`'s columns of each
 /// straight into its rows of preallocated buffers (one per column for all runs; the first
 /// `skips[i]` samples of job `i` are run, not stored; `skips` has one value per job or one for all).
-/// The workers take pieces of at most [`MAX_RUNS_PER_PIECE`] consecutive runs in turn; nothing is
+/// The workers take pieces of at most `MAX_RUNS_PER_PIECE` consecutive runs in turn; nothing is
 /// merged after but the events and the failures. The results do not depend on the number of
 /// threads. `Ok(None)` once `cancel` is set (no worker starts another run); an error, before any
 /// run, when the buffers cannot be had.

@@ -3,8 +3,8 @@
 //! Every entry point converts NumPy arrays to slices, releases the GIL for the computation and
 //! turns a core error ([`CoreError`]) into `tcsim._core.CoreInputError(message, field, value,
 //! expected, source)`, `source` naming the input at fault (`converter`, `drive`, `initial`,
-//! `scenario`, `vehicle`, `options`). The batch runs return typed results ([`TransientRun`],
-//! [`LaunchRun`]). A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
+//! `scenario`, `vehicle`, `options`). The batch runs return typed results (`TransientRun`,
+//! `LaunchRun`). A Rust panic is caught here and becomes a `RuntimeError`; it never unwinds into
 //! Python.
 
 mod design;

@@ -166,7 +166,7 @@ pub struct TableDynamics {
 /// ```
 ///
 /// with `T_p,ss` and `TR` the table's pump torque and (passivity-projected) torque ratio at the
-/// current speeds ([`Characteristic::torques`]). **Passivity rule**: where the candidate pair
+/// current speeds ([`TorqueCharacteristic::torques`]). **Passivity rule**: where the candidate pair
 /// would deliver power, `P = T_p,tr·ω_p − T_t,tr·ω_t < 0` (the lagged torque keeps its sign while
 /// the steady one has turned: a reversing pump, an overrun reached faster than t_c), the pair is
 /// projected orthogonally onto `P = 0` in the (T_p,tr, T_t,tr) plane:

@@ -7,7 +7,7 @@
 //! with the pump), a given one is `z(t)` (a measured speed; the pump of a locked lock-up in drive
 //! a follows the measured turbine speed), a held one is zero. The reduced system is
 //! `PᵀMP ẋ = Pᵀ(F + T_ext − M ż)`, and a closing link (a lock) projects the state so that the
-//! momentum `PᵀM u` of the free coordinates is conserved ([`Segment::project`]).
+//! momentum `PᵀM u` of the free coordinates is conserved (`Segment::project`).
 
 use crate::converter::dynamics::{ConverterDynamics, Mat4, Vec4, FLOW, PUMP, STATOR, TURBINE};
 use crate::engine::converter_events::{self, ConverterRoot, EventKind, LockupSample, Mode, Sample, SampleConstants};

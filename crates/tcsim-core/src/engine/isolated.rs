@@ -290,7 +290,7 @@ const STEADY_SCALE_RAD_S: f64 = 1.0;
 ///
 /// A steady state is homogeneous in speed: the speeds and the flow scale with a factor `s`, the
 /// torques with `s²` (the table's `CF(SR)·ω_p|ω_p|`, Hrovat & Tobler's `q ∝ ω_p`). So below
-/// [`STEADY_SCALE_RAD_S`] the state is solved at the speeds scaled to it and scaled back (a speed
+/// `STEADY_SCALE_RAD_S` the state is solved at the speeds scaled to it and scaled back (a speed
 /// ratio of two tiny speeds is as well-conditioned as of two large ones), and at rest (both
 /// speeds exactly 0) it is the limit of that scaling, all zero, whatever the model.
 pub fn steady_point_scaled(model: &dyn ConverterDynamics, wp: f64, wt: f64) -> CoreResult<SteadyPoint> {

@@ -20,7 +20,7 @@ pub struct SolverOptions {
     /// tolerances of the results.
     pub hysteresis: Hysteresis,
     /// The most memory a batch's outputs may take, bytes ([`DEFAULT_MAX_OUTPUT_BYTES`]): the
-    /// estimate of [`check_output_size`] is compared with it before anything runs.
+    /// estimate of [`OutputSize::check`] is compared with it before anything runs.
     pub max_output_bytes: f64,
     /// The optional quantities the samples compute (default all): a batch asks only for those its
     /// columns read ([`crate::engine::outputs::Selection::sampled`]).
@@ -181,7 +181,7 @@ pub type NamedState = Vec<(&'static str, f64)>;
 const COORDINATE_NAMES: [&str; 12] =
     ["ω_p", "ω_t", "ω_s", "Q", "ω_o", "ω_f", "ω_r", "v", "θ_f", "θ_r", "T_fast", "T_boost"];
 
-/// `values` named by position ([`COORDINATE_NAMES`], `x` beyond them): the converter's four
+/// `values` named by position (`COORDINATE_NAMES`, `x` beyond them): the converter's four
 /// coordinates then the vehicle's. With `model`, the converter's coordinates the model lacks are left
 /// out and a table model's lag state is named `T_lag` (a table model's error showed `ω_s = 0, Q = 0`,
 /// and a lagged table's lag torque as `Q`).

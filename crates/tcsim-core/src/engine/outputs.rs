@@ -195,7 +195,7 @@ impl RunConstants {
     }
 
     /// Column `c` of [`COLUMNS`] at sample `s` (see [`row`]): the one formula of every column.
-    /// Inlined, so that for a constant `c` only that column's arithmetic remains ([`fill_column`]).
+    /// Inlined, so that for a constant `c` only that column's arithmetic remains (`fill_column!`).
     #[inline(always)]
     pub fn value(&self, c: usize, s: &Sample) -> f64 {
         let coord = |k: usize, v: f64| if self.present[k] { v } else { f64::NAN };
@@ -391,7 +391,7 @@ macro_rules! fill_column {
 /// Write the selected columns of `samples`: `out[k]` (one slice per column of `selection`, in its
 /// order) gets column `selection.indices()[k]` at samples `skip..` (the first `skip` samples are
 /// computed and checked, not stored; every slice is `samples.len() - skip` long). The run's
-/// constants are taken once; each column is one tight loop over the samples ([`fill`]). Returns the
+/// constants are taken once; each column is one tight loop over the samples (`fill`). Returns the
 /// run's [`Overflow`], if any: the check covers the selected columns and the state, at every sample.
 /// Every row of every slice is written ([`OutputRow`]: the slices may be memory not yet written):
 /// the batch's buffers (`batch::run_transient_columns`) and [`columns`] rely on it to set their
