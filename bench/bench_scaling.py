@@ -16,8 +16,7 @@ friction loss drawn per run, drive c, 10 s, SAMPLES samples) in one call with TH
   views of the columnar arrays),
 
 with all 33 columns (``--columns all``) or the 9 columns of the CVODE peer (``--columns peer``,
-``bench/cvode_peer.py`` ``SAMPLE_COLUMNS``,
-its ``loss_power_w`` being ``fluid_loss_power_w``). Printed per configuration (medians over the repeats;
+``bench/cvode_peer.py`` ``TCSIM_COLUMNS``). Printed per configuration (medians over the repeats;
 the configurations take turns within each repeat, so that a change of the machine's load falls on
 all): the wall time of the call and, inside it, of the core call (``_core.transient_batch``: parsing,
 the parallel runs with the GIL released, the arrays), the Python rest, the CPU time of the process
@@ -41,7 +40,7 @@ import numpy as np
 sys.path.insert(0, os.path.dirname(__file__))
 import tcsim.simulation.transient as transient  # noqa: E402
 from bench_transient import batch_models  # noqa: E402
-from cvode_peer import SAMPLE_COLUMNS  # noqa: E402
+from cvode_peer import TCSIM_COLUMNS  # noqa: E402
 from tcsim.models.drives import isolated_takeoff  # noqa: E402
 from tcsim.models.dynamic import dynamic_model  # noqa: E402
 
@@ -65,9 +64,7 @@ def child(runs: int, samples: int, threads: int, path: str, columns: str) -> dic
     transient._core.transient_batch = timed
     models = batch_models(dynamic_model("li-sunden-2016", "hrovat-tobler"), runs)
     drive, times = isolated_takeoff(), np.linspace(0.0, 10.0, samples)
-    # the peer's loss_power_w is tcsim's fluid_loss_power_w
-    peer = [{"loss_power_w": "fluid_loss_power_w"}.get(c, c) for c in SAMPLE_COLUMNS]
-    chosen = peer if columns == "peer" else None
+    chosen = list(TCSIM_COLUMNS) if columns == "peer" else None
     call = transient.simulate_columns if path == "columns" else transient.simulate_batch
     call(models[:20], [drive], times_s=times, threads=threads, columns=chosen)  # warm-up
     core_time.clear()

@@ -29,6 +29,9 @@ SAMPLE_COLUMNS = (
     "stator_torque_nm",
     "loss_power_w",
 )
+#: The same quantities' columns in tcsim (:data:`tcsim.transient.COLUMNS`): what tcsim is asked for
+#: when it is timed against the peer with the same outputs (``simulate(..., columns=TCSIM_COLUMNS)``).
+TCSIM_COLUMNS = tuple({"loss_power_w": "fluid_loss_power_w"}.get(c, c) for c in SAMPLE_COLUMNS)
 
 
 class PeerUnavailable(RuntimeError):

@@ -23,7 +23,7 @@ use tcsim_core::converter::dynamics::{HtDynamics, Inertias};
 use tcsim_core::converter::hrovat_tobler::HtGeometry;
 use tcsim_core::engine::isolated::{simulate, Drive, InitialState, TurbineLoad};
 use tcsim_core::engine::options::SolverOptions;
-use tcsim_core::engine::outputs::{columns, Selection, COLUMNS};
+use tcsim_core::engine::outputs::{columns, Selection};
 use tcsim_core::engine::signal::Signal;
 
 fn median(v: &mut [f64]) -> f64 {
@@ -92,16 +92,26 @@ fn batch(runs: usize, samples: usize, threads: &[usize], columnar: bool) {
     }
 }
 
-/// The 9 columns the C + CVODE peer of `bench/` writes (`bench/cvode_peer.py`), as indices into
-/// [`COLUMNS`]: time, the four coordinates, the three torques and the torque ratio.
-const PEER_COLUMNS: [usize; 9] = [0, 1, 2, 3, 4, 8, 9, 10, 12];
+/// The 9 columns the C + CVODE peer of `bench/` writes (`bench/cvode_peer.py` `SAMPLE_COLUMNS`):
+/// time, the four coordinates, the three torques and the power lost in the fluid.
+const PEER_COLUMNS: [&str; 9] = [
+    "time_s",
+    "pump_speed_rad_s",
+    "turbine_speed_rad_s",
+    "stator_speed_rad_s",
+    "flow_m3_s",
+    "pump_torque_nm",
+    "turbine_torque_nm",
+    "stator_torque_nm",
+    "fluid_loss_power_w",
+];
 
 /// One take-off per call of [`run_transient_columns`] with the peer's columns, as Python's
 /// `simulate(..., columns=...)` runs it without the binding: the median wall time per call.
 fn peer(runs: usize, samples: usize) {
     let (model, drive) = takeoff();
     let t: Vec<f64> = (0..samples).map(|i| 10.0 * i as f64 / (samples - 1) as f64).collect();
-    let selection = Selection::from_names(&PEER_COLUMNS.map(|c| COLUMNS[c])).expect("known columns");
+    let selection = Selection::from_names(&PEER_COLUMNS).expect("known columns");
     let never = std::sync::atomic::AtomicBool::new(false);
     let mut wall = Vec::with_capacity(runs);
     for _ in 0..runs {
