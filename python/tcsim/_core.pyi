@@ -271,6 +271,7 @@ def fmu_event_indicator_variables(model: str) -> list[dict[str, Any]]:
     """FMI 3.0: the event indicators of a model kind as variables (as :func:`fmu_variables`)."""
 
 def time_resolution_s(t: float) -> float: ...
+def check_time_stamps(name: str, time_s: np.ndarray) -> None: ...
 
 # issue 15: the geometry of converter designs (tcsim_core::converter::design)
 def design_geometries(

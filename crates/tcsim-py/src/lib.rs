@@ -1784,6 +1784,17 @@ fn time_resolution_s(t: f64) -> f64 {
     tcsim_core::engine::signal::time_resolution_s(t)
 }
 
+/// The core's check of a run's time stamps or output times (`tcsim_core::engine::signal::
+/// check_time_stamps`): finite, strictly increasing and at least the time resolution apart. A
+/// `CoreInputError` about `name[i]`, the first time at fault (source `drive`).
+#[pyfunction]
+fn check_time_stamps(name: &str, time_s: PyReadonlyArray1<'_, f64>) -> PyResult<()> {
+    guard(|| {
+        tcsim_core::engine::signal::check_time_stamps(name, slice(&time_s, name)?)
+            .map_err(|e| input_error(e.about(InputSource::Drive)))
+    })
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
@@ -1834,6 +1845,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(transient_event_kinds, m)?)?;
     m.add_function(wrap_pyfunction!(output_value_rules, m)?)?;
     m.add_function(wrap_pyfunction!(time_resolution_s, m)?)?;
+    m.add_function(wrap_pyfunction!(check_time_stamps, m)?)?;
     fmu::register(m)?;
     design::register(m)?;
     Ok(())

@@ -278,8 +278,7 @@ def simulate(
             raise InputError.argument("model", model, f"none, or the DynamicModel's own ({m.name!r})")
     else:
         m = dynamic_model(converter, DEFAULT_MODEL if model is None else model)
-    # (the batch's arguments are this function's own: not checked again, :func:`_check_batch`)
-    return _results([m], [drive], times_s, initial, rtol, 1, files, columns, solver_options, checked=True)[0]
+    return _single_run(m, drive, times_s, initial, rtol, files, columns, solver_options)
 
 
 def simulate_batch(
@@ -318,39 +317,71 @@ def _results(
     files: Mapping[str, str] | None,
     columns: Sequence[str] | None,
     solver_options: dict[str, Any],
-    checked: bool = False,
 ) -> list[TransientResult]:
-    """:func:`simulate_batch`; ``checked`` as in :func:`_run_batch`."""
+    """:func:`simulate_batch`."""
     batch = _run_batch(
-        models,
-        drives,
-        times_s,
-        columns,
-        initial,
-        rtol,
-        threads,
-        files,
-        solver_options,
-        shaped=False,
-        every_time=False,
-        checked=checked,
+        models, drives, times_s, columns, initial, rtol, threads, files, solver_options, shaped=False, every_time=False
     )
     try:
         batch.check()
     except InputError as e:
-        if times_s is not None and e.core_source == "drive":  # the core names the output times the drive's
-            for spec in map(_drive_spec, drives):
-                if spec is not None:  # (each is: the run got this far) a time outside its span
-                    _output_times(spec["time_s"], times_s)
-            _check_increasing(_floats_1d(times_s))
+        _blame_times(e, drives, times_s)
         raise
     _warn_about_runs(batch)
-    if columns is not None and len(batch.columns) > len(columns):
-        batch.columns = {name: batch.columns[name] for name in columns}
+    batch.columns = _chosen(batch.columns, columns)
     runs = batch.runs()
     for r in runs:
         r.chosen_columns = columns is not None
     return runs
+
+
+def _single_run(
+    m: DynamicModel,
+    drive: Drive,
+    times_s: Sequence[float] | None,
+    initial: dict[str, float] | None,
+    rtol: float | None,
+    files: Mapping[str, str] | None,
+    columns: Sequence[str] | None,
+    solver_options: dict[str, Any],
+) -> TransientResult:
+    """``simulate_batch([m], [drive], ...)[0]`` without a batch's bookkeeping: the same call of the
+    core, errors, warnings and result, about 4 µs sooner (tests/unit/test_transient_single.py). The
+    arguments are :func:`simulate`'s own, which :func:`_check_batch` would look at again."""
+    spec = _drive_spec(drive)
+    if spec is None:
+        raise InputError.argument("drive", type(drive).__name__, _NOT_A_DRIVE)
+    if times_s is not None:
+        spec["output_time_s"], spec["output_skip"] = _output_times(spec["time_s"], times_s, False)
+    raw = _call_core([m], [spec], initial, rtol, 1, files, columns, solver_options)
+    if raw["failures"]:  # (one run: its one failure)
+        error = _failure(raw["failures"][0], m, "", files)
+        if isinstance(error, InputError):
+            _blame_times(error, [drive], times_s)
+        raise error
+    if m.name in _TABLE_MODELS:  # their warnings read the run's rows as a batch's
+        _warn_about_runs(_batch_columns(raw, [m], None, files, shaped=False))
+    return TransientResult(m.name, _chosen(raw["columns"], columns), _event_list(_raw_events(raw)), columns is not None)
+
+
+def _blame_times(e: InputError, drives: Sequence[Drive], times_s: Sequence[float] | None) -> None:
+    """Raise an :class:`InputError` about the argument ``times_s`` when the core's error ``e`` about
+    a drive came from them: the core names the output times the drive's (a time outside its span,
+    times not increasing or closer than the time resolution)."""
+    if times_s is None or e.core_source != "drive":
+        return
+    for spec in map(_drive_spec, drives):
+        if spec is not None:  # (each is: the run got this far) a time outside its span
+            _output_times(spec["time_s"], times_s)
+    _check_times_argument(_floats_1d(times_s))
+
+
+def _chosen(cols: dict[str, np.ndarray], columns: Sequence[str] | None) -> dict[str, np.ndarray]:
+    """The ``columns`` the caller chose of the core's ``cols``, which has more for a table model
+    (what its warnings read, :func:`_core_columns`)."""
+    if columns is None or len(cols) == len(columns):
+        return cols
+    return {name: cols[name] for name in columns}
 
 
 def _where(i: int, n: int) -> str:
@@ -367,23 +398,31 @@ def _drive_specs(
 ) -> tuple[list[dict], np.ndarray | None]:
     """The drives' dicts for the core (with ``output_time_s`` and ``output_skip`` for ``times_s``) and
     the sample times every run shares, s (None when the drives' time stamps differ). ``every_time``
-    as in :func:`_output_times`."""
+    as in :func:`_output_times`; with it, ``times_s`` are also checked to increase no closer than
+    the time resolution (:func:`_check_times_argument`; without it, :func:`_blame_times` does that
+    once the core has refused them)."""
     if not _is_list(drives):
         raise InputError.argument("drives", drives, "a list of one or more drives")
     specs = []
     for i, d in enumerate(drives):
         s = _drive_spec(d)
         if s is None:
-            expected = "a drive: tcsim.transient.PumpTorqueTurbineSpeed, Speeds or PumpTorqueLoad"
-            raise InputError.argument("drive" if len(drives) == 1 else f"drives[{i}]", type(d).__name__, expected)
+            raise InputError.argument("drive" if len(drives) == 1 else f"drives[{i}]", type(d).__name__, _NOT_A_DRIVE)
         if times_s is not None:
             s["output_time_s"], s["output_skip"] = _output_times(s["time_s"], times_s, every_time)
         specs.append(s)
     if times_s is not None:
-        return specs, _floats_1d(times_s)
+        t = _floats_1d(times_s)
+        if every_time:  # (the times every run shares: checked once, not blamed on each run's drive)
+            _check_times_argument(t)
+        return specs, t
     first = np.asarray(specs[0]["time_s"], dtype=float)
     same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
     return specs, first if same else None
+
+
+#: What an argument that is no drive is expected to be.
+_NOT_A_DRIVE = "a drive: tcsim.transient.PumpTorqueTurbineSpeed, Speeds or PumpTorqueLoad"
 
 
 def _drive_spec(d: Drive) -> dict[str, Any] | None:
@@ -445,8 +484,7 @@ def simulate_columns(
     """
     batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options)
     _warn_about_runs(batch)
-    if columns is not None and len(batch.columns) > len(columns):
-        batch.columns = {name: batch.columns[name] for name in columns}
+    batch.columns = _chosen(batch.columns, columns)
     return batch
 
 
@@ -462,18 +500,30 @@ def _run_batch(
     solver_options: dict[str, Any],
     shaped: bool = True,
     every_time: bool = True,
-    checked: bool = False,
 ) -> BatchColumns:
-    """The one call of the core's ``transient_batch`` (:func:`simulate_columns`), with the columns
-    the warnings read added for table models (:func:`_core_columns`); ``shaped`` as in
-    :func:`_batch_columns`, ``every_time`` as in :func:`_output_times`. ``checked``: the caller made
-    ``models`` (a list of DynamicModel) and ``threads`` itself (:func:`simulate`), which
-    :func:`_check_batch` would look at again."""
-    if not checked:
-        _check_batch(models, drives, threads)
+    """The one call of the core's ``transient_batch`` (:func:`simulate_columns`) after the checks of
+    its arguments; ``shaped`` as in :func:`_batch_columns`, ``every_time`` as in :func:`_output_times`."""
+    _check_batch(models, drives, threads)
     specs, shared_time = _drive_specs(drives, times_s, every_time)
+    raw = _call_core(models, specs, initial, rtol, threads, files, columns, solver_options)
+    return _batch_columns(raw, models, shared_time, files, shaped)
+
+
+def _call_core(
+    models: Sequence[DynamicModel],
+    specs: list[dict],
+    initial: dict[str, float] | None,
+    rtol: float | None,
+    threads: int,
+    files: Mapping[str, str] | None,
+    columns: Sequence[str] | None,
+    solver_options: dict[str, Any],
+) -> dict[str, Any]:
+    """The core's ``transient_batch`` of the drives' ``specs``, with the columns the warnings read
+    added for table models (:func:`_core_columns`); its refusal of an input as an
+    :class:`InputError` naming the file or argument."""
     try:
-        raw = _core.transient_batch(
+        return _core.transient_batch(
             [m.spec for m in models],
             specs,
             initial,
@@ -487,7 +537,6 @@ def _run_batch(
         converters = {m.source for m in models}
         sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
         raise from_core(e, sources) from None
-    return _batch_columns(raw, models, shared_time, files, shaped)
 
 
 def _check_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], threads: int) -> None:
@@ -544,12 +593,16 @@ def _batch_columns(
         cols = {k: v.reshape(n, samples) for k, v in cols.items()}
     if shared_time is not None and not (regular and samples == len(shared_time)):
         shared_time = None
-    events = {k: raw[key] for k, key in _EVENT_KEYS}
-    batch = BatchColumns(models, cols, offsets, shared_time, status, events)
+    batch = BatchColumns(models, cols, offsets, shared_time, status, _raw_events(raw))
     for f in raw["failures"]:
         i = int(f["run"])
         batch.errors[i] = _failure(f, batch._model(i), _where(i, n), files)
     return batch
+
+
+def _raw_events(raw: dict[str, Any]) -> dict[str, np.ndarray]:
+    """The event arrays of the core's ``transient_batch`` result, by :attr:`BatchColumns.events` key."""
+    return {k: raw[key] for k, key in _EVENT_KEYS}
 
 
 def _warn_about_runs(batch: BatchColumns) -> None:
@@ -617,6 +670,17 @@ def _output_times(
             f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
         )
     return np.concatenate(([start], t)), 1
+
+
+def _check_times_argument(t: np.ndarray) -> None:
+    """An :class:`InputError` about the argument ``times_s[i]`` unless the output times ``t`` increase
+    strictly (:func:`_check_increasing`) and are no closer than the time resolution (the core's rule
+    for time stamps, which every run applies to its output times, blaming the drive)."""
+    _check_increasing(t)
+    try:
+        _core.check_time_stamps("times_s", np.ascontiguousarray(t))
+    except _core.CoreInputError as e:
+        raise from_core(e, ARGUMENT) from None
 
 
 def _check_increasing(t: np.ndarray) -> None:
