@@ -14,8 +14,18 @@ import pytest
 
 from tcsim import transient as tr
 from tcsim.errors import InputError
+from tcsim.models.dynamic import NearCouplingWarning
+from tcsim.simulation.transient import output_times
 
-MODELS = ("table", "hrovat-tobler", "quasi-dynamic")
+MODELS = ("table", "hrovat-tobler", "quasi-dynamic", "fragile quasi-dynamic")
+
+
+def _model(name: str) -> tr.DynamicModel:
+    """A bundled model; "fragile quasi-dynamic" has shape effects for which it warns that it may ring
+    near coupling (a ``NearCouplingWarning`` at every run)."""
+    if name == "fragile quasi-dynamic":
+        return tr.dynamic_model("li-sunden-2016", "quasi-dynamic").with_shape_effects(0.015, 0.2)
+    return tr.dynamic_model("li-sunden-2016", name)
 
 
 def _lockup_takeoff() -> tr.PumpTorqueLoad:
@@ -66,7 +76,7 @@ def _assert_same(a: tr.TransientResult, b: tr.TransientResult) -> None:
 )
 @pytest.mark.parametrize("drive", [tr.isolated_takeoff, _lockup_takeoff, _overrun])
 def test_simulate_is_the_batch_of_one_run(name, kw, drive):
-    m = tr.dynamic_model("li-sunden-2016", name)
+    m = _model(name)
     d = drive()
     if drive is _overrun and "times_s" in kw:
         kw = {**kw, "times_s": np.linspace(0.0, 2.0, 5)}
@@ -75,6 +85,21 @@ def test_simulate_is_the_batch_of_one_run(name, kw, drive):
     assert w_one == w_batch
     if drive is _overrun and name != "hrovat-tobler":
         assert any("reached SR 3" in text for _c, text, _f, _l in w_one), "the table models warn of SR 3"
+    if name == "fragile quasi-dynamic":
+        assert any(c is NearCouplingWarning for c, _t, _f, _l in w_one)
+
+
+def test_every_entry_points_warning_comes_from_one_place():
+    """Python's default filter shows a warning once per place: the near-coupling warning of a model
+    run by ``simulate``, ``simulate_batch`` and ``simulate_columns`` is shown once (it came from two
+    places when ``simulate`` left the batch path)."""
+    m, d = _model("fragile quasi-dynamic"), tr.isolated_takeoff()
+    with warnings.catch_warnings(record=True) as w:
+        warnings.simplefilter("default")
+        tr.simulate(m, d)
+        tr.simulate_batch([m], [d])
+        tr.simulate_columns([m, m], [d], columns=["time_s"])
+    assert [x.category for x in w] == [NearCouplingWarning]
 
 
 def _raised(call) -> tuple[type, str, str | None, str | None]:
@@ -102,6 +127,7 @@ FAILURES = {
     "an unknown initial key": ("hrovat-tobler", tr.Speeds(T3, 100.0, 50.0), {"initial": {"pump": 1.0}}),
     "a NaN drive value": ("table", tr.Speeds(T3, np.array([100.0, np.nan, 100.0]), 50.0), {}),
     "no drive": ("table", "not a drive", {}),
+    "one time, at the drive's start": ("hrovat-tobler", tr.Speeds(T3, 100.0, 50.0), {"times_s": [0.0]}),
 }
 
 
@@ -113,8 +139,8 @@ def test_simulate_fails_as_the_batch_of_one_run(case):
     batch = _raised(lambda: tr.simulate_batch([m], [drive], **kw))
     assert one == batch
     assert issubclass(one[0], (InputError, tr.SolverError)), one
-    if "times_s" in kw and case != "an unknown column":
-        assert one[1].startswith("argument: times_s["), "the caller's times are blamed, not the drive's time_s"
+    if "times_s" in kw:
+        assert one[1].startswith("argument: times_s"), "the caller's times are blamed, not the drive's time_s"
 
 
 @pytest.mark.parametrize(
@@ -144,3 +170,21 @@ def test_files_name_the_input_the_core_blamed_in_both():
     one = _raised(lambda: tr.simulate(m, drive, files=files))
     assert one == _raised(lambda: tr.simulate_batch([m], [drive], files=files))
     assert one[1].startswith("log.csv: initial pump_speed_rad_s = 1e+200")
+
+
+@pytest.mark.parametrize(
+    ("times_s", "field"),
+    [
+        ([0.0, 1.5, 1.0], "times_s[2]"),
+        ([0.5, 0.5 + 1e-9], "times_s[1]"),
+        ([0.0], "times_s"),
+        ([0.0, 3.0], "times_s[1]"),
+    ],
+)
+def test_output_times_checks_what_a_run_would_refuse(times_s, field):
+    """``output_times`` (public) refuses what a run refuses about ``times_s``, as its docstring says:
+    before, times that do not increase or are too close were returned as they were."""
+    with pytest.raises(InputError) as e:
+        output_times([0.0, 1.0, 2.0], times_s)
+    assert (e.value.source, e.value.field) == ("argument", field)
+    assert output_times([0.0, 1.0, 2.0], [0.5, 1.0]) == ([0.0, 0.5, 1.0], 1)

@@ -327,8 +327,7 @@ def _results(
     except InputError as e:
         _blame_times(e, drives, times_s)
         raise
-    _warn_about_runs(batch)
-    batch.columns = _chosen(batch.columns, columns)
+    batch.columns = _warned_columns(batch, columns)
     runs = batch.runs()
     for r in runs:
         r.chosen_columns = columns is not None
@@ -346,7 +345,7 @@ def _single_run(
     solver_options: dict[str, Any],
 ) -> TransientResult:
     """``simulate_batch([m], [drive], ...)[0]`` without a batch's bookkeeping: the same call of the
-    core, errors, warnings and result, about 4 µs sooner (tests/unit/test_transient_single.py). The
+    core, errors, warnings and result, about 2 µs sooner (tests/integration/test_single_run.py). The
     arguments are :func:`simulate`'s own, which :func:`_check_batch` would look at again."""
     spec = _drive_spec(drive)
     if spec is None:
@@ -359,9 +358,11 @@ def _single_run(
         if isinstance(error, InputError):
             _blame_times(error, [drive], times_s)
         raise error
-    if m.name in _TABLE_MODELS:  # their warnings read the run's rows as a batch's
-        _warn_about_runs(_batch_columns(raw, [m], None, files, shaped=False))
-    return TransientResult(m.name, _chosen(raw["columns"], columns), _event_list(_raw_events(raw)), columns is not None)
+    if m.name in _TABLE_MODELS:  # only their runs have warnings, which read the run's rows as a batch's
+        cols = _warned_columns(_batch_columns(raw, [m], None, files, shaped=False), columns)
+    else:
+        cols = _chosen(raw["columns"], columns)
+    return TransientResult(m.name, cols, _event_list(_raw_events(raw)), columns is not None)
 
 
 def _blame_times(e: InputError, drives: Sequence[Drive], times_s: Sequence[float] | None) -> None:
@@ -374,6 +375,14 @@ def _blame_times(e: InputError, drives: Sequence[Drive], times_s: Sequence[float
         if spec is not None:  # (each is: the run got this far) a time outside its span
             _output_times(spec["time_s"], times_s)
     _check_times_argument(_floats_1d(times_s))
+
+
+def _warned_columns(batch: BatchColumns, columns: Sequence[str] | None) -> dict[str, np.ndarray]:
+    """The warnings about the batch's finished runs (:func:`_warn_about_runs`), then the columns the
+    caller chose (:func:`_chosen`). Every entry point's warnings come from here, one place, so that
+    Python's filter shows a warning that ``simulate`` and ``simulate_batch`` both give once."""
+    _warn_about_runs(batch)
+    return _chosen(batch.columns, columns)
 
 
 def _chosen(cols: dict[str, np.ndarray], columns: Sequence[str] | None) -> dict[str, np.ndarray]:
@@ -483,8 +492,7 @@ def simulate_columns(
         failed run does not raise here: :meth:`BatchColumns.check` or :meth:`BatchColumns.run` do.
     """
     batch = _run_batch(models, drives, times_s, columns, initial, rtol, threads, files, solver_options)
-    _warn_about_runs(batch)
-    batch.columns = _chosen(batch.columns, columns)
+    batch.columns = _warned_columns(batch, columns)
     return batch
 
 
@@ -633,6 +641,7 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
     start than the engine's time resolution (1 µs, or 1024 ulp of the time) is refused likewise.
     """
     t, skip = _output_times(drive_time_s, times_s)
+    _check_times_argument(t[skip:])
     return t.tolist(), skip
 
 
@@ -661,6 +670,8 @@ def _output_times(
                 f"times_s[{i}]", float(t[i]), f"a time within the drive's span, {start:g} to {end:g} s"
             )
     if t[0] == start:
+        if t.size == 1:  # (a run needs two output times; a later single time gets the start before it)
+            raise InputError.argument("times_s", [start], "two or more output times, or one after the drive's start")
         return t, 0
     resolution = _core.time_resolution_s(start)
     if t[0] - start < (1.0 - 1e-3) * resolution:
