@@ -188,3 +188,22 @@ def test_output_times_checks_what_a_run_would_refuse(times_s, field):
         output_times([0.0, 1.0, 2.0], times_s)
     assert (e.value.source, e.value.field) == ("argument", field)
     assert output_times([0.0, 1.0, 2.0], [0.5, 1.0]) == ([0.0, 0.5, 1.0], 1)
+
+
+@pytest.mark.parametrize("stamps", [["a", "b"], [], [[0.0, 1.0]], 5.0, [0.0, "x"], [3.0]])
+@pytest.mark.parametrize("times_s", [None, [0.0, 0.5]])
+def test_a_drive_without_time_stamps_is_an_input_error_about_them(stamps, times_s):
+    """Before: with ``times_s``, a ValueError, IndexError or TypeError escaped, and a drive of
+    constants with no or one time stamp ran between the output times; the batches failed the same
+    way without ``times_s`` (found by a review)."""
+    m = tr.dynamic_model("li-sunden-2016", "hrovat-tobler")
+    d = tr.Speeds(stamps, 100.0, 50.0)
+    calls = (
+        lambda: tr.simulate(m, d, times_s=times_s),
+        lambda: tr.simulate_batch([m], [d], times_s=times_s),
+        lambda: tr.simulate_columns([m], [d], times_s=times_s).check(),
+    )
+    for call in calls:
+        with pytest.raises(InputError) as e:
+            call()
+        assert (e.value.core_source, e.value.field) == ("drive", "time_s"), str(e.value)

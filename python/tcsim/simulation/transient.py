@@ -425,8 +425,9 @@ def _drive_specs(
         if every_time:  # (the times every run shares: checked once, not blamed on each run's drive)
             _check_times_argument(t)
         return specs, t
-    first = np.asarray(specs[0]["time_s"], dtype=float)
-    same = all(np.array_equal(first, np.asarray(s["time_s"], dtype=float)) for s in specs[1:])
+    stamps = [_time_stamps(s["time_s"]) for s in specs]  # (None where they are no time stamps: the core refuses them)
+    first = stamps[0]
+    same = first is not None and all(s is not None and np.array_equal(first, s) for s in stamps[1:])
     return specs, first if same else None
 
 
@@ -640,6 +641,8 @@ def output_times(drive_time_s: Sequence[float] | float, times_s: Sequence[float]
     the drive's span, else :class:`InputError` about ``times_s[i]``; a first sample closer to the
     start than the engine's time resolution (1 µs, or 1024 ulp of the time) is refused likewise.
     """
+    if _time_stamps(drive_time_s) is None:
+        raise InputError.argument("drive_time_s", drive_time_s, _TIME_STAMPS)
     t, skip = _output_times(drive_time_s, times_s)
     _check_times_argument(t[skip:])
     return t.tolist(), skip
@@ -657,10 +660,13 @@ def _output_times(
         t = _floats_1d(times_s)
     except (TypeError, ValueError):
         raise InputError.argument("times_s", times_s, "output times, s: a list or a 1-D array of numbers") from None
-    span = _floats_1d(drive_time_s)
-    start, end = float(span[0]), float(span[-1])
     if t.ndim != 1 or t.size < 1:
         raise InputError.argument("times_s", f"shape {t.shape}", "a one-dimensional sequence of output times")
+    span = _time_stamps(drive_time_s)
+    if span is None:  # (a drive of constants would run between the output times, its own unread)
+        shown = drive_time_s.tolist() if isinstance(drive_time_s, np.ndarray) else drive_time_s
+        raise InputError("drive", "time_s", shown, _TIME_STAMPS, core_source="drive")
+    start, end = float(span[0]), float(span[-1])
     ends_inside = not every_time and start <= t[0] and t[-1] <= end
     if not ends_inside and not (start <= t.min() and t.max() <= end):  # a time outside the span or NaN
         outside = np.flatnonzero(~np.isfinite(t) | (t < start) | (t > end))
@@ -681,6 +687,20 @@ def _output_times(
             f"the drive's start ({start:g} s) or a time at least {resolution:g} s after it (the time resolution)",
         )
     return np.concatenate(([start], t)), 1
+
+
+#: What a drive's time stamps are expected to be, before they are checked as the core checks them.
+_TIME_STAMPS = "time stamps: a list or a 1-D array of two or more numbers"
+
+
+def _time_stamps(drive_time_s: Any) -> np.ndarray | None:
+    """A drive's time stamps as floats; None unless they are a one-dimensional sequence of two or
+    more numbers (the core's first check of a drive's ``time_s``)."""
+    try:
+        span = np.asarray(drive_time_s, dtype=float)
+    except (TypeError, ValueError):
+        return None
+    return span if span.ndim == 1 and span.size >= 2 else None
 
 
 def _check_times_argument(t: np.ndarray) -> None:
