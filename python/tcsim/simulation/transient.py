@@ -304,21 +304,6 @@ def simulate_batch(
     ``speed_atol_rad_s``, ``flow_atol_m3_s``, ``first_step_s``, ``max_events`` and
     ``max_output_bytes`` (default 2e9: the estimated size of all runs' outputs, counting only the
     chosen columns, is refused above it before anything runs)."""
-    return _results(models, drives, times_s, initial, rtol, threads, files, columns, solver_options)
-
-
-def _results(
-    models: Sequence[DynamicModel],
-    drives: Sequence[Drive],
-    times_s: Sequence[float] | None,
-    initial: dict[str, float] | None,
-    rtol: float | None,
-    threads: int,
-    files: Mapping[str, str] | None,
-    columns: Sequence[str] | None,
-    solver_options: dict[str, Any],
-) -> list[TransientResult]:
-    """:func:`simulate_batch`."""
     batch = _run_batch(
         models, drives, times_s, columns, initial, rtol, threads, files, solver_options, shaped=False, every_time=False
     )
