@@ -92,8 +92,9 @@ fn batch(runs: usize, samples: usize, threads: &[usize], columnar: bool) {
     }
 }
 
-/// The 9 columns the C + CVODE peer of `bench/` writes (`bench/cvode_peer.py` `SAMPLE_COLUMNS`):
-/// time, the four coordinates, the three torques and the power lost in the fluid.
+/// The 9 columns the C + CVODE peer of `bench/` writes, by their tcsim names: time, the four
+/// coordinates, the three torques and the power lost in the fluid. The same list as
+/// `bench/cvode_peer.py` `TCSIM_COLUMNS`, which the Python benchmarks use (keep the two alike).
 const PEER_COLUMNS: [&str; 9] = [
     "time_s",
     "pump_speed_rad_s",
