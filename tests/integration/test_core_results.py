@@ -136,6 +136,21 @@ def test_the_columns_chosen_are_kept_even_when_the_model_lacks_them():
     assert "flow_m3_s" not in full.columns and "time_s" in full.columns  # the default drops what the model lacks
 
 
+@pytest.mark.parametrize("model", ["table", "hrovat-tobler", "quasi-dynamic"])
+@pytest.mark.parametrize("rtol", [1.0, 10.0, 1e6, float("inf")])
+def test_a_relative_tolerance_of_one_or_more_is_refused(model, rtol):
+    """A review: ``rtol=1e6`` ran, and the table model's take-off ended at 3.9e7 rad/s (346 rad/s
+    at the default), without an error or a warning; ``rtol`` 1 and 10 missed by 19–400 rad/s. At
+    ``rtol`` ≥ 1 the error test passes whatever the step. Below 1 a loose tolerance still runs (its
+    accuracy is the caller's choice: 0.5 misses the default run's end by up to 4 %)."""
+    with pytest.raises(InputError) as e:
+        tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model=model, times_s=T, rtol=rtol)
+    assert (e.value.source, e.value.field, e.value.value) == ("solver options", "rtol", rtol)
+    assert e.value.expected.startswith("a finite, positive tolerance" if rtol == float("inf") else "a relative tolerance below 1")
+    loose = tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model=model, times_s=T, rtol=0.5)
+    assert np.isfinite(loose["turbine_speed_rad_s"]).all() and loose["turbine_speed_rad_s"][-1] > 0.0
+
+
 def test_option_errors_name_the_solver_options():
     with pytest.raises(InputError) as e:
         tr.simulate("li-sunden-2016", tr.isolated_takeoff(), model="table", times_s=T, rtol=-1.0)
@@ -145,9 +160,10 @@ def test_option_errors_name_the_solver_options():
     with pytest.raises(InputError) as e:
         run_launch(v, flip_flop(), models, options={"output_step_s": -0.01})
     assert (e.value.source, e.value.field) == ("solver options", "output_step_s")
-    with pytest.raises(InputError) as e:
-        run_launch(v, flip_flop(), models, options={"rtol": 0.0})
-    assert (e.value.source, e.value.field) == ("solver options", "rtol")
+    for rtol in (0.0, 1.0):
+        with pytest.raises(InputError) as e:
+            run_launch(v, flip_flop(), models, options={"rtol": rtol})
+        assert (e.value.source, e.value.field) == ("solver options", "rtol")
 
 
 def test_converter_errors_of_a_launch_name_the_shared_converter_file():

@@ -1102,16 +1102,7 @@ fn options_from(d: Option<&Bound<'_, PyDict>>, extra: &[&str]) -> PyResult<Solve
         let expected = "a finite, positive number of bytes";
         return Err(input_error(CoreError::of(InputSource::Options, "max_output_bytes", o.max_output_bytes, expected)));
     }
-    for (k, v) in [
-        ("rtol", o.rtol),
-        ("speed_atol_rad_s", o.speed_atol_rad_s),
-        ("flow_atol_m3_s", o.flow_atol_m3_s),
-        ("first_step_s", o.first_step_s),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(input_error(CoreError::of(InputSource::Options, k, v, "a finite, positive tolerance")));
-        }
-    }
+    o.check_tolerances().map_err(input_error)?;
     Ok(o)
 }
 

@@ -129,6 +129,34 @@ pub struct Hysteresis {
     pub head_pa: f64,
 }
 
+impl SolverOptions {
+    /// The tolerances and the first step are finite and positive, and the relative tolerance is
+    /// below 1 (at 1 or more the error test passes whatever the step: a take-off at `rtol = 1e6`
+    /// ended at 3.9·10⁷ rad/s, without an error). An error about [`InputSource::Options`] naming the
+    /// first at fault.
+    pub fn check_tolerances(&self) -> CoreResult<()> {
+        for (k, v) in [
+            ("rtol", self.rtol),
+            ("speed_atol_rad_s", self.speed_atol_rad_s),
+            ("flow_atol_m3_s", self.flow_atol_m3_s),
+            ("first_step_s", self.first_step_s),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(CoreError::of(InputSource::Options, k, v, "a finite, positive tolerance"));
+            }
+        }
+        if self.rtol >= 1.0 {
+            return Err(CoreError::of(
+                InputSource::Options,
+                "rtol",
+                self.rtol,
+                "a relative tolerance below 1 (the default is 1e-6)",
+            ));
+        }
+        Ok(())
+    }
+}
+
 impl Default for SolverOptions {
     fn default() -> Self {
         Self {
@@ -198,6 +226,22 @@ pub fn named_state(model: Option<&dyn ConverterDynamics>, values: &[f64]) -> Nam
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tolerances_are_finite_positive_and_rtol_below_one() {
+        assert!(SolverOptions::default().check_tolerances().is_ok());
+        let ok = SolverOptions { rtol: 0.999, ..Default::default() };
+        assert!(ok.check_tolerances().is_ok());
+        for (rtol, expected) in
+            [(1.0, "a relative tolerance below 1"), (1e6, "a relative"), (0.0, "a finite, positive")]
+        {
+            let e = SolverOptions { rtol, ..Default::default() }.check_tolerances().unwrap_err();
+            assert_eq!((e.source, e.field.as_str()), (InputSource::Options, "rtol"));
+            assert!(e.expected.starts_with(expected), "{}", e.expected);
+        }
+        let e = SolverOptions { first_step_s: f64::NAN, ..Default::default() }.check_tolerances().unwrap_err();
+        assert_eq!(e.field, "first_step_s");
+    }
 
     #[test]
     fn the_output_size_is_estimated_and_capped() {
