@@ -100,6 +100,38 @@ def test_ragged_sample_times_give_flat_columns_with_offsets():
     assert [len(r["pump_speed_rad_s"]) for r in runs] == [41, 301] and list(runs[0].columns) == ["pump_speed_rad_s"]
 
 
+def test_a_run_index_counts_from_the_end_when_negative_and_is_refused_out_of_range():
+    """``-1`` is the last run, in every accessor and in both layouts (a ragged batch's flat columns
+    once sliced ``offsets[-1]:offsets[0]``: empty, silently); an index out of range, not an integer,
+    or an unknown column is an InputError naming it (once a bare IndexError or KeyError)."""
+    m = tr.dynamic_model("li-sunden-2016", "quasi-dynamic")
+    short = tr.PumpTorqueLoad(np.linspace(0.0, 2.0, 41), 150.0, load_inertia_kg_m2=1.2, load_torque_nm=10.0)
+    long = tr.PumpTorqueLoad(np.linspace(0.0, 3.0, 301), 200.0, load_inertia_kg_m2=1.2, load_torque_nm=10.0)
+    ragged = tr.simulate_columns([m], [short, long], columns=["time_s", "pump_speed_rad_s"])
+    even = tr.simulate_columns([m], [short, short], columns=["time_s", "pump_speed_rad_s"], times_s=TIMES[:15])
+    for b in (ragged, even):
+        for k in (-1, -2):
+            i = k + len(b)
+            assert np.array_equal(_bits(b.rows("pump_speed_rad_s", k)), _bits(b.rows("pump_speed_rad_s", i)))
+            assert b.rows("time_s", k).size == b.rows("time_s", i).size > 0
+            assert b.run_events(k) == b.run_events(i)
+            assert b.frame(k).equals(b.frame(i))
+        assert b.rows("time_s", np.int64(-1)).size == b.rows("time_s", 1).size
+        for bad in (2, -3, 99, 1.0, True, "0", None):
+            for call in (lambda: b.rows("time_s", bad), lambda: b.run(bad), lambda: b.run_events(bad)):
+                with pytest.raises(InputError) as e:
+                    call()
+                assert (e.value.field, e.value.value) == ("i", bad)
+                assert e.value.expected == "an integer run index from -2 to 1 (the batch has 2 runs)"
+        with pytest.raises(InputError, match=r"^argument: name = 'foo': expected one of the batch's columns: time_s"):
+            b.rows("foo", 0)
+    table = tr.dynamic_model("li-sunden-2016", "table")
+    failed = tr.simulate_columns([table], [short, tr.Speeds([0.0, 1.0], 1e200, 0.0)])
+    with pytest.raises(InputError) as e:
+        failed.run(-1)  # the last run's own error (once a bare KeyError: -1)
+    assert e.value is failed.errors[1]
+
+
 def test_a_failing_run_reports_its_status_and_leaves_the_others_intact():
     table, ht = (tr.dynamic_model("li-sunden-2016", name) for name in ("table", "hrovat-tobler"))
     t = np.array([0.0, 1.0, 2.0])

@@ -22,6 +22,7 @@ stored by the core.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -171,13 +172,29 @@ class BatchColumns:
     def _model(self, i: int) -> DynamicModel:
         return self.models[i if len(self.models) > 1 else 0]
 
+    def _index(self, i: int) -> int:
+        """Run ``i`` as an index from 0: ``-1`` is the last run, as in a sequence; an index out of
+        range, or not an integer, is an :class:`~tcsim.errors.InputError` about ``i``."""
+        n = len(self)
+        try:
+            k = operator.index(i)
+        except TypeError:
+            k = None
+        if k is None or isinstance(i, bool) or not -n <= k < n:
+            raise InputError.argument("i", i, f"an integer run index from {-n} to {n - 1} (the batch has {n} runs)")
+        return k + n if k < 0 else k
+
     def rows(self, name: str, i: int) -> np.ndarray:
-        """Column ``name`` of run ``i`` (a view, no copy)."""
-        col = self.columns[name]
+        """Column ``name`` of run ``i`` (a view, no copy); ``i = -1`` is the last run."""
+        col = self.columns.get(name) if isinstance(name, str) else None
+        if col is None:
+            raise InputError.argument("name", name, f"one of the batch's columns: {', '.join(self.columns)}")
+        i = self._index(i)
         return col[i] if col.ndim == 2 else col[self.offsets[i] : self.offsets[i + 1]]
 
     def run_events(self, i: int) -> list[Event]:
-        """The events of run ``i``."""
+        """The events of run ``i`` (``-1``: the last run)."""
+        i = self._index(i)
         a, b = np.searchsorted(self.events["run"], [i, i + 1])
         return _event_list(self.events, slice(a, b))
 
@@ -194,7 +211,8 @@ class BatchColumns:
 
     def run(self, i: int) -> TransientResult:
         """Run ``i`` as a :class:`TransientResult` (its columns are views of :attr:`columns`); raises
-        the run's error if it failed."""
+        the run's error if it failed. ``i = -1`` is the last run."""
+        i = self._index(i)
         if self.status[i] != RUN_OK:
             raise self.errors[i]
         cols = {name: self.rows(name, i) for name in self.columns}
