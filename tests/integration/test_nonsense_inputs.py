@@ -20,6 +20,7 @@ from tcsim.errors import InputError, TcsimWarning
 from tcsim.io.results import non_finite_columns, write_frames
 from tcsim.models.characteristic import Characteristic
 from tcsim.models.converter import bundled_converters, load_converter
+from tcsim.models.dynamic import dynamic_model
 from tcsim.models.steady import characterise, coupling_point, hrovat_tobler_steady_state
 
 BUNDLED = resources.files("tcsim") / "data" / "converters" / "li-sunden-2016.toml"
@@ -54,10 +55,28 @@ def test_the_closed_form_steady_state_refuses_bad_arguments_as_input_errors():
         ((np.atleast_2d(g)[:, :5], [200.0], [0.0]), {}, "geometry"),
         ((g, ["a"], [0.0]), {}, "pump_speed_rad_s"),
         ((g, [200.0], [0.0]), {"threads": -1}, "threads"),
+        # a review: these were bare ValueErrors and a TypeError from the binding
+        ((g, [100.0, 200.0], [0.0, 1.0, 2.0]), {}, "turbine_speed_rad_s"),
+        ((np.zeros((0, g.size)), [200.0], [0.0]), {}, "geometry"),
+        ((np.tile(g, (2, 1)), [100.0, 200.0, 300.0], [0.0, 1.0, 2.0]), {}, "geometry"),
+        ((g.reshape(1, 1, -1), [200.0], [0.0]), {}, "geometry"),
+        ((g, [1.0], [0.0]), {"strict": "no"}, "strict"),
     ]:
         with pytest.raises(InputError) as e:
             hrovat_tobler_steady_state(*args, **kwargs)
         assert (e.value.source, e.value.field) == ("argument", field), str(e.value)
+
+
+def test_the_closed_form_steady_state_broadcasts_a_speed_against_an_array():
+    """As :func:`steady_state` does: one pump speed with several turbine speeds (a review: it was a
+    ValueError, "equal lengths")."""
+    g = load_converter("li-sunden-2016").core_geometry()
+    wt = np.array([0.0, 50.0, 100.0])
+    one = hrovat_tobler_steady_state(g, 200.0, wt)
+    each = hrovat_tobler_steady_state(g, np.full(3, 200.0), wt)
+    assert all(np.array_equal(one[k], each[k]) for k in each) and one["pump_torque_nm"].shape == (3,)
+    rows = hrovat_tobler_steady_state(np.tile(g, (3, 1)), 200.0, wt)
+    assert all(np.array_equal(rows[k], each[k]) for k in each)
 
 
 @pytest.mark.parametrize("model", ["hrovat-tobler", "table", "quasi-dynamic"])
@@ -236,3 +255,30 @@ def test_a_table_made_in_python_runs_like_the_files():
 
 def test_the_coupling_point_of_a_bundled_name_is_that_of_its_converter():
     assert coupling_point("li-sunden-2016") == coupling_point(load_converter("li-sunden-2016"))
+
+
+def test_a_converter_that_is_not_a_name_or_a_path_is_an_input_error():
+    """A review: ``coupling_point(None)`` and ``load_converter(123)`` were bare TypeErrors of
+    ``Path``; ``steady_state(None, ...)`` already named the argument."""
+    for call in (lambda: coupling_point(None), lambda: load_converter(123), lambda: load_converter(["a"])):
+        with pytest.raises(InputError) as e:
+            call()
+        assert (e.value.source, e.value.field) == ("argument", "converter")
+        assert e.value.expected.startswith("a bundled converter's name")
+
+
+def test_other_shape_effects_are_numbers_of_a_model_that_has_them():
+    """A review: the table model's ``with_shape_effects`` was a bare ValueError, a string a
+    ValueError of ``float`` and None a TypeError."""
+    table = dynamic_model("li-sunden-2016", "table")
+    with pytest.raises(InputError) as e:
+        table.with_shape_effects(0.001, 0.001)
+    assert (e.value.field, e.value.value) == ("model", "table")
+    ht = dynamic_model("li-sunden-2016", "hrovat-tobler")
+    for args, field in [(("a", 0.0), "pump_m2"), ((0.0, None), "turbine_m2"), ((0.0, 0.0, True), "stator_m2")]:
+        with pytest.raises(InputError) as e:
+            ht.with_shape_effects(*args)
+        assert (e.value.source, e.value.field) == ("argument", field)
+    other = ht.with_shape_effects(np.float64(0.001), 0.002)
+    assert other.shape_effect_m2 == (0.001, 0.002, ht.shape_effect_m2[2])
+    assert all(type(v) is float for v in other.spec["shape_effect_m2"])

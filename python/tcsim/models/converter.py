@@ -8,6 +8,7 @@ sections and keys are those of ``conventions.md``; each model needs only its own
 from __future__ import annotations
 
 import math
+import os
 import tomllib
 from dataclasses import dataclass, field
 from importlib import resources
@@ -431,6 +432,9 @@ def bundled_converters() -> list[Converter]:
 
 def load_converter(spec: str | Path) -> Converter:
     """A bundled name, a converter TOML, or a characteristic table (.csv, .vtcc)."""
+    if not isinstance(spec, str | os.PathLike):
+        expected = "a bundled converter's name (tcsim.bundled_names()) or a file path"
+        raise InputError.argument("converter", type(spec).__name__, expected)
     text = str(spec)
     if isinstance(spec, str) and text in bundled_names():
         with resources.as_file(_bundled_dir() / f"{text}.toml") as p:

@@ -14,6 +14,7 @@ import numpy as np
 from .. import _core
 from ..errors import InputError, TcsimWarning, from_core
 from ..units import DEFAULT_PUMP_SPEED_RAD_S
+from .arguments import real_number
 from .characteristic import extension_message, extension_reached, warn_if_extended
 from .converter import MODELS, Converter, load_converter
 
@@ -95,11 +96,11 @@ class DynamicModel:
     def with_shape_effects(self, pump_m2: float, turbine_m2: float, stator_m2: float | None = None) -> DynamicModel:
         """The same model with other shape effects (eqs 2.16–2.18 sign convention)."""
         if self.name == "table":
-            raise ValueError("the table model has no shape effects")
-        shape = [pump_m2, turbine_m2]
+            raise InputError.argument("model", self.name, "a model with shape effects: hrovat-tobler or quasi-dynamic")
+        shape = [real_number("pump_m2", pump_m2), real_number("turbine_m2", turbine_m2)]
         if self.name == "hrovat-tobler":
-            shape.append(self.shape_effect_m2[2] if stator_m2 is None else stator_m2)
-        return replace(self, spec={**self.spec, "shape_effect_m2": [float(s) for s in shape]})
+            shape.append(self.shape_effect_m2[2] if stator_m2 is None else real_number("stator_m2", stator_m2))
+        return replace(self, spec={**self.spec, "shape_effect_m2": shape})
 
 
 def _and_list(words: Sequence[str]) -> str:

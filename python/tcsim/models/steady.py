@@ -13,6 +13,7 @@ Each returns a :class:`pandas.DataFrame` with the columns of ``characteristic.cs
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -190,12 +191,17 @@ def hrovat_tobler_steady_state(
     so smaller batches run on fewer threads); the results do not depend on it.
     """
     names = _core.ht_parameter_names()
-    geometry = np.ascontiguousarray(np.atleast_2d(float_array("geometry", geometry)))
-    wp = np.ascontiguousarray(float_array("pump_speed_rad_s", pump_speed_rad_s).reshape(-1))
-    wt = np.ascontiguousarray(float_array("turbine_speed_rad_s", turbine_speed_rad_s).reshape(-1))
-    if geometry.shape[1] != len(names):
-        expected = f"rows of the {len(names)} core parameters ({', '.join(names)})"
-        raise InputError.argument("geometry", f"{geometry.shape[1]} columns", expected)
+    geometry = np.atleast_2d(float_array("geometry", geometry))
+    if geometry.ndim != 2 or geometry.shape[1] != len(names):
+        expected = f"one row, or one per point, of the {len(names)} core parameters ({', '.join(names)})"
+        raise InputError.argument("geometry", f"shape {geometry.shape}", expected)
+    wp, wt = _speed_pairs(pump_speed_rad_s, turbine_speed_rad_s)
+    if len(geometry) not in (1, wp.size):
+        expected = f"one row, or one per point ({wp.size} points)"
+        raise InputError.argument("geometry", f"{len(geometry)} rows", expected)
+    if not isinstance(strict, (bool, np.bool_)):
+        raise InputError.argument("strict", strict, "True or False")
+    geometry = np.ascontiguousarray(geometry)
     threads = worker_count(threads)
     try:
         return _core.ht_steady_states(geometry, wp, wt, strict, threads)
@@ -204,6 +210,20 @@ def hrovat_tobler_steady_state(
         if source == "converter":  # a parameter of the geometry: named in what is expected
             field, expected = "geometry", f"{field}: {expected}"
         raise InputError.argument(field, core_value(value), expected, core_source=source) from None
+
+
+def _speed_pairs(pump_speed_rad_s: Any, turbine_speed_rad_s: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The pump and turbine speeds as two flat arrays of one length, broadcast against each other
+    (a scalar with an array, as :func:`steady_state` does); shapes that do not broadcast are an
+    :class:`InputError` about the turbine speeds."""
+    wp = float_array("pump_speed_rad_s", pump_speed_rad_s)
+    wt = float_array("turbine_speed_rad_s", turbine_speed_rad_s)
+    try:
+        wp, wt = np.broadcast_arrays(wp, wt)
+    except ValueError:
+        expected = f"a shape that broadcasts with the pump speeds' {wp.shape}"
+        raise InputError.argument("turbine_speed_rad_s", f"shape {wt.shape}", expected) from None
+    return np.ascontiguousarray(wp.reshape(-1)), np.ascontiguousarray(wt.reshape(-1))
 
 
 def steady_torque_ratio(out: dict[str, np.ndarray]) -> np.ndarray:
