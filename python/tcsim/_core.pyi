@@ -272,6 +272,9 @@ def fmu_event_indicator_variables(model: str) -> list[dict[str, Any]]:
 
 def time_resolution_s(t: float) -> float: ...
 def check_time_stamps(name: str, time_s: np.ndarray) -> None: ...
+def ignored_initial(
+    model: dict[str, Any], drive: dict[str, Any], initial: dict[str, float]
+) -> list[tuple[str, str]]: ...
 
 # issue 15: the geometry of converter designs (tcsim_core::converter::design)
 def design_geometries(

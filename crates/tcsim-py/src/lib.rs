@@ -36,7 +36,7 @@ use tcsim_core::converter::hrovat_tobler::{
 use tcsim_core::converter::table::{Characteristic, TableOperatingPoint};
 use tcsim_core::converter::torque_capacity::TorqueCharacteristic;
 use tcsim_core::engine::converter_events::EventKind;
-use tcsim_core::engine::isolated::{Drive, InitialState, TurbineLoad};
+use tcsim_core::engine::isolated::{Drive, IgnoredInitial, InitialState, TurbineLoad};
 use tcsim_core::engine::lockup::LockupCommand;
 use tcsim_core::engine::options::{SolverOptions, TransientError};
 use tcsim_core::engine::outputs::{isolated_output_size, Selection, COLUMNS, INFINITE_ALLOWED, NAN_NOT_EXPECTED};
@@ -1786,6 +1786,26 @@ fn check_time_stamps(name: &str, time_s: PyReadonlyArray1<'_, f64>) -> PyResult<
     })
 }
 
+/// The values of `initial` that a run of `model` under `drive` (the dicts of `transient_batch`)
+/// does not use ([`InitialState::ignored`]): `(name, why)` pairs, `why` being `"drive"` (the drive
+/// gives that speed) or `"model"` (the model has no such state).
+#[pyfunction]
+fn ignored_initial(
+    model: &Bound<'_, PyDict>,
+    drive: &Bound<'_, PyDict>,
+    initial: &Bound<'_, PyDict>,
+) -> PyResult<Vec<(&'static str, &'static str)>> {
+    guard(|| {
+        let m = model_from(model)?;
+        let (d, _) = drive_from(drive)?;
+        let why = |w| match w {
+            IgnoredInitial::GivenByDrive => "drive",
+            IgnoredInitial::NotAState => "model",
+        };
+        Ok(init_from(Some(initial))?.ignored(m.as_ref(), &d).into_iter().map(|(k, w)| (k, why(w))).collect())
+    })
+}
+
 #[pymodule]
 fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("CoreInputError", m.py().get_type::<CoreInputError>())?;
@@ -1837,6 +1857,7 @@ fn _core(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(output_value_rules, m)?)?;
     m.add_function(wrap_pyfunction!(time_resolution_s, m)?)?;
     m.add_function(wrap_pyfunction!(check_time_stamps, m)?)?;
+    m.add_function(wrap_pyfunction!(ignored_initial, m)?)?;
     fmu::register(m)?;
     design::register(m)?;
     Ok(())

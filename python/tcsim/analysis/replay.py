@@ -125,7 +125,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import pandas as pd
 
-from ..errors import InputError, TcsimWarning
+from ..errors import InputError
 from ..models import drives
 from ..models.converter import Converter
 from ..models.drives import DERIVATIVE_WINDOW_S, Drive
@@ -137,8 +137,8 @@ from .effective import measured_effective_torques
 
 #: Default width of the consecutive metric windows, s.
 METRICS_WINDOW_S = 1.0
-#: Keys of ``--initial``.
-INITIAL_KEYS: tuple[str, ...] = ("pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s")
+#: Keys of ``--initial``: those of the API's ``initial``.
+INITIAL_KEYS = transient.INITIAL_KEYS
 METRIC_COLUMNS = [
     "model",
     "channel",
@@ -261,18 +261,6 @@ def check_record_windows(meas: Measurement, window_s: float | None, metrics_wind
 # runs
 
 
-def _warn_ignored_initial(initial: dict[str, float], drive: DriveKind, models: Sequence[DynamicModel]) -> None:
-    for key in initial:
-        if key in drive.inputs:
-            warnings.warn(f"--initial {key} is ignored: drive {drive.name} prescribes it", TcsimWarning, stacklevel=3)
-    lacking = {"table": ("stator_speed_rad_s", "flow_m3_s"), "quasi-dynamic": ("stator_speed_rad_s",)}
-    for m in models:
-        for key in set(initial) & set(lacking.get(m.name, ())):
-            warnings.warn(
-                f"--initial {key} is ignored by the {m.name} model (it has no such state)", TcsimWarning, stacklevel=3
-            )
-
-
 def run_models(
     models: Sequence[DynamicModel], drive: Drive, initial: dict[str, float] | None = None, drive_file: str = "drive"
 ) -> dict[str, transient.TransientResult]:
@@ -291,8 +279,14 @@ def run_models(
                     field = f"--{e.field}"
                     raise InputError("command line", field, e.value, e.expected, core_source="initial") from None
                 raise
-    for w in caught:
-        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    shown = set()
+    for w in caught:  # a value of --initial that a run ignores: once, named as on the command line
+        text = str(w.message)
+        if text.startswith("initial ") and " is ignored" in text:
+            text = f"--{text}"
+        if text not in shown:
+            shown.add(text)
+            warnings.warn_explicit(text, w.category, w.filename, w.lineno)
     return results
 
 
@@ -477,7 +471,6 @@ def replay_measurement(
     if metrics_window_s is not None:
         metrics_window_s = check_window("--metrics-window", metrics_window_s, positive=True)
     dyn = select_models(conv, models)
-    _warn_ignored_initial(initial or {}, kind, dyn)
     results = run_models(dyn, kind.make(meas, window_s), initial, meas.source)
     inertia = dyn[0].spec["inertia_kg_m2"]
     effective = {

@@ -23,6 +23,7 @@ stored by the core.
 from __future__ import annotations
 
 import operator
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -31,13 +32,15 @@ import numpy as np
 import pandas as pd
 
 from .. import _core
-from ..errors import ARGUMENT, InputError, core_input_error, from_core
+from ..errors import ARGUMENT, InputError, TcsimWarning, core_input_error, from_core
 from ..models.arguments import worker_count
 from ..models.converter import Converter
 from ..models.drives import Drive
 from ..models.dynamic import DynamicModel, dynamic_model
 
 COLUMNS: tuple[str, ...] = tuple(_core.transient_columns())
+#: The names of ``initial``'s values (a run's coordinates).
+INITIAL_KEYS: tuple[str, ...] = ("pump_speed_rad_s", "turbine_speed_rad_s", "stator_speed_rad_s", "flow_m3_s")
 
 
 class SolverError(RuntimeError):
@@ -534,6 +537,8 @@ def _call_core(
     """The core's ``transient_batch`` of the drives' ``specs``, with the columns the warnings read
     added for table models (:func:`_core_columns`); its refusal of an input as an
     :class:`InputError` naming the file or argument."""
+    if initial is not None:
+        _warn_ignored_initial(models, specs, initial)
     try:
         return _core.transient_batch(
             [m.spec for m in models],
@@ -549,6 +554,34 @@ def _call_core(
         converters = {m.source for m in models}
         sources = {"converter": converters.pop() if len(converters) == 1 else "model", **(files or {})}
         raise from_core(e, sources) from None
+
+
+def _warn_ignored_initial(models: Sequence[DynamicModel], specs: list[dict], initial: Any) -> None:
+    """A :class:`TcsimWarning` for each value of ``initial`` that a run does not use (the core's
+    ``InitialState::ignored``): a speed its drive gives, or a state its model lacks. ``initial``
+    that is not a dict is an :class:`InputError`; its other faults (a misspelt name, a value not a
+    number), and a drive's, are the run's to report."""
+    if not isinstance(initial, Mapping):
+        expected = f"a dict of initial values by name: {', '.join(INITIAL_KEYS)}"
+        raise InputError("initial state", "initial", type(initial).__name__, expected)
+    seen: set[tuple[str, str, str]] = set()
+    asked: set[tuple[int, str]] = set()  # what is ignored depends on the model and the drive's kind only
+    for i, spec in enumerate(specs):
+        m = models[i if len(models) > 1 else 0]
+        if (id(m), spec["kind"]) in asked:
+            continue
+        asked.add((id(m), spec["kind"]))
+        try:
+            ignored = _core.ignored_initial(m.spec, spec, dict(initial))
+        except (_core.CoreInputError, TypeError, ValueError):
+            return
+        for key, why in ignored:
+            why_not = f": the drive prescribes it ({spec['kind']})"
+            if why == "model":
+                why_not = f" by the {m.name} model: it has no such state"
+            if (key, why, m.name) not in seen:
+                seen.add((key, why, m.name))
+                warnings.warn(f"initial {key} is ignored{why_not}", TcsimWarning, stacklevel=4)
 
 
 def _check_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], threads: int) -> None:

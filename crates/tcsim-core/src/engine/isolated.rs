@@ -57,6 +57,40 @@ pub struct InitialState {
     pub flow_m3_s: Option<f64>,
 }
 
+/// Why a run ignores a value of its [`InitialState`] ([`InitialState::ignored`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum IgnoredInitial {
+    /// The drive gives this speed: the run starts at the drive's first sample of it.
+    GivenByDrive,
+    /// The model has no such state (the table model's stator speed and flow, the quasi-dynamic
+    /// model's stator speed), or the coordinate holds the table model's lag state, which starts at
+    /// its steady value.
+    NotAState,
+}
+
+impl InitialState {
+    /// The values given here that a run of `model` under `drive` does not use, by coordinate name
+    /// (`pump_speed_rad_s`, ...), with why: the rules of [`initial_state`], which silently passes
+    /// over them.
+    pub fn ignored(&self, model: &dyn ConverterDynamics, drive: &Drive) -> Vec<(&'static str, IgnoredInitial)> {
+        let present = model.coordinates();
+        let given = [self.pump_speed_rad_s, self.turbine_speed_rad_s, self.stator_speed_rad_s, self.flow_m3_s];
+        (0..4)
+            .filter(|&c| given[c].is_some())
+            .filter_map(|c| {
+                let why = if drive.given(c).is_some() {
+                    IgnoredInitial::GivenByDrive
+                } else if !present[c] || (c == FLOW && model.lag_state()) {
+                    IgnoredInitial::NotAState
+                } else {
+                    return None;
+                };
+                Some((COORDINATES[c], why))
+            })
+            .collect()
+    }
+}
+
 /// An event: time, kind and the mode after it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Event {
