@@ -275,7 +275,9 @@ def test_other_shape_effects_are_numbers_of_a_model_that_has_them():
         table.with_shape_effects(0.001, 0.001)
     assert (e.value.field, e.value.value) == ("model", "table")
     ht = dynamic_model("li-sunden-2016", "hrovat-tobler")
-    for args, field in [(("a", 0.0), "pump_m2"), ((0.0, None), "turbine_m2"), ((0.0, 0.0, True), "stator_m2")]:
+    bad = [(("a", 0.0), "pump_m2"), ((0.0, None), "turbine_m2"), ((0.0, 0.0, True), "stator_m2")]
+    bad += [((np.nan, 0.0), "pump_m2"), ((0.0, np.inf), "turbine_m2"), ((0.0, 0.0, -np.inf), "stator_m2")]
+    for args, field in bad:
         with pytest.raises(InputError) as e:
             ht.with_shape_effects(*args)
         assert (e.value.source, e.value.field) == ("argument", field)

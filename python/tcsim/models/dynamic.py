@@ -4,6 +4,7 @@ See ``docs/transient.md``."""
 
 from __future__ import annotations
 
+import math
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
@@ -97,9 +98,13 @@ class DynamicModel:
         """The same model with other shape effects (eqs 2.16–2.18 sign convention)."""
         if self.name == "table":
             raise InputError.argument("model", self.name, "a model with shape effects: hrovat-tobler or quasi-dynamic")
-        shape = [real_number("pump_m2", pump_m2), real_number("turbine_m2", turbine_m2)]
+        given = {"pump_m2": pump_m2, "turbine_m2": turbine_m2}
         if self.name == "hrovat-tobler":
-            shape.append(self.shape_effect_m2[2] if stator_m2 is None else real_number("stator_m2", stator_m2))
+            given["stator_m2"] = self.shape_effect_m2[2] if stator_m2 is None else stator_m2
+        shape = [real_number(name, v) for name, v in given.items()]
+        for name, v in zip(given, shape):
+            if not math.isfinite(v):  # (the core would name the converter file's field)
+                raise InputError.argument(name, v, "a finite shape effect in m²")
         return replace(self, spec={**self.spec, "shape_effect_m2": shape})
 
 

@@ -192,7 +192,10 @@ class BatchColumns:
         col = self.columns.get(name) if isinstance(name, str) else None
         if col is None:
             raise InputError.argument("name", name, f"one of the batch's columns: {', '.join(self.columns)}")
-        i = self._index(i)
+        return self._run_rows(col, self._index(i))
+
+    def _run_rows(self, col: np.ndarray, i: int) -> np.ndarray:
+        """Run ``i``'s rows (an index from 0) of the column ``col``, in either layout."""
         return col[i] if col.ndim == 2 else col[self.offsets[i] : self.offsets[i + 1]]
 
     def run_events(self, i: int) -> list[Event]:
@@ -218,7 +221,7 @@ class BatchColumns:
         i = self._index(i)
         if self.status[i] != RUN_OK:
             raise self.errors[i]
-        cols = {name: self.rows(name, i) for name in self.columns}
+        cols = {name: self._run_rows(col, i) for name, col in self.columns.items()}
         return TransientResult(self._model(i).name, cols, self.run_events(i))
 
     def frame(self, i: int) -> pd.DataFrame:
@@ -564,7 +567,7 @@ def _warn_ignored_initial(models: Sequence[DynamicModel], specs: list[dict], ini
     if not isinstance(initial, Mapping):
         expected = f"a dict of initial values by name: {', '.join(INITIAL_KEYS)}"
         raise InputError("initial state", "initial", type(initial).__name__, expected)
-    seen: set[tuple[str, str, str]] = set()
+    shown: set[str] = set()
     asked: set[tuple[int, str]] = set()  # what is ignored depends on the model and the drive's kind only
     for i, spec in enumerate(specs):
         m = models[i if len(models) > 1 else 0]
@@ -574,14 +577,15 @@ def _warn_ignored_initial(models: Sequence[DynamicModel], specs: list[dict], ini
         try:
             ignored = _core.ignored_initial(m.spec, spec, dict(initial))
         except (_core.CoreInputError, TypeError, ValueError):
-            return
+            continue  # an error of the drive or the model: the core call below reports it
         for key, why in ignored:
             why_not = f": the drive prescribes it ({spec['kind']})"
             if why == "model":
                 why_not = f" by the {m.name} model: it has no such state"
-            if (key, why, m.name) not in seen:
-                seen.add((key, why, m.name))
-                warnings.warn(f"initial {key} is ignored{why_not}", TcsimWarning, stacklevel=4)
+            message = f"initial {key} is ignored{why_not}"
+            if message not in shown:
+                shown.add(message)
+                warnings.warn(message, TcsimWarning, stacklevel=4)
 
 
 def _check_batch(models: Sequence[DynamicModel], drives: Sequence[Drive], threads: int) -> None:
